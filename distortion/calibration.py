@@ -1,0 +1,353 @@
+"""Calibrated distortion (Pestrecov 1958, Section IV, Eqs. 10–15).
+
+A calibration replaces the paraxial constant of orthoscopy K0 (F0 in mm for an object at infinity,
+M0 for finite conjugates) by a calibrated constant Kc (F_c or M_c). Nothing physical changes: the
+actual image sizes ``y' = y0' + D0`` stay the same. With ``x = tan α`` (or the object height y):
+
+- calibrated image size    ``y_c' = Kc·x``
+- calibrated linear        ``D_c = y' − Kc·x = D0 − (Kc/K0 − 1)·y0'``           Eqs. (10)–(12)
+- rotation of the axis     ``tan ρ = Kc/K0 − 1``; with plot exaggeration k, ``tan ρ_k = k·tan ρ``
+                                                                                 Eqs. (13)–(14)
+- calibrated relative      ``D_rc = Dr·K0/Kc + (K0/Kc − 1)``; on the axis ``K0/Kc − 1`` ≠ 0
+                                                                                 Eq. (15)
+
+``D_c`` is linear in Kc, so every criterion is a one-parameter fit of a line through the origin
+``y' ≈ Kc·x`` (:func:`fit_scale`), which :mod:`distortion.compensation` reuses.
+
+Criteria (``CRITERIA``):
+
+- ``two-point``: equal magnitude and opposite sign of D_c at two chosen fields (the paper's
+  example, 37.5° and 45°): ``Kc = (y'_a + y'_b)/(x_a + x_b)``.
+- ``minimax``: the smallest maximum |D_c| over the curve's field points: the exact Chebyshev
+  best approximation by a line through the origin, solved as a linear program and polished to the
+  intersection of the two active lines (not by sampling candidates).
+- ``least-squares``: minimum Σ D_c² over the field points (normal equation ``Σ x y' / Σ x²``).
+- ``zero-at``: D_c = 0 at one chosen off-axis field: ``Kc = y'_a / x_a``.
+- ``given``: a user-supplied Kc.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from raytrace.errors import DataError
+
+from .tables import DistortionCurve, format_columns
+
+CRITERIA = ("two-point", "minimax", "least-squares", "zero-at", "given")
+
+
+class CalibrationError(DataError, ValueError):
+    """An impossible calibration request (unknown criterion, a field not in the curve, too few
+    points, a degenerate fit). A :class:`DataError` and a :class:`ValueError`."""
+
+
+def _match_fields(fields: np.ndarray, at, what: str) -> list[int]:
+    lo, hi = float(np.min(fields)), float(np.max(fields))
+    span = max(abs(lo), abs(hi), 1.0)
+    idx = []
+    listing = ", ".join(f"{v:g}" for v in fields)
+    for a in at:
+        a = float(a)
+        if not math.isfinite(a):
+            raise CalibrationError(f"{what}: field {a!r} is not a finite number")
+        hit = np.nonzero(np.abs(fields - a) <= 1e-9 * span)[0]
+        if hit.size:
+            idx.append(int(hit[0]))
+            continue
+        if a < lo - 1e-9 * span or a > hi + 1e-9 * span:
+            raise CalibrationError(
+                f"{what}: field {a:g} is outside the curve's fields ({lo:g} … {hi:g})"
+            )
+        raise CalibrationError(
+            f"{what}: field {a:g} is not one of the curve's field points ({listing}); "
+            "choose one of them (or trace the curve with that field included)"
+        )
+    return idx
+
+
+def _minimax(x: np.ndarray, r: np.ndarray) -> float:
+    """Exact argmin over K of max_i |r_i − K x_i| (Chebyshev fit of a line through the origin).
+
+    Linear program (variables K, t; minimise t subject to ±(r_i − K x_i) ≤ t) solved by HiGHS,
+    then polished: the optimum of this convex piecewise-linear function of K is the intersection
+    of an active decreasing line and an active increasing line, computed in closed form.
+    """
+    from scipy.optimize import linprog
+
+    n = x.size
+    scale = float(np.max(np.abs(x)))
+    xs = x / scale  # K' = K*scale keeps the LP well conditioned
+    A = np.zeros((2 * n, 2))
+    A[:n, 0], A[:n, 1] = -xs, -1.0  # r - K x <= t  ->  -x K - t <= -r
+    A[n:, 0], A[n:, 1] = xs, -1.0  # -(r - K x) <= t ->  x K - t <= r
+    b = np.concatenate([-r, r])
+    res = linprog([0.0, 1.0], A_ub=A, b_ub=b, bounds=[(None, None), (0.0, None)], method="highs")
+    if not res.success:  # pragma: no cover - an LP this small always solves
+        raise CalibrationError(f"minimax calibration failed: {res.message}")
+    K = float(res.x[0]) / scale
+
+    def worst(k: float) -> float:
+        return float(np.max(np.abs(r - k * x)))
+
+    best, bestv = K, worst(K)
+    e = r - K * x
+    m = np.max(np.abs(e))
+    active = np.nonzero(np.abs(np.abs(e) - m) <= 1e-7 * max(m, 1e-300) + 1e-15)[0]
+    # slope of |e_i| as a function of K at the active set: -x_i sign(e_i)
+    dec = [i for i in active if -x[i] * np.sign(e[i]) < 0]
+    inc = [i for i in active if -x[i] * np.sign(e[i]) > 0]
+    for i in dec:
+        for j in inc:
+            # sign(e_i)(r_i - K x_i) = sign(e_j)(r_j - K x_j)
+            si, sj = np.sign(e[i]), np.sign(e[j])
+            den = si * x[i] - sj * x[j]
+            if den != 0.0:
+                k = float((si * r[i] - sj * r[j]) / den)
+                v = worst(k)
+                if v <= bestv:
+                    best, bestv = k, v
+    return best
+
+
+def fit_scale(
+    x: np.ndarray,
+    r: np.ndarray,
+    criterion: str,
+    *,
+    idx: list[int] | None = None,
+    given: float | None = None,
+) -> float:
+    """The scale K of the line ``r ≈ K·x`` by a calibration criterion (see module docstring).
+
+    ``idx`` are the indices of the chosen fields for ``two-point`` (two) and ``zero-at`` (one).
+    Raises :class:`CalibrationError` for an unknown criterion or a degenerate request.
+    """
+    x = np.asarray(x, dtype=float)
+    r = np.asarray(r, dtype=float)
+    if criterion not in CRITERIA:
+        raise CalibrationError(
+            f"unknown calibration criterion {criterion!r}; expected one of {', '.join(CRITERIA)}"
+        )
+    if criterion == "given":
+        if given is None or not math.isfinite(given) or given == 0.0:
+            raise CalibrationError("criterion 'given' needs a finite nonzero calibrated constant")
+        return float(given)
+    off = x != 0.0
+    if criterion == "two-point":
+        if idx is None or len(idx) != 2:
+            raise CalibrationError("criterion 'two-point' needs exactly two fields (--at A,B)")
+        a, b = idx
+        if a == b or x[a] + x[b] == 0.0:
+            raise CalibrationError("criterion 'two-point' needs two different off-axis fields")
+        return float((r[a] + r[b]) / (x[a] + x[b]))
+    if criterion == "zero-at":
+        if idx is None or len(idx) != 1:
+            raise CalibrationError("criterion 'zero-at' needs exactly one field (--at A)")
+        a = idx[0]
+        if x[a] == 0.0:
+            raise CalibrationError(
+                "criterion 'zero-at' needs an off-axis field (D_c is 0 on the axis)"
+            )
+        return float(r[a] / x[a])
+    if np.count_nonzero(off) < 2:
+        raise CalibrationError(
+            f"criterion {criterion!r} needs at least two off-axis field points, got "
+            f"{np.count_nonzero(off)}"
+        )
+    if criterion == "least-squares":
+        sol, *_ = np.linalg.lstsq(x[:, None], r, rcond=None)
+        return float(sol[0])
+    return _minimax(x[off], r[off])
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """A calibrated distortion curve (one row of Pestrecov's Table II per field).
+
+    Kc, K0: calibrated and characteristic constants: F_c, F0 in mm (object at infinity) or
+        M_c, M0 (finite conjugates); ``symbol`` says which ("F" / "M").
+    scale_error: ``Kc/K0 − 1`` = tan ρ (Eq. 13).
+    rho_deg, k, rho_k_deg: ρ and, for plot exaggeration k, ρ_k with tan ρ_k = k·tan ρ (Eq. 14).
+    ycp: calibrated image size ``y_c' = Kc·x`` (mm). Dc: ``y' − y_c'`` (mm), Eqs. (10)–(12).
+    Drc: ``y'/y_c' − 1`` as a fraction, Eq. (15) (on the axis its limit, the constant term).
+    Drc_axis: ``K0/Kc − 1``, the constant term of Eq. (15) (fraction).
+    Dc_max_abs, Dc_spread (max − min of D_c, mm), Drc_spread, Dr_spread (fractions),
+    D0_max_abs, D0_spread (mm) summarise the field points.
+    """
+
+    curve: DistortionCurve
+    criterion: str
+    at: tuple[float, ...]
+    Kc: float
+    k: float
+    ycp: np.ndarray
+    Dc: np.ndarray
+    Drc: np.ndarray
+
+    @property
+    def symbol(self) -> str:
+        return self.curve.symbol
+
+    @property
+    def K0(self) -> float:
+        return self.curve.constant
+
+    @property
+    def scale_error(self) -> float:
+        return self.Kc / self.K0 - 1.0
+
+    @property
+    def rho_deg(self) -> float:
+        return math.degrees(math.atan(self.scale_error))
+
+    @property
+    def rho_k_deg(self) -> float:
+        return math.degrees(math.atan(self.k * self.scale_error))
+
+    @property
+    def Drc_axis(self) -> float:
+        return self.K0 / self.Kc - 1.0
+
+    @property
+    def Dc_max_abs(self) -> float:
+        return float(np.max(np.abs(self.Dc)))
+
+    @property
+    def Dc_spread(self) -> float:
+        return float(np.max(self.Dc) - np.min(self.Dc))
+
+    @property
+    def Drc_spread(self) -> float:
+        return float(np.max(self.Drc) - np.min(self.Drc))
+
+    @property
+    def D0_max_abs(self) -> float:
+        return float(np.max(np.abs(self.curve.D0)))
+
+    @property
+    def D0_spread(self) -> float:
+        return float(np.max(self.curve.D0) - np.min(self.curve.D0))
+
+    @property
+    def Dr_spread(self) -> float:
+        d = self.curve.Dr
+        return float(np.max(d) - np.min(d))
+
+    @property
+    def yp(self) -> np.ndarray:
+        """Actual image size, the same before and after calibration: ``y_c' + D_c``."""
+        return self.ycp + self.Dc
+
+
+def calibrate(
+    curve: DistortionCurve,
+    criterion: str = "two-point",
+    *,
+    at=None,
+    value: float | None = None,
+    k: float = 200.0,
+) -> CalibrationResult:
+    """Calibrate a characteristic distortion curve (Eqs. 10–15) by a criterion (module docstring).
+
+    ``at``: the field values (same kind and unit as ``curve.fields``) for ``two-point`` (two) and
+    ``zero-at`` (one); they must be field points of the curve. ``value``: F_c (mm) or M_c for
+    ``given``. ``k``: the plot exaggeration for ρ_k (Eq. 14; the paper's Fig. 2 uses 200).
+    """
+    what = f"calibration ({criterion})"
+    if criterion not in CRITERIA:
+        raise CalibrationError(
+            f"unknown calibration criterion {criterion!r}; expected one of {', '.join(CRITERIA)}"
+        )
+    if curve.fields.size < 2:
+        raise CalibrationError(f"{what}: a curve needs at least two field points")
+    need = {"two-point": 2, "zero-at": 1}.get(criterion, 0)
+    at_t: tuple[float, ...] = tuple(float(a) for a in (at or ()))
+    if need and len(at_t) != need:
+        raise CalibrationError(
+            f"{what} needs exactly {need} field(s) given with --at, got {len(at_t)}"
+        )
+    if not need and at_t:
+        raise CalibrationError(f"{what} takes no --at fields")
+    idx = _match_fields(curve.fields, at_t, what) if need else None
+    if criterion == "given" and value is None:
+        raise CalibrationError(f"{what} needs the calibrated constant {curve.symbol}_c")
+    Kc = fit_scale(curve.x, curve.yp, criterion, idx=idx, given=value)
+    if not math.isfinite(Kc) or Kc == 0.0:
+        raise CalibrationError(f"{what} gave a degenerate constant {Kc!r}")
+    ycp = Kc * curve.x
+    Dc = curve.yp - ycp
+    # D_rc = y'/y_c' − 1 off the axis; on the axis its limit, the constant term of Eq. (15)
+    # (for a characteristic curve y' = K0 x + D0 this is D_r K0/Kc + (K0/Kc − 1), Eq. 15)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        Drc = np.where(
+            ycp != 0.0, curve.yp / np.where(ycp != 0.0, ycp, 1.0) - 1.0, curve.constant / Kc - 1.0
+        )
+    return CalibrationResult(curve, criterion, at_t, float(Kc), float(k), ycp, Dc, Drc)
+
+
+def format_calibration(
+    res: CalibrationResult, *, layout: str = "auto", decimals: int | None = None
+) -> str:
+    """Pestrecov's Table II layout: the calibrated constant, then per field y_c', D_c and D_rc (%),
+    followed by the summary (scale error, ρ, ρ_k, D_rc on the axis, max |D_c|, spreads)."""
+    c = res.curve
+    dec = c.decimals if decimals is None else decimals
+    s = res.symbol
+    unit = " mm" if not c.finite else ""
+    at = f" at {', '.join(f'{a:g}' for a in res.at)}" if res.at else ""
+    title = [
+        " ".join(p for p in (c.name, c.plane) if p) + " — calibrated distortion data",
+        f"{s}_c = {res.Kc:.{max(dec, 3)}f}{unit}   ({res.criterion}{at}; {s}0 = "
+        f"{res.K0:.{max(dec, 3)}f}{unit})",
+    ]
+    q = [
+        ("Yc' (mm)", res.ycp, dec, False),
+        ("Dc (mm)", res.Dc, dec, True),
+        ("Drc (%)", 100.0 * res.Drc, dec, True),
+    ]
+    table = format_columns(title, c.field_label, c.fields, q, layout=layout)
+    summary = [
+        "",
+        f"{s}_c/{s}0 - 1 = tan rho = {res.scale_error:+.6e}   rho = {res.rho_deg:.4f} deg   "
+        f"rho_k = {res.rho_k_deg:.2f} deg (k = {res.k:g})",
+        f"Drc on the axis (Eq. 15) = {100 * res.Drc_axis:+.{dec}f} %",
+        f"max |D0| = {res.D0_max_abs:.{dec}f} mm, spread {res.D0_spread:.{dec}f} mm;  "
+        f"max |Dc| = {res.Dc_max_abs:.{dec}f} mm, spread {res.Dc_spread:.{dec}f} mm",
+        f"spread of Dr = {100 * res.Dr_spread:.{dec}f} %, "
+        f"of Drc = {100 * res.Drc_spread:.{dec}f} %",
+    ]
+    return table + "\n".join(summary)
+
+
+def calibration_to_dict(res: CalibrationResult) -> dict:
+    """JSON-ready dict of a calibration (relative quantities as fractions and in per cent)."""
+    from .tables import curve_to_dict
+
+    s = res.symbol
+    return {
+        "criterion": res.criterion,
+        "at": list(res.at),
+        f"{s}0": res.K0,
+        f"{s}c": res.Kc,
+        "scale_error": res.scale_error,
+        "rho_deg": res.rho_deg,
+        "k": res.k,
+        "rho_k_deg": res.rho_k_deg,
+        "Drc_axis": res.Drc_axis,
+        "Drc_axis_pct": 100.0 * res.Drc_axis,
+        "Dc_max_abs_mm": res.Dc_max_abs,
+        "Dc_spread_mm": res.Dc_spread,
+        "D0_max_abs_mm": res.D0_max_abs,
+        "D0_spread_mm": res.D0_spread,
+        "Dr_spread": res.Dr_spread,
+        "Drc_spread": res.Drc_spread,
+        "ycp_mm": res.ycp.tolist(),
+        "Dc_mm": res.Dc.tolist(),
+        "Drc": res.Drc.tolist(),
+        "Drc_pct": (100.0 * res.Drc).tolist(),
+        "characteristic": curve_to_dict(res.curve),
+    }

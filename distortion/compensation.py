@@ -1,0 +1,181 @@
+"""Compensation of a camera's distortion by a printer (Pestrecov 1958, Section VI, Eqs. 16–17).
+
+Camera (object at infinity): ``y' = F1·tan α + D1(α)`` in the negative.
+Printer (finite conjugates, negative → print, image-space magnification M2): its characteristic
+curve gives the print height ``y'' = M2·h + Dp(h)`` of a negative point at height h (Dp in the
+print plane, mm). In the negative plane its distortion is ``D2(h) = h − y''/M2 = −Dp(h)/M2``.
+
+The print of the camera's image is ``y'' = M2·(y' − D2(y'))`` and its ideal size ``M·F1·tan α``.
+The residual, in the negative plane (Eq. 16 rearranged), is
+
+    R(α) = D1 − D2 − (M/M2 − 1)·F1·tan α = (y'' − M·F1·tan α)/M2,
+
+and ``M2·R`` is the distortion of the print itself (mm in the print plane). D2 is evaluated at
+the actual negative point ``y' = F1 tan α + D1`` the printer images (exact); Pestrecov's
+first-order reading evaluates it at ``F1 tan α`` — the difference is of order ``D·dD/dy``.
+The printer curve is interpolated in h by a cubic spline of the odd extension D2(−h) = −D2(h)
+(nodes are reproduced exactly); heights beyond the printer's field raise a DataError.
+
+R is linear in M, so the M that best removes it is a calibration fit (``fit_scale``) of
+``r = D1 − D2 + F1 tan α`` against ``x = F1 tan α / M2`` with any criterion of
+:mod:`distortion.calibration`. Recalibrating either curve (Eq. 11) leaves the print's distortion
+unchanged (Eq. 16 ⇔ Eq. 17).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from raytrace.errors import DataError
+
+from .calibration import CRITERIA, CalibrationError, _match_fields, fit_scale
+from .tables import DistortionCurve, format_columns
+
+
+@dataclass(frozen=True)
+class CompensationResult:
+    """Residual distortion of the print (Section VI).
+
+    alpha_deg: the camera's field angles; F1 (mm) and M2 the constants the two curves use;
+    M: the print magnification factor (Eq. 16) used for the residual;
+    y1: camera image ``F1 tan α`` (mm, negative plane); yp: actual negative point (mm);
+    D1, D2: the camera's and the printer's distortion in the negative plane (mm);
+    residual: R = D1 − D2 − (M/M2 − 1) F1 tan α (mm, negative plane);
+    print_residual: M2·R, the distortion of the print (mm, print plane).
+    """
+
+    alpha_deg: np.ndarray
+    F1: float
+    M2: float
+    M: float
+    criterion: str
+    y1: np.ndarray
+    yp: np.ndarray
+    D1: np.ndarray
+    D2: np.ndarray
+    residual: np.ndarray
+    print_residual: np.ndarray
+
+    @property
+    def max_abs(self) -> float:
+        """max |R| (mm, negative plane)."""
+        return float(np.max(np.abs(self.residual)))
+
+    @property
+    def spread(self) -> float:
+        return float(np.max(self.residual) - np.min(self.residual))
+
+
+def printer_negative_distortion(printer: DistortionCurve, h) -> np.ndarray:
+    """D2(h) = −Dp(h)/M2: the printer's distortion referred to the negative plane at negative
+    heights h (mm), by a cubic spline of the odd extension of the printer curve."""
+    from scipy.interpolate import CubicSpline
+
+    if not printer.finite:
+        raise DataError("the printer curve must be for finite conjugates (object heights, M2)")
+    x = np.asarray(printer.x, dtype=float)
+    d2 = -printer.D0 / printer.constant
+    ax = np.abs(x)
+    sd = np.where(x < 0, -d2, d2)  # odd extension: D2 for positive heights
+    order = np.argsort(ax)
+    ax, sd = ax[order], sd[order]
+    if ax[0] != 0.0:
+        ax, sd = np.concatenate([[0.0], ax]), np.concatenate([[0.0], sd])
+    xx = np.concatenate([-ax[:0:-1], ax])
+    yy = np.concatenate([-sd[:0:-1], sd])
+    h = np.asarray(h, dtype=float)
+    hmax = ax[-1]
+    if np.any(np.abs(h) > hmax * (1 + 1e-12)):
+        bad = float(np.max(np.abs(h)))
+        raise DataError(
+            f"the camera image reaches {bad:.4f} mm in the negative but the printer curve only "
+            f"covers object heights up to {hmax:.4f} mm"
+        )
+    if xx.size < 4:
+        return np.interp(h, xx, yy)
+    return CubicSpline(xx, yy)(h)
+
+
+def compensate(
+    camera: DistortionCurve,
+    printer: DistortionCurve,
+    *,
+    criterion: str = "given",
+    M: float | None = None,
+    at=None,
+) -> CompensationResult:
+    """Residual distortion of the print of ``camera``'s negative by ``printer`` (Eq. 16).
+
+    camera: object at infinity (field angles, constant F1 in mm, D1 in the negative).
+    printer: finite conjugates with the negative as its object (object heights in mm, constant M2,
+        D0 in the print plane).
+    criterion: how M is chosen: ``given`` (``M``, default M2 — the paper's compensation condition
+        for characteristic curves) or any calibration criterion over the camera's fields
+        (``two-point`` / ``zero-at`` with ``at`` angles, ``minimax``, ``least-squares``).
+    """
+    if camera.finite:
+        raise DataError("the camera curve must be for an object at infinity (field angles, F1)")
+    if criterion not in CRITERIA:
+        raise CalibrationError(
+            f"unknown criterion {criterion!r}; expected one of {', '.join(CRITERIA)}"
+        )
+    F1, M2 = camera.constant, printer.constant
+    y1 = camera.y0p
+    yp = camera.yp
+    D1 = camera.D0
+    D2 = printer_negative_distortion(printer, yp)
+    x = y1 / M2
+    r = D1 - D2 + y1
+    need = {"two-point": 2, "zero-at": 1}.get(criterion, 0)
+    idx = _match_fields(camera.fields, at or (), f"compensation ({criterion})") if need else None
+    if need and (idx is None or len(idx) != need):
+        raise CalibrationError(f"criterion {criterion!r} needs {need} field(s) with --at")
+    Mv = fit_scale(
+        x, r, criterion, idx=idx, given=M2 if (criterion == "given" and M is None) else M
+    )
+    if not math.isfinite(Mv):
+        raise CalibrationError("compensation gave a degenerate magnification")
+    R = D1 - D2 - (Mv / M2 - 1.0) * y1
+    return CompensationResult(
+        camera.fields.copy(), F1, M2, float(Mv), criterion, y1, yp, D1, D2, R, M2 * R
+    )
+
+
+def format_compensation(res: CompensationResult, *, layout: str = "auto", decimals: int = 4) -> str:
+    """Text table: per camera field D1, D2 (negative plane), residual R, the print's distortion."""
+    title = [
+        "Distortion compensation (Pestrecov Eq. 16): camera F1 = "
+        f"{res.F1:.4f} mm, printer M2 = {res.M2:.6f}, M = {res.M:.6f} ({res.criterion})",
+        f"max |R| = {res.max_abs:.{decimals}f} mm (negative plane), "
+        f"spread {res.spread:.{decimals}f} mm",
+    ]
+    q = [
+        ("F1 tan α (mm)", res.y1, 3, False),
+        ("D1 (mm)", res.D1, decimals, True),
+        ("D2 (mm)", res.D2, decimals, True),
+        ("R (mm)", res.residual, decimals, True),
+        ("print (mm)", res.print_residual, decimals, True),
+    ]
+    return format_columns(title, "α (deg)", res.alpha_deg, q, layout=layout)
+
+
+def compensation_to_dict(res: CompensationResult) -> dict:
+    """JSON-ready dict of a compensation result."""
+    return {
+        "F1": res.F1,
+        "M2": res.M2,
+        "M": res.M,
+        "criterion": res.criterion,
+        "alpha_deg": res.alpha_deg.tolist(),
+        "y1_mm": res.y1.tolist(),
+        "yp_mm": res.yp.tolist(),
+        "D1_mm": res.D1.tolist(),
+        "D2_mm": res.D2.tolist(),
+        "residual_mm": res.residual.tolist(),
+        "print_residual_mm": res.print_residual.tolist(),
+        "max_abs_mm": res.max_abs,
+        "spread_mm": res.spread,
+    }

@@ -1,0 +1,1 @@
+"""Bundled lens prescriptions (TOML), installed as package data."""

@@ -1,0 +1,608 @@
+"""Numba real-ray kernels: surface intersection, vector refraction, bulk trace, chief-ray aiming.
+
+Everything here sees only contiguous float64 / int64 arrays and scalars (DESIGN.md §5); the Python
+layer in :mod:`raytrace.trace` owns objects, validation and errors.
+
+Geometry (DESIGN.md §3): millimetres, light toward +z, first vertex at z = 0. A ray is a point
+(x, y, z) and unit direction cosines (L, M, N). The lens arrays are those of
+:class:`raytrace.lens.PackedLens`: ``kind, c, k, asph, zv, n_in, n_out, sd``.
+
+Intersection (cancellation-free curvature form)
+    The ray is first transferred to the vertex tangent plane of the surface (local z = 0) at
+    (x1, y1). The quadric ``c (x² + y² + (1 + k) z²) − 2 z = 0`` then gives, along the ray
+    parameter s (mm), ``A s² − 2 B s + C = 0`` with ``A = c (1 + k N²)``,
+    ``B = N − c (x1 L + y1 M)``, ``C = c (x1² + y1²)``; the root continuous with the vertex is
+    ``s = C / (B + sqrt(B² − A C))`` — no subtraction of nearly equal numbers, exact for c → 0
+    (plane). Negative discriminant → MISSED; a root on the far sheet of the quadric
+    (``1 − c (1 + k) z <= 0``) → MISSED. Even aspheres: Newton iteration on
+    ``z − sag(x² + y²) = 0`` along the ray, started at the conic solution, stopped when the step
+    is below 1e-14 mm × (1 + |x| + |y| + |z|); more than ``NEWTON_MAX`` steps → MISSED.
+
+Refraction (vector Snell)
+    With the unit normal n̂ oriented along the ray (cos I = d·n̂ >= 0) and μ = n/n':
+    ``sin² I' = μ² (1 − cos² I)``; > 1 → TIR; ``d' = μ d + (cos I' − μ cos I) n̂``, renormalised so
+    the direction cosines stay unit length to rounding (<= 1e-15).
+
+Status codes: OK 0, MISSED 1, TIR 2, CLIPPED 3 (outside the semi-diameter, when clipping is on),
+AIM_FAILED 4. A failed ray carries the 1-based number of the surface where it failed and NaN
+coordinates; every ray gets a status.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+STATUS_OK = 0
+STATUS_MISSED = 1
+STATUS_TIR = 2
+STATUS_CLIPPED = 3
+STATUS_AIM_FAILED = 4
+
+KIND_PLANE = 0
+KIND_QUADRIC = 1
+KIND_ASPHERE = 2
+
+NEWTON_MAX = 60
+NEWTON_TOL = 1e-14
+
+# Chief-ray aiming limits (per field): secant/bisection iterations per solve, step halvings of
+# the field continuation, total residual evaluations.
+AIM_MAXIT = 60
+AIM_MAX_HALVINGS = 40
+AIM_MAX_EVALS = 1500
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _asphere_sag(c, k, asph, j, rho):
+    """Even-asphere sag z(ρ) and dz/dρ at ρ = x² + y²; ok False outside the conic's domain."""
+    arg = 1.0 - (1.0 + k) * c * c * rho
+    if not (arg > 0.0):
+        return 0.0, 0.0, False
+    q = math.sqrt(arg)
+    z = c * rho / (1.0 + q)
+    dz = 0.5 * c / q
+    pw = rho  # ρ^(j+1)
+    for m in range(asph.shape[1]):
+        a = asph[j, m]
+        z += a * pw * rho
+        dz += (m + 2) * a * pw
+        pw *= rho
+    return z, dz, True
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
+    """Intersect one surface and refract. Returns (status, x, y, z, L, M, N) with the point on the
+    surface (global z) and the direction after it; status != 0 leaves the values meaningless."""
+    if not (N > 0.0):
+        return STATUS_MISSED, x, y, z, L, M, N
+    t0 = (zvj - z) / N
+    x = x + t0 * L
+    y = y + t0 * M
+    zl = 0.0
+    nx = 0.0
+    ny = 0.0
+    nz = 1.0
+    if kind != KIND_PLANE:
+        A = c * (1.0 + k * N * N)
+        B = N - c * (x * L + y * M)
+        C = c * (x * x + y * y)
+        D = B * B - A * C
+        s = 0.0
+        have = False
+        if D >= 0.0:
+            den = B + math.sqrt(D)
+            if den > 0.0:
+                s = C / den
+                have = True
+        if kind == KIND_QUADRIC:
+            if not have:
+                return STATUS_MISSED, x, y, z, L, M, N
+            x = x + s * L
+            y = y + s * M
+            zl = s * N
+            w = 1.0 - c * (1.0 + k) * zl
+            if not (w > 0.0):
+                return STATUS_MISSED, x, y, z, L, M, N
+            nx = -c * x
+            ny = -c * y
+            nz = w
+        else:
+            x = x + s * L
+            y = y + s * M
+            zl = s * N
+            converged = False
+            for _ in range(NEWTON_MAX):
+                sag, dsag, ok = _asphere_sag(c, k, asph, j, x * x + y * y)
+                if not ok:
+                    return STATUS_MISSED, x, y, z, L, M, N
+                gp = N - 2.0 * dsag * (x * L + y * M)
+                if gp == 0.0 or not math.isfinite(gp):
+                    return STATUS_MISSED, x, y, z, L, M, N
+                ds = -(zl - sag) / gp
+                x += ds * L
+                y += ds * M
+                zl += ds * N
+                if abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl)):
+                    converged = True
+                    break
+            if not converged:
+                return STATUS_MISSED, x, y, z, L, M, N
+            sag, dsag, ok = _asphere_sag(c, k, asph, j, x * x + y * y)
+            if not ok:
+                return STATUS_MISSED, x, y, z, L, M, N
+            nx = -2.0 * x * dsag
+            ny = -2.0 * y * dsag
+            nz = 1.0
+    z = zvj + zl
+    if clip and x * x + y * y > sdj * sdj:
+        return STATUS_CLIPPED, x, y, z, L, M, N
+    if mu != 1.0:
+        inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+        nx *= inv
+        ny *= inv
+        nz *= inv
+        cosi = L * nx + M * ny + N * nz
+        if cosi < 0.0:
+            nx = -nx
+            ny = -ny
+            nz = -nz
+            cosi = -cosi
+        sin2t = mu * mu * (1.0 - cosi * cosi)
+        if sin2t > 1.0:
+            return STATUS_TIR, x, y, z, L, M, N
+        g = math.sqrt(1.0 - sin2t) - mu * cosi
+        L = mu * L + g * nx
+        M = mu * M + g * ny
+        N = mu * N + g * nz
+        inv = 1.0 / math.sqrt(L * L + M * M + N * N)
+        L *= inv
+        M *= inv
+        N *= inv
+    return STATUS_OK, x, y, z, L, M, N
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def trace_span(kind, c, k, asph, zv, n_in, n_out, sd, j0, j1, clip, x, y, z, L, M, N):
+    """Trace surfaces j0 .. j1-1 (0-based). Returns (status, surface_1based, x, y, z, L, M, N)."""
+    for j in range(j0, j1):
+        st, x, y, z, L, M, N = surface_step(
+            kind[j], c[j], k[j], asph, j, zv[j], n_in[j] / n_out[j], sd[j], clip, x, y, z, L, M, N
+        )
+        if st != STATUS_OK:
+            return st, j + 1, x, y, z, L, M, N
+    return STATUS_OK, 0, x, y, z, L, M, N
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _trace_one(kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N):
+    nrm = math.sqrt(L * L + M * M + N * N)
+    if not (nrm > 0.0 and math.isfinite(nrm) and math.isfinite(x + y + z)):
+        return STATUS_MISSED, 1, x, y, z, L, M, N
+    L /= nrm
+    M /= nrm
+    N /= nrm
+    return trace_span(kind, c, k, asph, zv, n_in, n_out, sd, 0, c.shape[0], clip, x, y, z, L, M, N)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _store(i, st, sf, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf):
+    ost[i] = st
+    osf[i] = sf
+    if st == STATUS_OK:
+        ox[i] = x
+        oy[i] = y
+        oz[i] = z
+        oL[i] = L
+        oM[i] = M
+        oN[i] = N
+    else:
+        ox[i] = np.nan
+        oy[i] = np.nan
+        oz[i] = np.nan
+        oL[i] = np.nan
+        oM[i] = np.nan
+        oN[i] = np.nan
+
+
+BLOCK = 256
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, i1, x, y, z, L, M, N,
+                 ox, oy, oz, oL, oM, oN, ost, osf):  # fmt: skip
+    """Trace rays i0..i1-1 surface by surface, in place in the output arrays.
+
+    Plane / quadric surfaces run a branch-free loop over the rays (SIMD-friendly: failures are
+    recorded with selects, the arithmetic of failed rays continues on meaningless values that are
+    replaced by NaN at the end); asphere surfaces use the scalar Newton path per live ray."""
+    for i in range(i0, i1):
+        nrm = math.sqrt(L[i] * L[i] + M[i] * M[i] + N[i] * N[i])
+        good = nrm > 0.0 and math.isfinite(nrm) and math.isfinite(x[i] + y[i] + z[i])
+        ox[i] = x[i]
+        oy[i] = y[i]
+        oz[i] = z[i]
+        oL[i] = L[i] / nrm
+        oM[i] = M[i] / nrm
+        oN[i] = N[i] / nrm
+        ost[i] = STATUS_OK if good else STATUS_MISSED
+        osf[i] = 0 if good else 1
+    for j in range(c.shape[0]):
+        mu = n_in[j] / n_out[j]
+        if kind[j] == KIND_ASPHERE:
+            for i in range(i0, i1):
+                if ost[i] != STATUS_OK:
+                    continue
+                st, xx, yy, zz, LL, MM, NN = surface_step(
+                    kind[j], c[j], k[j], asph, j, zv[j], mu, sd[j], clip,
+                    ox[i], oy[i], oz[i], oL[i], oM[i], oN[i],
+                )  # fmt: skip
+                ox[i] = xx
+                oy[i] = yy
+                oz[i] = zz
+                oL[i] = LL
+                oM[i] = MM
+                oN[i] = NN
+                if st != STATUS_OK:
+                    ost[i] = st
+                    osf[i] = j + 1
+            continue
+        cj = c[j]
+        ck = c[j] * (1.0 + k[j])
+        kj = k[j]
+        zvj = zv[j]
+        sd2 = sd[j] * sd[j] if clip else np.inf
+        mu2 = mu * mu
+        for i in range(i0, i1):
+            LL = oL[i]
+            MM = oM[i]
+            NN = oN[i]
+            t0 = (zvj - oz[i]) / NN
+            xx = ox[i] + t0 * LL
+            yy = oy[i] + t0 * MM
+            A = cj * (1.0 + kj * NN * NN)
+            B = NN - cj * (xx * LL + yy * MM)
+            rho = xx * xx + yy * yy
+            C = cj * rho
+            D = B * B - A * C
+            den = B + math.sqrt(max(D, 0.0))
+            s = C / den
+            xx += s * LL
+            yy += s * MM
+            zl = s * NN
+            w = 1.0 - ck * zl
+            nx = -cj * xx
+            ny = -cj * yy
+            inv = 1.0 / math.sqrt(nx * nx + ny * ny + w * w)
+            nx *= inv
+            ny *= inv
+            nz = w * inv
+            cosi = LL * nx + MM * ny + NN * nz
+            sgn = 1.0 if cosi >= 0.0 else -1.0
+            nx *= sgn
+            ny *= sgn
+            nz *= sgn
+            cosi *= sgn
+            sin2t = mu2 * (1.0 - cosi * cosi)
+            g = math.sqrt(max(1.0 - sin2t, 0.0)) - mu * cosi
+            L2 = mu * LL + g * nx
+            M2 = mu * MM + g * ny
+            N2 = mu * NN + g * nz
+            inv = 1.0 / math.sqrt(L2 * L2 + M2 * M2 + N2 * N2)
+            missed = (not (NN > 0.0)) or D < 0.0 or not (den > 0.0) or not (w > 0.0)
+            clipped = xx * xx + yy * yy > sd2
+            code = STATUS_TIR if sin2t > 1.0 else STATUS_OK
+            code = STATUS_CLIPPED if clipped else code
+            code = STATUS_MISSED if missed else code
+            ox[i] = xx
+            oy[i] = yy
+            oz[i] = zvj + zl
+            oL[i] = L2 * inv
+            oM[i] = M2 * inv
+            oN[i] = N2 * inv
+            old = ost[i]
+            fresh = old == STATUS_OK and code != STATUS_OK
+            ost[i] = code if old == STATUS_OK else old
+            osf[i] = j + 1 if fresh else osf[i]
+    for i in range(i0, i1):
+        if ost[i] != STATUS_OK:
+            ox[i] = np.nan
+            oy[i] = np.nan
+            oz[i] = np.nan
+            oL[i] = np.nan
+            oM[i] = np.nan
+            oN[i] = np.nan
+
+
+@njit(cache=True, error_model="numpy")
+def trace_batch_serial(
+    kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
+):
+    """Bulk trace, one thread. Inputs/outputs are 1-D arrays of equal length (structure of
+    arrays); outputs hold the final segment (point on the last surface, direction after it),
+    status (int8) and failed surface (int32, 1-based, 0 when OK). Rays are processed in blocks
+    of ``BLOCK``, surface by surface within a block."""
+    n = x.shape[0]
+    for b in range((n + BLOCK - 1) // BLOCK):
+        i0 = b * BLOCK
+        _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
+                     x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def trace_batch_parallel(
+    kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
+):
+    """Same as :func:`trace_batch_serial`, blocks split over numba's threads (prange)."""
+    n = x.shape[0]
+    for b in prange((n + BLOCK - 1) // BLOCK):
+        i0 = b * BLOCK
+        _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
+                     x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf)  # fmt: skip
+
+
+# --------------------------------------------------------------------------------------------
+# Chief-ray aiming
+# --------------------------------------------------------------------------------------------
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _start_ray(finite, z_obj, f, u):
+    """Object-space meridional ray for field value f and unknown u.
+
+    finite == 0 (object at infinity): f = α (rad), start (0, u, 0), direction (0, sin α, cos α).
+    finite == 1: f = object height (mm), start (0, f, z_obj), direction ∝ (0, u, 1) (u = tan θ).
+    """
+    if finite == 0:
+        return u, 0.0, math.sin(f), math.cos(f)
+    nrm = math.sqrt(1.0 + u * u)
+    return f, z_obj, u / nrm, 1.0 / nrm
+
+
+@njit(cache=True, error_model="numpy")
+def _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u):
+    """Meridional height at the stop surface of the ray (f, u) (unclipped); (status, y)."""
+    y0, z0, M0, N0 = _start_ray(finite, z_obj, f, u)
+    st, sf, x, y, z, L, M, N = trace_span(
+        kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, False, 0.0, y0, z0, 0.0, M0, N0
+    )
+    return st, y
+
+
+@njit(cache=True, error_model="numpy")
+def _solve_field(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u0, tol, hscale):
+    """Safeguarded secant solve of y_stop(u) = 0 from the guess u0.
+
+    Returns (converged, u, residual, evaluations). A sign change between two traceable points
+    keeps a bracket; secant steps outside it are replaced by bisection; an untraceable trial
+    point is pulled halfway back toward the last good point (up to 20 times)."""
+    nev = 1
+    st, r0 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u0)
+    if st != STATUS_OK or not math.isfinite(r0):
+        return False, u0, np.nan, nev
+    if abs(r0) <= tol:
+        return True, u0, r0, nev
+    h = 1e-7 * max(abs(u0), hscale)
+    u1 = u0 + h
+    st, r1 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+    nev += 1
+    if st != STATUS_OK:
+        u1 = u0 - h
+        st, r1 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+        nev += 1
+        if st != STATUS_OK:
+            return False, u0, r0, nev
+    if abs(r1) <= tol:
+        return True, u1, r1, nev
+    # best point (ub, rb) and bracket [lo, hi] (valid when have_br)
+    g = (r1 - r0) / (u1 - u0)
+    ub, rb = u0, r0
+    if abs(r1) < abs(r0):
+        ub, rb = u1, r1
+    have_br = False
+    lo = 0.0
+    hi = 0.0
+    rlo = 0.0
+    if r0 * r1 < 0.0:
+        have_br = True
+        if u0 < u1:
+            lo, hi, rlo = u0, u1, r0
+        else:
+            lo, hi, rlo = u1, u0, r1
+    for _ in range(AIM_MAXIT):
+        if g != 0.0 and math.isfinite(g):
+            un = ub - rb / g
+        else:
+            un = 0.5 * (lo + hi) if have_br else ub + h
+        if have_br and not (lo < un < hi):
+            un = 0.5 * (lo + hi)
+        ok = False
+        rn = 0.0
+        for _k in range(20):
+            st, rn = _stop_residual(
+                kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, un
+            )
+            nev += 1
+            if st == STATUS_OK and math.isfinite(rn):
+                ok = True
+                break
+            un = ub + 0.5 * (un - ub)
+        if not ok:
+            return False, ub, rb, nev
+        if abs(rn) <= tol:
+            return True, un, rn, nev
+        if un != ub:
+            g = (rn - rb) / (un - ub)
+        # update bracket
+        if have_br:
+            if (rn < 0.0) == (rlo < 0.0):
+                lo, rlo = un, rn
+            else:
+                hi = un
+        elif rn * rb < 0.0:
+            have_br = True
+            if un < ub:
+                lo, hi, rlo = un, ub, rn
+            else:
+                lo, hi, rlo = ub, un, rb
+        if abs(rn) < abs(rb) or have_br:
+            ub, rb = un, rn
+        if have_br and hi - lo <= 4e-16 * max(abs(lo), abs(hi)):
+            return False, ub, rb, nev
+    return False, ub, rb, nev
+
+
+@njit(cache=True, error_model="numpy")
+def aim_chief(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
+              hscale, clip):  # fmt: skip
+    """Aim the meridional chief ray (through the stop vertex) for every field; one call.
+
+    fields: field values (α in rad for ``finite == 0``; object height in mm for ``finite == 1``),
+    any order and sign (negative fields are mirror images of positive ones). slope0: paraxial
+    du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object). tol: absolute
+    stop-height tolerance (mm). hscale: scale of u for finite-difference steps.
+
+    Fields are solved in order of |f| by continuation: each starts from the extrapolation of the
+    last two solutions; a failed solve halves the field step (intermediate fields) until it
+    succeeds or AIM_MAX_HALVINGS / AIM_MAX_EVALS is exhausted (→ AIM_FAILED).
+
+    Returns a (13, n) float64 array with rows: u, y_start, z_start, M_start, N_start, y_last,
+    z_last, M_last, N_last, status, surface, evaluations, stop residual. Rays of fields that
+    failed have NaN rows (except z_start, status, surface, evaluations).
+    """
+    n = fields.shape[0]
+    ns = c.shape[0]
+    out = np.empty((13, n))
+    order = np.argsort(np.abs(fields))
+    # continuation state: last solved field (fb, ub) and the secant slope du/df there
+    fb = 0.0
+    ub = 0.0
+    slope = slope0
+    for ii in range(n):
+        i = order[ii]
+        ftarget = abs(fields[i])
+        sign = 1.0 if fields[i] >= 0.0 else -1.0
+        nev = 0
+        conv = False
+        u = 0.0
+        res = 0.0
+        if ftarget == 0.0:
+            conv = True
+            u = 0.0
+            res = 0.0
+        else:
+            fcur = fb
+            ucur = ub
+            step = ftarget - fcur
+            halvings = 0
+            while True:
+                ftry = fcur + step
+                if step == ftarget - fcur:
+                    ftry = ftarget
+                guess = ucur + slope * (ftry - fcur)
+                ok, usol, rsol, ne = _solve_field(
+                    kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, ftry, guess, tol,
+                    hscale,
+                )  # fmt: skip
+                nev += ne
+                if ok:
+                    if ftry != fcur:
+                        slope = (usol - ucur) / (ftry - fcur)
+                    fcur, ucur = ftry, usol
+                    fb, ub = fcur, ucur
+                    if ftry == ftarget:
+                        conv = True
+                        u = usol
+                        res = rsol
+                        break
+                    step = min(2.0 * step, ftarget - fcur)
+                else:
+                    halvings += 1
+                    if halvings > AIM_MAX_HALVINGS or nev > AIM_MAX_EVALS:
+                        u = usol
+                        res = rsol
+                        break
+                    step *= 0.5
+        y0, z0, M0, N0 = _start_ray(finite, z_obj, ftarget, u)
+        out[0, i] = sign * u
+        out[1, i] = sign * y0
+        out[2, i] = z0
+        out[3, i] = sign * M0
+        out[4, i] = N0
+        out[11, i] = nev
+        if not conv:
+            for r in range(0, 9):
+                if r != 2:
+                    out[r, i] = np.nan
+            out[9, i] = STATUS_AIM_FAILED
+            out[10, i] = 0
+            out[12, i] = np.nan
+            continue
+        st, sf, x, y, z, L, M, N = trace_span(
+            kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, clip, 0.0, y0, z0, 0.0, M0, N0
+        )
+        ystop = y
+        if st == STATUS_OK:
+            st, sf, x, y, z, L, M, N = trace_span(
+                kind, c, k, asph, zv, n_in, n_out, sd, stop + 1, ns, clip, x, y, z, L, M, N
+            )
+        out[9, i] = st
+        out[10, i] = sf
+        if st == STATUS_OK:
+            out[5, i] = sign * y
+            out[6, i] = z
+            out[7, i] = sign * M
+            out[8, i] = N
+            out[12, i] = sign * ystop
+        else:
+            for r in range(5, 9):
+                out[r, i] = np.nan
+            out[12, i] = sign * res
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def trace_paths(kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N, px, py, pz, st, sf):
+    """Trace rays and record the intersection point on every surface (for drawings and checks).
+
+    px, py, pz: (n_rays, n_surfaces) outputs; entries after a failure are NaN. st / sf: status and
+    1-based failed surface per ray. Serial: this is for tens of rays, not for throughput."""
+    ns = c.shape[0]
+    for i in range(x.shape[0]):
+        xi, yi, zi = x[i], y[i], z[i]
+        nrm = math.sqrt(L[i] * L[i] + M[i] * M[i] + N[i] * N[i])
+        Li, Mi, Ni = L[i] / nrm, M[i] / nrm, N[i] / nrm
+        st[i] = STATUS_OK
+        sf[i] = 0
+        for j in range(ns):
+            px[i, j] = np.nan
+            py[i, j] = np.nan
+            pz[i, j] = np.nan
+        for j in range(ns):
+            s, xi, yi, zi, Li, Mi, Ni = surface_step(
+                kind[j],
+                c[j],
+                k[j],
+                asph,
+                j,
+                zv[j],
+                n_in[j] / n_out[j],
+                sd[j],
+                clip,
+                xi,
+                yi,
+                zi,
+                Li,
+                Mi,
+                Ni,
+            )
+            if s != STATUS_OK:
+                st[i] = s
+                sf[i] = j + 1
+                break
+            px[i, j] = xi
+            py[i, j] = yi
+            pz[i, j] = zi

@@ -1,0 +1,127 @@
+"""Paraxial optics against analytic cases and Pestrecov's Eqs. (5)-(8)."""
+
+import math
+
+import pytest
+
+from raytrace import AIR, Aperture, Field, Lens, LensError, Surface, fixed_index, model_glass
+from raytrace.paraxial import paraxial, paraxial_chief_heights, pestrecov_constants
+
+F4 = Aperture("fnumber", 4.0)
+FIELD10 = Field("angle", 10.0)
+
+
+def make(rows, stop, ap=F4, fld=FIELD10, od=math.inf):
+    ss = []
+    for i, (r, t, m) in enumerate(rows):
+        ss.append(Surface(0.0 if r == 0 else 1.0 / r, t, m or AIR, stop=(i == stop)))
+    return Lens("test", tuple(ss), ap, fld, od)
+
+
+def test_ball_lens_efl():
+    # Analytic: a ball of diameter D and index n has EFL = n D / (4 (n - 1)) from its centre.
+    n, R = 1.7, 5.0
+    g = fixed_index(n)
+    lens = make([(R, R, g), (0, R, g), (-R, 10.0, None)], stop=1)
+    p = paraxial(lens)
+    assert p.efl == pytest.approx(n * 2 * R / (4 * (n - 1)), rel=1e-13)
+    # principal planes of a ball coincide with its centre (z = R)
+    assert p.z_H == pytest.approx(R, abs=1e-12)
+    assert p.z_Hp == pytest.approx(R, abs=1e-12)
+
+
+def test_thin_lens_limit():
+    # Lensmaker's equation for a thin lens: 1/f = (n-1)(1/R1 - 1/R2).
+    n, r1, r2 = 1.5168, 40.0, -60.0
+    lens = make([(r1, 1e-9, fixed_index(n)), (r2, 50.0, None)], stop=0)
+    p = paraxial(lens)
+    f = 1.0 / ((n - 1) * (1 / r1 - 1 / r2))
+    assert p.efl == pytest.approx(f, rel=1e-9)
+    assert p.bfl == pytest.approx(f, rel=1e-9)
+    assert p.ffl == pytest.approx(-f, rel=1e-9)
+    # Gaussian conjugates 1/s' - 1/s = 1/f (Pestrecov Eq. 1) and m0 = f/(f+s) (Eq. 5)
+    pf = paraxial(lens, 150.0)
+    assert 1 / pf.s_prime_gauss - 1 / pf.s == pytest.approx(1 / f, rel=1e-9)
+    assert pf.m0 == pytest.approx(f / (f + pf.s), rel=1e-9)
+    # stop on the lens: entrance pupil = stop, so m_e = 1 and HE0 = 0
+    assert pf.m_e == pytest.approx(1.0, abs=1e-9)
+    assert pf.HE0 == pytest.approx(0.0, abs=1e-8)
+
+
+def test_single_refracting_sphere_conjugates():
+    # n'/s' - n/s = (n' - n)/R, distances from the vertex, image in the glass.
+    n1, R, d = 1.6, 20.0, 100.0
+    lens = make([(R, 80.0, fixed_index(n1))], stop=0, od=d)
+    p = paraxial(lens)
+    s_img = n1 / ((n1 - 1.0) / R + 1.0 / (-d))
+    assert p.gaussian_image_distance == pytest.approx(s_img, rel=1e-12)
+    # magnification of a single surface: m = (n s') / (n' s)
+    assert p.m0 == pytest.approx((1.0 * s_img) / (n1 * -d), rel=1e-12)
+    # focal lengths in different media: f' = n'/Φ, f = -n/Φ
+    phi = (n1 - 1.0) / R
+    assert p.f_image == pytest.approx(n1 / phi, rel=1e-12)
+    assert p.f_object == pytest.approx(-1.0 / phi, rel=1e-12)
+    # nodal points are at the centre of curvature of a single surface
+    assert p.z_N == pytest.approx(R, rel=1e-12)
+    assert p.z_Np == pytest.approx(R, rel=1e-12)
+
+
+def test_stop_at_first_surface_pupil_is_stop():
+    lens = make(
+        [(30.0, 3.0, model_glass(1.6, 50.0)), (-80.0, 45.0, None)], stop=0, ap=Aperture("epd", 10.0)
+    )
+    p = paraxial(lens)
+    assert p.z_E0 == pytest.approx(0.0, abs=1e-12)
+    assert p.stop_radius == pytest.approx(5.0, rel=1e-12)
+
+
+def test_pestrecov_constants_gaussian_plane_equal_m0_and_f():
+    # Pestrecov Eqs. (7)-(8): in the Gaussian plane M0 = m0 and F0 = f.
+    g = model_glass(1.62, 60.0)
+    lens = make(
+        [(25.0, 4.0, g), (60.0, 3.0, None), (0, 3.0, None), (-60.0, 4.0, g), (-25.0, 40.0, None)],
+        stop=2,
+    )
+    pi = paraxial(lens)
+    c = pestrecov_constants(pi, pi.s_prime_gauss)
+    assert c.infinite and c.scale == pytest.approx(pi.efl, rel=1e-12)
+    pf = paraxial(lens, 300.0)
+    c = pestrecov_constants(pf, pf.s_prime_gauss)
+    assert not c.infinite and c.scale == pytest.approx(pf.m0, rel=1e-12)
+    # Eq. (7): P0g' = m_e m0 p0
+    assert c.p0p == pytest.approx(pf.m_e * pf.m0 * pf.p0, rel=1e-12)
+    # A lens symmetric about its stop has m_e = 1 and the nodal points on the pupils (HE0 = 0
+    # is not implied, but HE0 = -H'E0' by symmetry).
+    assert pi.m_e == pytest.approx(1.0, abs=1e-12)
+    assert pi.HE0 == pytest.approx(-pi.HpE0p, abs=1e-12)
+
+
+def test_paraxial_chief_heights_linear_in_tan():
+    g = model_glass(1.62, 60.0)
+    lens = make(
+        [(25.0, 4.0, g), (60.0, 3.0, None), (0, 3.0, None), (-50.0, 4.0, g), (-25.0, 40.0, None)],
+        stop=2,
+    )
+    p = paraxial(lens)
+    h = paraxial_chief_heights(p, [0.0, 5.0], "angle", p.z_Fp)
+    # at the focal plane the paraxial image height is f tan(alpha)
+    assert h[1] == pytest.approx(p.efl * math.tan(math.radians(5.0)), rel=1e-12)
+    assert h[0] == 0.0
+
+
+def test_afocal_lens_is_an_error():
+    # Two thin lenses f=50 and f=50 separated by 100 mm: a Keplerian telescope (zero power).
+    n = 1.5
+    r = 2 * (n - 1) * 50.0
+    lens = make(
+        [
+            (r, 1e-9, fixed_index(n)),
+            (-r, 100.0, None),
+            (0, 0.0, None),
+            (r, 1e-9, fixed_index(n)),
+            (-r, 30.0, None),
+        ],
+        stop=2,
+    )
+    with pytest.raises(LensError, match="afocal"):
+        paraxial(lens)
