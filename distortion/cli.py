@@ -31,7 +31,8 @@ S_HELP = (
 )
 IMAGE_HELP = (
     "Image plane as Pestrecov's s': mm from the second principal point H', positive to the right "
-    "(e.g. 525). Default: the plane the lens file defines (its last thickness)."
+    "(e.g. 525). Default: the plane the lens file defines (its last thickness; a file whose last "
+    "thickness is \"gaussian\" means the Gaussian plane of whatever object is traced)."
 )
 VERTEX_HELP = "Image plane as a distance (mm) from the LAST VERTEX, positive to the right."
 DEFOCUS_HELP = (
@@ -198,7 +199,7 @@ def fmt(v: float, width: int = 12, prec: int = 4) -> str:
     return f"{v:>{width}.{prec}f}"
 
 
-def resolve_image_z(par, args) -> tuple[float, str]:
+def resolve_image_z(par, args, lens=None) -> tuple[float, str]:
     """Absolute z of the image plane from --image-distance / --image-from-vertex / --defocus."""
     given = [
         (n, v)
@@ -212,6 +213,8 @@ def resolve_image_z(par, args) -> tuple[float, str]:
     if len(given) > 1:
         raise CliError("give only one of --image-distance, --image-from-vertex, --defocus")
     if not given:
+        if lens is not None and lens.image_solve == "gaussian":
+            return par.z_gauss, "lens file: Gaussian plane of the object"
         return par.z_image_file, "lens file"
     name, v = given[0]
     if isinstance(v, list):
@@ -311,7 +314,7 @@ def cmd_trace(args) -> int:
     od = resolve_object_distance(lens, args.object_distance, args.s)
     fields, kind = resolve_fields(lens, args)
     par = paraxial(lens, od, args.wavelength)
-    z_img, plane_from = resolve_image_z(par, args)
+    z_img, plane_from = resolve_image_z(par, args, lens)
     if kind == "height" and par.infinite:
         raise CliError("object-height fields need a finite object (--object-distance)")
     cr = chief_rays(lens, fields, field_kind=kind, object_distance=od, wavelength=args.wavelength)

@@ -143,8 +143,9 @@ def cmd_distortion(args) -> int:
     for flag in ("plot", "plot_rotation", "layout"):
         _check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"))
     planes = _planes(args)
-    if planes.pop("file", False):
-        # the image plane the lens file defines (its last thickness)
+    if planes.pop("file", False) and lens.image_solve != "gaussian":
+        # the image plane the lens file defines (its last thickness); a "gaussian" solve in the
+        # file means the Gaussian plane of the object being traced (the default of the call)
         planes = {"image_distance": [lens.surfaces[-1].thickness]}
     if kind == "height" and math.isinf(od):
         raise CliError("object-height fields need a finite object (--object-distance)")

@@ -43,7 +43,7 @@ from .errors import LensError, PrescriptionError
 from .glass import lookup_glass, parse_glass_code
 from .lens import Aperture, Field, Lens, Surface
 from .materials import AIR, LAMBDA_D, Material, model_glass
-from .zemax import ImportResult, emit_warnings, decode_text, lens_error, number, read_bytes
+from .zemax import ImportResult, decode_text, emit_warnings, lens_error, number, read_bytes
 
 #: CODE V treats an object distance of 1e10 or more as infinite.
 CODEV_INFINITY = 1.0e10

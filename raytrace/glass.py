@@ -20,11 +20,12 @@ Zemax ``GCAT`` line, or a model glass). Six-digit glass codes (``620603`` → nd
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 import warnings
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 from .errors import PrescriptionError
 from .materials import Material, model_glass
@@ -76,7 +77,7 @@ def _canonical_catalog(name: str) -> str | None:
     return None
 
 
-@lru_cache(maxsize=None)
+@cache
 def _catalog_index(catalog: str) -> dict[str, tuple[CatalogGlass, ...]]:
     """normalized name -> glasses of one catalog (loaded once per process)."""
     try:
@@ -117,14 +118,17 @@ def _catalog_index(catalog: str) -> dict[str, tuple[CatalogGlass, ...]]:
 def parse_glass_code(text: str) -> Material | None:
     """A model glass from a glass code, or ``None`` when ``text`` is not one.
 
-    Accepted: six-digit codes ``620603`` (nd = 1 + 620/1000, vd = 603/10, the CODE V and
-    catalog convention), ``620.603``, and ``nd:vd`` / ``nd/vd`` strings such as ``1.620:60.3``.
+    Accepted: six-digit codes ``620603`` (nd = 1 + 620/1000, vd = 603/10, the catalog
+    convention), dotted codes ``620.603`` and CODE V's long form ``517000.520000`` (the digits
+    before the dot are nd − 1, the ones after it vd with two integer digits: nd 1.517,
+    vd 52.0), and ``nd:vd`` / ``nd/vd`` strings such as ``1.620:60.3``.
     """
     t = text.strip().strip("'\"")
-    m = re.fullmatch(r"(\d{3})\.?(\d{3})", t)
+    m = re.fullmatch(r"(\d{3})(\d{3})|(\d{3,9})\.(\d{3,9})", t)
     if m:
-        nd = 1.0 + int(m.group(1)) / 1000.0
-        vd = int(m.group(2)) / 10.0
+        a, b = (m.group(1), m.group(2)) if m.group(1) else (m.group(3), m.group(4))
+        nd = 1.0 + int(a) / 10.0 ** len(a)
+        vd = int(b) / 10.0 ** (len(b) - 2)
         return model_glass(nd, vd) if vd > 0 else None
     m = re.fullmatch(r"(\d+(?:\.\d*)?)\s*[:/]\s*(\d+(?:\.\d*)?)", t)
     if m:
@@ -151,6 +155,23 @@ def find_glass(
     for c in cats:
         found.extend(_catalog_index(c).get(key, ()))
     return found
+
+
+def _similar(name: str, limit: int = 5) -> list[str]:
+    """Catalog glasses whose name ends with ``name`` (``BK7`` → ``N-BK7``) or is close to it."""
+    key = normalize_name(name)
+    if not key:
+        return []
+    everything: dict[str, list[CatalogGlass]] = {}
+    for c in CATALOGS:
+        for k, gs in _catalog_index(c).items():
+            everything.setdefault(k, []).extend(gs)
+    keys = [k for k in everything if k.endswith(key) and len(k) - len(key) <= 2]
+    keys += [k for k in difflib.get_close_matches(key, list(everything), n=3, cutoff=0.8)]
+    out = []
+    for k in dict.fromkeys(keys):
+        out += [f"{g.name} ({g.catalog})" for g in everything[k]]
+    return out[:limit]
 
 
 def lookup_glass(
@@ -188,9 +209,11 @@ def lookup_glass(
     if not cand:
         cand = find_glass(raw)
     if not cand:
+        similar = _similar(raw)
+        hint = f"; similar catalog names: {', '.join(similar)}" if similar else ""
         raise PrescriptionError(
             f"unknown glass {name!r}: it is in none of the catalogs "
-            f"({', '.join(CATALOGS)}); check the spelling, or replace it by a model glass "
+            f"({', '.join(CATALOGS)}){hint}; check the spelling, or replace it by a model glass "
             "with its nd and vd (Zemax: GLAS ___BLANK 1 0 nd vd 0 0 0 0 0 0; CODE V: "
             'nd:vd such as 1.620:60.3; native: glass = "nd/vd")'
         )

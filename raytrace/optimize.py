@@ -17,7 +17,8 @@ Operand types (all lengths in mm, angles in degrees, signs as in DESIGN.md §3):
 ``image_height``    real chief-ray image height y' at ``field`` in ``plane``.
 ``best_focus``      the plane of least RMS spot for a ``field`` bundle (default on axis) at
                     ``aperture`` (fraction of the pupil radius), given as s' from H'.
-``rms_spot``        RMS spot radius at ``field`` in ``plane``.
+``rms_spot``        RMS spot radius at ``field`` in ``plane`` (``plane = "best"``: at the plane
+                    of least RMS spot of that bundle).
 ``center_thickness``  one-sided: thickness of ``surface`` ≥ ``min`` (and/or ≤ ``max``).
 ``edge_thickness``    one-sided: axial gap at height ``height`` between ``surface`` and the
                     next surface ≥ ``min``.
@@ -344,7 +345,9 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
             if t == "best_focus":
                 v = _best_focus_z(stats) - par.z_Hp
             else:
-                v = _rms_at(stats, _plane_z(par, p.get("plane")))
+                plane = p.get("plane")
+                z = _best_focus_z(stats) if plane == "best" else _plane_z(par, plane)
+                v = _rms_at(stats, z)
         elif t == "center_thickness":
             v = lens.surfaces[int(p["surface"]) - 1].thickness
         elif t == "edge_thickness":

@@ -155,3 +155,15 @@ def test_seq_to_native_to_zmx_conversion(tmp_path):
     back = load_lens(zmx)
     assert back.surfaces == lens.surfaces
     assert math.isinf(back.object_distance) and back.aperture == lens.aperture
+
+
+def test_glass_codes_and_unknown_name_suggestions():
+    from raytrace.glass import parse_glass_code
+
+    # CODE V / catalog glass codes: nd - 1 before the dot, vd (two integer digits) after it
+    assert parse_glass_code("517000.520000") == model_glass(1.517, 52.0)
+    assert parse_glass_code("500.700") == model_glass(1.5, 70.0)
+    assert parse_glass_code("1.5") is None
+    if catalog_available():
+        with pytest.raises(PrescriptionError, match=r"similar catalog names: N-BK7 \(Schott\)"):
+            loads_seq(TRIPLET.replace("1.61659:36.63", "BK7"))

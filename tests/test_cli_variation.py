@@ -1,0 +1,220 @@
+"""CLI: ``orthoscope variation`` and ``orthoscope coefficients`` (distortion.cli_variation).
+
+Sources: Fraser & Shortis (1992) Table 1 (Pentax, lenses/fraser-shortis-1992-table1-pentax.csv)
+and the paper's text (γ = 1.04, 0.98, 0.97 for 12x with 8x, 16x, 20x); synthetic profiles with
+known coefficients.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from distortion.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+PENTAX = ROOT / "lenses" / "fraser-shortis-1992-table1-pentax.csv"
+S65 = ["--lens", "super-angulon-de975637", "--scale-to-efl", "65"]
+
+
+def run(capsys, *argv):
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_help_teaches_units_signs_and_image_scale(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["variation", "--help"])
+    assert e.value.code == 0
+    out = " ".join(capsys.readouterr().out.split())
+    for needle in (
+        "micrometres",
+        "positive OUTWARD",
+        "magnification -1/N",
+        "12x",
+        "mm",
+        "first principal point H",
+        "unit focusing",
+    ):
+        assert needle in out
+
+
+def test_pentax_one_focus_setting(capsys):
+    # Table 1: one focus setting (8 m), four object planes, no Gaussian profile: no g possible.
+    rc, out, err = run(capsys, "variation", PENTAX)
+    assert rc == 0 and not err
+    assert "one focus setting only (8 m)" in out
+    assert "no g_ss' could be determined" in out
+    assert "368.80" in out and "362.30" in out  # Table 1 at r = 28 mm: 1.5 m and 3.4 m
+
+
+def test_pentax_json(capsys):
+    rc, out, _ = run(capsys, "variation", PENTAX, "--json")
+    d = json.loads(out)
+    assert rc == 0 and d["mode"] == "data"
+    assert d["variation"]["focal_length_mm"] == 45
+    assert len(d["variation"]["profiles"]) == 4
+
+
+def test_prescription_mode_csv_and_roundtrip(capsys, tmp_path):
+    prof = tmp_path / "s65.csv"
+    rc, out, err = run(
+        capsys,
+        "variation",
+        *S65,
+        "--focus",
+        "12x",
+        "--objects",
+        "8x,16x,20x",
+        "--max-field",
+        "45",
+        "--csv",
+        "--profiles-csv",
+        prof,
+    )
+    assert rc == 0 and not err
+    rows = out.strip().splitlines()
+    assert rows[0].startswith("focus,object,gamma,g,se")
+    assert len(rows) == 4
+    gam = [round(float(r.split(",")[2]), 2) for r in rows[1:]]
+    assert gam == [1.04, 0.98, 0.97]  # the paper's text (12x focus; 8x, 16x, 20x)
+    g = [float(r.split(",")[3]) for r in rows[1:]]
+    assert all(0 < v < 1 for v in g)
+    # the written profiles read back in data mode give the same g (same radii: no resampling)
+    rc, out2, _ = run(capsys, "variation", prof, "--csv")
+    g2 = [float(r.split(",")[3]) for r in out2.strip().splitlines()[1:]]
+    np.testing.assert_allclose(g2, g, rtol=1e-6)
+
+
+def test_prescription_mode_text_json_and_plots(capsys, tmp_path):
+    p1, p2 = tmp_path / "p.png", tmp_path / "g.png"
+    rc, out, _ = run(
+        capsys,
+        "variation",
+        *S65,
+        "--focus",
+        "12x",
+        "--objects",
+        "8x,20x",
+        "--max-field",
+        "45",
+        "--plot",
+        p1,
+        "--plot-g",
+        p2,
+    )
+    assert rc == 0
+    assert "Prescription mode" in out and "Brown Eq. (1) prediction" in out
+    assert "8×(12×)" in out and "mean g =" in out
+    assert p1.stat().st_size > 1000 and p2.stat().st_size > 1000
+    rc, out, _ = run(
+        capsys,
+        "variation",
+        *S65,
+        "--focus",
+        "12x",
+        "--objects",
+        "8x",
+        "--max-field",
+        "45",
+        "--json",
+    )
+    d = json.loads(out)
+    assert d["mode"] == "prescription" and d["efl_mm"] == pytest.approx(65.0)
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["variation"], "give a CSV"),
+        (["variation", PENTAX, "--lens", "cooke-triplet-f4"], "either"),
+        (["variation", PENTAX, "--focus", "12x"], "only apply with --lens"),
+        (["variation", "--lens", "cooke-triplet-f4", "--objects", "8x"], "needs --focus"),
+        (["variation", "--lens", "cooke-triplet-f4", "--focus", "12x"], "needs --objects"),
+        (["variation", "--lens", "cooke-triplet-f4", "--focus", "12q", "--objects", "8x"], "'12q'"),
+        (
+            ["variation", "--lens", "no-such-lens", "--focus", "12x", "--objects", "8x"],
+            "no-such-lens",
+        ),
+        (
+            ["variation", "--lens", "cooke-triplet-f4", "--focus", "12x", "--objects", "12x"],
+            "one profile",
+        ),
+        (["variation", "/nonexistent/x.csv"], "cannot read"),
+        (["variation", PENTAX, "--threshold-um", "-1"], "threshold"),
+        (["coefficients", PENTAX], "--profile"),
+        (["coefficients", PENTAX, "--profile", "8,9.9"], "no profile"),
+        (["coefficients"], "give a CSV"),
+    ],
+)
+def test_bad_input_exit_2_one_line(capsys, argv, needle):
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2
+    assert out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0]
+
+
+def test_missing_columns_csv(capsys, tmp_path):
+    p = tmp_path / "bad.csv"
+    p.write_text("r_mm,dr_um,focus\n1,2,12x\n2,3,12x\n")
+    rc, _, err = run(capsys, "variation", p)
+    assert rc == 2 and "missing column" in err
+
+
+def test_coefficients_from_csv_recovers_polynomial(capsys, tmp_path):
+    # Exact Gaussian-form profile δr = K1 r^3 + K2 r^5 (mm): the fit must return K1, K2, K3 = 0.
+    k1, k2 = -2.0e-5, 3.0e-9
+    r = np.linspace(2, 40, 20)
+    dr_um = 1000 * (k1 * r**3 + k2 * r**5)
+    p = tmp_path / "one.csv"
+    p.write_text(
+        "r_mm,dr_um,focus,object\n"
+        + "".join(f"{float(a)!r},{float(b)!r},12x,12x\n" for a, b in zip(r, dr_um, strict=True))
+    )
+    rc, out, _ = run(
+        capsys,
+        "coefficients",
+        p,
+        "--principal-distance-mm",
+        "70",
+        "--pixel-pitch-um",
+        "5",
+        "--json",
+    )
+    d = json.loads(out)
+    assert rc == 0
+    assert d["gaussian_fit"]["K1"] == pytest.approx(k1, rel=1e-8)
+    assert d["gaussian_fit"]["K2"] == pytest.approx(k2, rel=1e-6)
+    cv = d["opencv"]
+    assert cv["fx_px"] == pytest.approx(70 / 0.005)
+    assert len(cv["dist_coeffs"]) == 5 and cv["dist_coeffs"][2:4] == [0.0, 0.0]
+
+
+def test_coefficients_traced(capsys):
+    rc, out, _ = run(
+        capsys,
+        "coefficients",
+        *S65,
+        "--focus",
+        "12x",
+        "--max-field",
+        "40",
+        "--focal-length-px",
+        "10000",
+        "--json",
+    )
+    d = json.loads(out)
+    assert rc == 0
+    c = d["profile"]["principal_distance_mm"]
+    # Gaussian plane of 12x: principal distance F0 = p0'/m_e = m0 p0 ≈ f (1 + 1/12) = 70.4 mm
+    # when the pupils are near the principal planes (Super-Angulon: nearly symmetric).
+    assert c == pytest.approx(65 * 13 / 12, rel=0.05)
+    assert d["opencv"]["pixel_pitch_um"] == pytest.approx(c / 10000 * 1000)
+    assert d["gaussian_fit"]["rms_um"] < 1.0
+    rc, out, _ = run(capsys, "coefficients", *S65, "--focus", "12x", "--max-field", "40")
+    assert rc == 0 and "OpenCV" in out and "K1" in out
