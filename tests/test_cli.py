@@ -1,0 +1,247 @@
+"""The orthoscope command line, end to end: output content, JSON/CSV, errors with exit status 2."""
+
+import csv
+import io
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from distortion.cli import main
+
+DATA = Path(__file__).parent / "data"
+TABLE1 = DATA / "pestrecov_table1.csv"
+
+
+def run(capsys, *argv):
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_lenses_lists_every_bundled_lens(capsys):
+    rc, out, _ = run(capsys, "lenses")
+    assert rc == 0
+    for name in (
+        "topogon-us2031792-fig1",
+        "cooke-triplet-f4",
+        "tessar-fr1066698",
+        "super-angulon-de975637",
+        "wide-field-ektar-us2518719",
+    ):
+        assert name in out
+    rc, out, _ = run(capsys, "lenses", "--json")
+    names = {d["name"] for d in json.loads(out)}
+    assert "cooke-triplet-f4" in names
+
+
+def test_paraxial_json_published_values(capsys):
+    # Cooke triplet: EFL 50.000, BFL 43.080 (issue 2's reference values for this prescription).
+    rc, out, _ = run(capsys, "paraxial", "cooke-triplet-f4", "--json")
+    d = json.loads(out)
+    assert rc == 0
+    assert d["efl"] == pytest.approx(50.000, abs=5e-4)
+    assert d["bfl"] == pytest.approx(43.080, abs=5e-4)
+    assert d["object_distance"] == "inf"
+
+
+def test_paraxial_image_scale_object(capsys):
+    # '12x' means Gaussian magnification -1/12 (Pestrecov Eq. 5: m0 = f/(f+s)).
+    rc, out, _ = run(capsys, "paraxial", "cooke-triplet-f4", "--object-distance", "12x", "--json")
+    d = json.loads(out)
+    assert d["m0"] == pytest.approx(-1.0 / 12.0, rel=1e-12)
+    assert d["m0"] == pytest.approx(d["efl"] / (d["efl"] + d["s"]), rel=1e-12)
+
+
+def test_trace_topogon_published_heights(capsys):
+    # US 2,031,792 Fig. 1, public lens-test fixture: real chief-ray heights on the paraxial image
+    # plane at 7, 14, 21, 28, 35 degrees.
+    rc, out, _ = run(
+        capsys, "trace", "topogon-us2031792-fig1", "--fields", "7,14,21,28,35", "--json"
+    )
+    d = json.loads(out)
+    got = [r["y_image_mm"] for r in d["rays"]]
+    assert got == pytest.approx([8.112, 16.495, 25.457, 35.382, 46.805], abs=1e-3)
+    assert all(r["status"] == "ok" for r in d["rays"])
+    assert d["image_plane"]["defocus_mm"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_trace_csv_and_text(capsys):
+    rc, out, _ = run(
+        capsys, "trace", "cooke-triplet-f4", "--max-field", "20", "--steps", "4", "--csv"
+    )
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert [float(r["angle_deg"]) for r in rows] == [0, 5, 10, 15, 20]
+    rc, out, _ = run(capsys, "trace", "cooke-triplet-f4", "--defocus", "0.5")
+    assert rc == 0 and "defocus +0.500000 mm" in out
+
+
+def test_trace_field_beyond_lens_gets_a_status(capsys):
+    rc, out, _ = run(capsys, "trace", "topogon-us2031792-fig1", "--fields", "30,70", "--json")
+    d = json.loads(out)
+    assert rc == 0
+    assert d["rays"][0]["status"] == "ok"
+    assert d["rays"][1]["status"] != "ok" and d["rays"][1]["y_image_mm"] is None
+
+
+def test_calibrate_prints_table_II(capsys):
+    # Acceptance (issue 3): Table I with two-point calibration at 37.5 and 45 deg prints Table II
+    # (Pestrecov 1958): Fc = 154.059, Yc' and Dc per field.
+    rc, out, _ = run(
+        capsys, "calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,45"
+    )
+    assert rc == 0
+    assert "F_c = 154.059 mm" in out
+    assert "27.165" in out and "154.059" in out  # Yc' at 10 and 45 deg
+    assert "-0.045" in out and "+0.081" in out and "-0.081" in out  # Dc at 10, 37.5, 45 deg
+    rc, out, _ = run(
+        capsys, "calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,45", "--json"
+    )
+    d = json.loads(out)
+    assert d["Fc"] == pytest.approx(154.059, abs=5e-4)
+    assert d["rho_k_deg"] == pytest.approx(24.67, abs=0.015)
+
+
+def test_distortion_several_planes_and_fig6_plot(capsys, tmp_path):
+    png = tmp_path / "fig6.png"
+    rc, out, _ = run(
+        capsys,
+        "distortion",
+        "topogon-us2031792-fig1",
+        "--image-distance",
+        "65.5",
+        "--image-distance",
+        "66.5",
+        "--plot",
+        str(png),
+        "--json",
+    )
+    d = json.loads(out)["distortion"]
+    assert rc == 0 and png.stat().st_size > 10_000
+    assert [p["s_prime_mm"] for p in d["planes"]] == pytest.approx([65.5, 66.5])
+    # Pestrecov Eq. (8): F0 = p0'/m_e in each plane; the Topogon is symmetric so m_e = 1, HE0 = 0
+    assert [p["F0_mm"] for p in d["planes"]] == pytest.approx([65.5, 66.5], abs=1e-9)
+
+
+def test_distortion_calibrate_and_layout(capsys, tmp_path):
+    rc, out, _ = run(
+        capsys,
+        "distortion",
+        "topogon-us2031792-fig1",
+        "--fields",
+        "0,20,40,45",
+        "--calibrate",
+        "two-point",
+        "--at",
+        "40,45",
+        "--layout",
+        str(tmp_path / "l.svg"),
+        "--plot-rotation",
+        str(tmp_path / "f4.pdf"),
+    )
+    assert rc == 0
+    assert "calibrated distortion" in out and "F_c =" in out
+    assert (tmp_path / "l.svg").stat().st_size > 1000
+    assert (tmp_path / "f4.pdf").stat().st_size > 1000
+
+
+def test_distortion_csv_rows(capsys):
+    rc, out, _ = run(
+        capsys,
+        "distortion",
+        "cooke-triplet-f4",
+        "--defocus",
+        "-1",
+        "--defocus",
+        "1",
+        "--steps",
+        "2",
+        "--csv",
+    )
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert len(rows) == 6
+    assert {round(float(r["defocus_mm"]), 9) for r in rows} == {-1.0, 1.0}
+
+
+def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
+    # Pestrecov Section VI: characteristic curves compensate when they are identical (D1 = D2)
+    # and M = M2. A printer whose negative-plane distortion equals the camera's, built from
+    # Table I itself, leaves zero residual.
+    printer = tmp_path / "printer.csv"
+    rows = [ln for ln in TABLE1.read_text().splitlines() if ln and not ln.startswith("#")][1:]
+    m2 = -2.0
+    out_rows = ["y_mm, y0p_mm, D0_mm"]
+    yneg = d0 = 0.0
+    for r in rows:
+        yneg_prev, d_prev = yneg, d0
+        a, y0p, d0, _ = (float(v) for v in r.split(","))
+        yneg = y0p + d0  # the point of the negative, imaged by the printer
+        # printer: D2 (negative plane) = D1 at that point  ->  print distortion Dp = -M2 * D2
+        out_rows.append(f"{yneg!r}, {m2 * yneg!r}, {-m2 * d0!r}")
+    # one more row 0.1 % beyond the field (linear extrapolation of D): the reader recomputes y0'
+    # from the fitted F0, so the camera's last negative point can exceed the printed one by the
+    # rounding of Table I.
+    yneg_end = 1.001 * yneg
+    d_end = d0 + (yneg_end - yneg) * (d0 - d_prev) / (yneg - yneg_prev)
+    out_rows.append(f"{yneg_end!r}, {m2 * yneg_end!r}, {-m2 * d_end!r}")
+    printer.write_text("\n".join(out_rows) + "\n")
+    rc, out, err = run(capsys, "compensate", str(TABLE1), str(printer), "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert max(abs(v) for v in d["residual_mm"]) < 2e-3
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["trace", "no-such-lens"], "no-such-lens"),
+        (["trace", "cooke-triplet-f4", "--fields", "0,abc"], "expected a number"),
+        (["trace", "cooke-triplet-f4", "--object-distance", "-5"], "positive magnitude"),
+        (["trace", "cooke-triplet-f4", "--image-from-vertex", "-3"], "before the last vertex"),
+        (["trace", "cooke-triplet-f4", "--field-kind", "height", "--fields", "1"], "finite object"),
+        (["distortion", "cooke-triplet-f4", "--at", "5"], "--calibrate"),
+        (["distortion", "cooke-triplet-f4", "--calibrate", "two-point", "--at", "5,99"], "90 degrees"),
+        (["distortion", "cooke-triplet-f4", "--plot", "x.gif"], ".png"),
+        (["calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,50"], "50"),
+        (["calibrate", "/nonexistent.csv", "--criterion", "minimax"], "nonexistent"),
+        (["convert", "cooke-triplet-f4", "out.seq"], ".seq"),
+        (["paraxial", "cooke-triplet-f4", "--s", "10"], "negative"),
+    ],
+)
+def test_bad_input_exit_2_one_line(capsys, argv, needle):
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2
+    assert needle in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+BROKEN = {
+    "two_stops.toml": "aperture = { fnumber = 4 }\nfield = { angle = 10 }\nsurfaces = [\n"
+    '  { r = 20, t = 2, glass = "1.5/60", stop = true },\n  { r = -20, t = 40, stop = true },\n]\n',
+    "unknown_material.toml": "aperture = { fnumber = 4 }\nfield = { angle = 10 }\nsurfaces = [\n"
+    '  { r = 20, t = 2, glass = "unobtainium", stop = true },\n  { r = -20, t = 40 },\n]\n',
+    "empty.toml": "",
+}
+
+
+@pytest.mark.parametrize("name", sorted(BROKEN))
+def test_broken_lens_file_via_console_script(tmp_path, name):
+    # End to end through the installed console script: exit status 2, the file named, no traceback.
+    exe = shutil.which("orthoscope")
+    f = tmp_path / name
+    f.write_text(BROKEN[name])
+    cmd = [exe] if exe else [sys.executable, "-m", "distortion.cli"]
+    p = subprocess.run([*cmd, "trace", str(f)], capture_output=True, text=True, cwd=tmp_path)
+    assert p.returncode == 2
+    assert name in p.stderr and "Traceback" not in p.stderr
+    assert p.stdout == ""
+
+
+def test_binary_garbage_lens_file(tmp_path, capsys):
+    f = tmp_path / "garbage.toml"
+    f.write_bytes(bytes(range(256)) * 4)
+    rc, out, err = run(capsys, "paraxial", str(f))
+    assert rc == 2 and "garbage.toml" in err and "Traceback" not in err
