@@ -43,7 +43,7 @@ from .errors import LensError, PrescriptionError
 from .glass import lookup_glass, parse_glass_code
 from .lens import Aperture, Field, Lens, Surface
 from .materials import AIR, LAMBDA_D, Material, model_glass
-from .zemax import ImportResult, decode_text, emit_warnings, lens_error, number, read_bytes
+from .zemax import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
 
 #: CODE V treats an object distance of 1e10 or more as infinite.
 CODEV_INFINITY = 1.0e10
@@ -499,17 +499,7 @@ class _SeqParser:
 
 def parse_seq(text: str | bytes, *, path: str | Path | None = None) -> ImportResult:
     """Parse CODE V ``.seq`` content (text or bytes) into an :class:`ImportResult`."""
-    spath = None if path is None else str(path)
-    if isinstance(text, bytes):
-        text = decode_text(text, spath, "a CODE V .seq lens file")
-    try:
-        return _SeqParser(text, spath).parse()
-    except PrescriptionError:
-        raise
-    except (ValueError, ArithmeticError, RecursionError, MemoryError) as e:  # pragma: no cover
-        raise PrescriptionError(
-            f"cannot read the file ({type(e).__name__}: {e})", path=spath, line=1
-        ) from None
+    return guarded_parse(_SeqParser, text, path, "a CODE V .seq lens file")
 
 
 def loads_seq(text: str | bytes, *, path: str | Path | None = None) -> Lens:

@@ -209,112 +209,139 @@ def _store(i, st, sf, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf):
 
 
 BLOCK = 256
+#: Blocks per parallel work item (one scratch buffer per item): 16 x 256 = 4096 rays.
+CHUNK_BLOCKS = 16
+
+# Row offsets of the per-block scratch buffer ``buf`` (one flat float64 array of 8 * BLOCK):
+# x, y, z, L, M, N, status, failed surface. One flat buffer with compile-time row offsets lets
+# LLVM prove that the rows do not overlap (dependence distance >= BLOCK), so the surface loop
+# below is vectorised (AVX2: 4 rays per instruction). With the eight separate output arrays the
+# runtime alias checks exceed LLVM's limit and the loop stayed scalar (profiled: 3.7x slower).
+_RX = 0
+_RY = BLOCK
+_RZ = 2 * BLOCK
+_RL = 3 * BLOCK
+_RM = 4 * BLOCK
+_RN = 5 * BLOCK
+_RS = 6 * BLOCK
+_RF = 7 * BLOCK
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1):
+    """One plane / quadric surface for the nb rays of the scratch buffer, branch-free (selects
+    only) so that it vectorises. Failed rays keep computing on meaningless values; their status
+    row records the first failure and they are replaced by NaN when the block is written out."""
+    ck = cj * (1.0 + kj)
+    mu2 = mu * mu
+    for i in range(nb):
+        LL = buf[_RL + i]
+        MM = buf[_RM + i]
+        NN = buf[_RN + i]
+        t0 = (zvj - buf[_RZ + i]) / NN
+        xx = buf[_RX + i] + t0 * LL
+        yy = buf[_RY + i] + t0 * MM
+        A = cj * (1.0 + kj * NN * NN)
+        B = NN - cj * (xx * LL + yy * MM)
+        C = cj * (xx * xx + yy * yy)
+        D = B * B - A * C
+        den = B + math.sqrt(max(D, 0.0))
+        s = C / den
+        xx += s * LL
+        yy += s * MM
+        zl = s * NN
+        w = 1.0 - ck * zl
+        nx = -cj * xx
+        ny = -cj * yy
+        inv = 1.0 / math.sqrt(nx * nx + ny * ny + w * w)
+        nx *= inv
+        ny *= inv
+        nz = w * inv
+        cosi = LL * nx + MM * ny + NN * nz
+        sgn = 1.0 if cosi >= 0.0 else -1.0
+        nx *= sgn
+        ny *= sgn
+        nz *= sgn
+        cosi *= sgn
+        sin2t = mu2 * (1.0 - cosi * cosi)
+        g = math.sqrt(max(1.0 - sin2t, 0.0)) - mu * cosi
+        L2 = mu * LL + g * nx
+        M2 = mu * MM + g * ny
+        N2 = mu * NN + g * nz
+        inv = 1.0 / math.sqrt(L2 * L2 + M2 * M2 + N2 * N2)
+        missed = (not (NN > 0.0)) or D < 0.0 or not (den > 0.0) or not (w > 0.0)
+        clipped = xx * xx + yy * yy > sd2
+        code = float(STATUS_TIR) if sin2t > 1.0 else 0.0
+        code = float(STATUS_CLIPPED) if clipped else code
+        code = float(STATUS_MISSED) if missed else code
+        buf[_RX + i] = xx
+        buf[_RY + i] = yy
+        buf[_RZ + i] = zvj + zl
+        buf[_RL + i] = L2 * inv
+        buf[_RM + i] = M2 * inv
+        buf[_RN + i] = N2 * inv
+        old = buf[_RS + i]
+        fresh = old == 0.0 and code != 0.0
+        buf[_RS + i] = code if old == 0.0 else old
+        buf[_RF + i] = jp1 if fresh else buf[_RF + i]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, i1, x, y, z, L, M, N,
-                 ox, oy, oz, oL, oM, oN, ost, osf):  # fmt: skip
-    """Trace rays i0..i1-1 surface by surface, in place in the output arrays.
+                 ox, oy, oz, oL, oM, oN, ost, osf, buf):  # fmt: skip
+    """Trace rays i0..i1-1 (i1 - i0 <= BLOCK) surface by surface in the scratch buffer ``buf``
+    (8 * BLOCK float64, rows ``_RX`` ... ``_RF``), then write them to the output arrays.
 
-    Plane / quadric surfaces run a branch-free loop over the rays (SIMD-friendly: failures are
-    recorded with selects, the arithmetic of failed rays continues on meaningless values that are
-    replaced by NaN at the end); asphere surfaces use the scalar Newton path per live ray."""
-    for i in range(i0, i1):
-        nrm = math.sqrt(L[i] * L[i] + M[i] * M[i] + N[i] * N[i])
-        good = nrm > 0.0 and math.isfinite(nrm) and math.isfinite(x[i] + y[i] + z[i])
-        ox[i] = x[i]
-        oy[i] = y[i]
-        oz[i] = z[i]
-        oL[i] = L[i] / nrm
-        oM[i] = M[i] / nrm
-        oN[i] = N[i] / nrm
-        ost[i] = STATUS_OK if good else STATUS_MISSED
-        osf[i] = 0 if good else 1
+    Plane / quadric surfaces run the vectorised branch-free loop :func:`_quadric_rows`; asphere
+    surfaces use the scalar Newton path (:func:`surface_step`) per live ray."""
+    nb = i1 - i0
+    for i in range(nb):
+        ii = i0 + i
+        nrm = math.sqrt(L[ii] * L[ii] + M[ii] * M[ii] + N[ii] * N[ii])
+        good = nrm > 0.0 and math.isfinite(nrm) and math.isfinite(x[ii] + y[ii] + z[ii])
+        buf[_RX + i] = x[ii]
+        buf[_RY + i] = y[ii]
+        buf[_RZ + i] = z[ii]
+        buf[_RL + i] = L[ii] / nrm
+        buf[_RM + i] = M[ii] / nrm
+        buf[_RN + i] = N[ii] / nrm
+        buf[_RS + i] = 0.0 if good else float(STATUS_MISSED)
+        buf[_RF + i] = 0.0 if good else 1.0
     for j in range(c.shape[0]):
         mu = n_in[j] / n_out[j]
         if kind[j] == KIND_ASPHERE:
-            for i in range(i0, i1):
-                if ost[i] != STATUS_OK:
+            for i in range(nb):
+                if buf[_RS + i] != 0.0:
                     continue
                 st, xx, yy, zz, LL, MM, NN = surface_step(
                     kind[j], c[j], k[j], asph, j, zv[j], mu, sd[j], clip,
-                    ox[i], oy[i], oz[i], oL[i], oM[i], oN[i],
+                    buf[_RX + i], buf[_RY + i], buf[_RZ + i],
+                    buf[_RL + i], buf[_RM + i], buf[_RN + i],
                 )  # fmt: skip
-                ox[i] = xx
-                oy[i] = yy
-                oz[i] = zz
-                oL[i] = LL
-                oM[i] = MM
-                oN[i] = NN
+                buf[_RX + i] = xx
+                buf[_RY + i] = yy
+                buf[_RZ + i] = zz
+                buf[_RL + i] = LL
+                buf[_RM + i] = MM
+                buf[_RN + i] = NN
                 if st != STATUS_OK:
-                    ost[i] = st
-                    osf[i] = j + 1
+                    buf[_RS + i] = float(st)
+                    buf[_RF + i] = float(j + 1)
             continue
-        cj = c[j]
-        ck = c[j] * (1.0 + k[j])
-        kj = k[j]
-        zvj = zv[j]
         sd2 = sd[j] * sd[j] if clip else np.inf
-        mu2 = mu * mu
-        for i in range(i0, i1):
-            LL = oL[i]
-            MM = oM[i]
-            NN = oN[i]
-            t0 = (zvj - oz[i]) / NN
-            xx = ox[i] + t0 * LL
-            yy = oy[i] + t0 * MM
-            A = cj * (1.0 + kj * NN * NN)
-            B = NN - cj * (xx * LL + yy * MM)
-            rho = xx * xx + yy * yy
-            C = cj * rho
-            D = B * B - A * C
-            den = B + math.sqrt(max(D, 0.0))
-            s = C / den
-            xx += s * LL
-            yy += s * MM
-            zl = s * NN
-            w = 1.0 - ck * zl
-            nx = -cj * xx
-            ny = -cj * yy
-            inv = 1.0 / math.sqrt(nx * nx + ny * ny + w * w)
-            nx *= inv
-            ny *= inv
-            nz = w * inv
-            cosi = LL * nx + MM * ny + NN * nz
-            sgn = 1.0 if cosi >= 0.0 else -1.0
-            nx *= sgn
-            ny *= sgn
-            nz *= sgn
-            cosi *= sgn
-            sin2t = mu2 * (1.0 - cosi * cosi)
-            g = math.sqrt(max(1.0 - sin2t, 0.0)) - mu * cosi
-            L2 = mu * LL + g * nx
-            M2 = mu * MM + g * ny
-            N2 = mu * NN + g * nz
-            inv = 1.0 / math.sqrt(L2 * L2 + M2 * M2 + N2 * N2)
-            missed = (not (NN > 0.0)) or D < 0.0 or not (den > 0.0) or not (w > 0.0)
-            clipped = xx * xx + yy * yy > sd2
-            code = STATUS_TIR if sin2t > 1.0 else STATUS_OK
-            code = STATUS_CLIPPED if clipped else code
-            code = STATUS_MISSED if missed else code
-            ox[i] = xx
-            oy[i] = yy
-            oz[i] = zvj + zl
-            oL[i] = L2 * inv
-            oM[i] = M2 * inv
-            oN[i] = N2 * inv
-            old = ost[i]
-            fresh = old == STATUS_OK and code != STATUS_OK
-            ost[i] = code if old == STATUS_OK else old
-            osf[i] = j + 1 if fresh else osf[i]
-    for i in range(i0, i1):
-        if ost[i] != STATUS_OK:
-            ox[i] = np.nan
-            oy[i] = np.nan
-            oz[i] = np.nan
-            oL[i] = np.nan
-            oM[i] = np.nan
-            oN[i] = np.nan
+        _quadric_rows(buf, nb, c[j], k[j], zv[j], sd2, mu, float(j + 1))
+    for i in range(nb):
+        ii = i0 + i
+        s = buf[_RS + i]
+        ost[ii] = np.int8(s)
+        osf[ii] = np.int32(buf[_RF + i])
+        good = s == 0.0
+        ox[ii] = buf[_RX + i] if good else np.nan
+        oy[ii] = buf[_RY + i] if good else np.nan
+        oz[ii] = buf[_RZ + i] if good else np.nan
+        oL[ii] = buf[_RL + i] if good else np.nan
+        oM[ii] = buf[_RM + i] if good else np.nan
+        oN[ii] = buf[_RN + i] if good else np.nan
 
 
 @njit(cache=True, error_model="numpy")
@@ -326,22 +353,42 @@ def trace_batch_serial(
     status (int8) and failed surface (int32, 1-based, 0 when OK). Rays are processed in blocks
     of ``BLOCK``, surface by surface within a block."""
     n = x.shape[0]
+    buf = np.empty(8 * BLOCK)
     for b in range((n + BLOCK - 1) // BLOCK):
         i0 = b * BLOCK
         _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
-                     x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf)  # fmt: skip
+                     x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf, buf)  # fmt: skip
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def trace_batch_parallel(
     kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
 ):
-    """Same as :func:`trace_batch_serial`, blocks split over numba's threads (prange)."""
+    """Same as :func:`trace_batch_serial`; chunks of ``CHUNK_BLOCKS`` blocks are split over
+    numba's threads (prange), each with its own scratch buffer."""
     n = x.shape[0]
-    for b in prange((n + BLOCK - 1) // BLOCK):
-        i0 = b * BLOCK
-        _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
-                     x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf)  # fmt: skip
+    nblk = (n + BLOCK - 1) // BLOCK
+    nch = (nblk + CHUNK_BLOCKS - 1) // CHUNK_BLOCKS
+    for ch in prange(nch):
+        buf = np.empty(8 * BLOCK)
+        for b in range(ch * CHUNK_BLOCKS, min(ch * CHUNK_BLOCKS + CHUNK_BLOCKS, nblk)):
+            i0 = b * BLOCK
+            _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
+                         x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf, buf)  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def transfer_to_plane(x, y, z, L, M, N, z_plane):
+    """(x, y) where the lines (x, y, z) + t (L, M, N) meet the plane z = z_plane (mm); one pass,
+    NaN in → NaN out."""
+    n = x.shape[0]
+    ox = np.empty(n)
+    oy = np.empty(n)
+    for i in range(n):
+        t = (z_plane - z[i]) / N[i]
+        ox[i] = x[i] + t * L[i]
+        oy[i] = y[i] + t * M[i]
+    return ox, oy
 
 
 # --------------------------------------------------------------------------------------------

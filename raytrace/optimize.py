@@ -212,15 +212,26 @@ def _object_distance(lens: Lens, op: Operand) -> float:
 
 
 def _bundle(
-    lens: Lens, par: ParaxialResult, field_value: float, kind: str, aperture: float, n_ring: int = 6
+    lens: Lens,
+    par: ParaxialResult,
+    field_value: float,
+    kind: str,
+    aperture: float,
+    n_ring: int = 10,
+    per_ring: int = 24,
 ):
-    """A pupil grid of rays (hexapolar, rings × 6k) for one field: start arrays for trace_rays."""
-    rho, theta = [0.0], [0.0]
-    for r in range(1, n_ring + 1):
-        k = 6 * r
-        rho += [aperture * r / n_ring] * k
-        theta += list(np.linspace(0.0, 2 * np.pi, k, endpoint=False))
-    rho, theta = np.array(rho), np.array(theta)
+    """A pupil grid of rays for one field: start arrays for trace_rays.
+
+    Equal-area rings (the midpoint rule in ρ²): ring k = 1..n_ring at ρ = aperture·√((k − ½)/n),
+    ``per_ring`` rays each (alternate rings rotated by half a step), so every ray stands for the
+    same pupil area and RMS / best-focus estimates are those of a uniformly filled pupil. (A
+    hexapolar grid with a ring on the rim over-weights the rim: for a lens with strong
+    spherical aberration it moved the least-RMS focus by ~1 % of s'.)
+    """
+    k = np.arange(1, n_ring + 1)
+    rho = np.repeat(aperture * np.sqrt((k - 0.5) / n_ring), per_ring)
+    step = 2 * np.pi / per_ring
+    theta = np.tile(np.arange(per_ring) * step, n_ring) + np.repeat((k % 2) * 0.5 * step, per_ring)
     a = par.epd / 2.0
     px, py = a * rho * np.cos(theta), a * rho * np.sin(theta)
     zE = par.z_E0

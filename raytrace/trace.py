@@ -81,6 +81,11 @@ class RayBatch:
     def at_plane(self, z_plane: float) -> tuple[np.ndarray, np.ndarray]:
         """(x, y) where each final segment meets the plane z = ``z_plane`` (mm), by analytic
         transfer; NaN for failed rays."""
+        arrs = (self.x, self.y, self.z, self.L, self.M, self.N)
+        if all(a.ndim == 1 and a.dtype == np.float64 and a.flags.c_contiguous for a in arrs) and (
+            len({a.shape for a in arrs}) == 1
+        ):
+            return _k.transfer_to_plane(*arrs, float(z_plane))  # one pass, no temporaries
         t = (float(z_plane) - self.z) / self.N
         return self.x + t * self.L, self.y + t * self.M
 

@@ -740,11 +740,17 @@ class _ZmxParser:
 def parse_zmx(text: str | bytes, *, path: str | Path | None = None) -> ImportResult:
     """Parse ``.zmx`` content (text, or raw bytes in any of the supported encodings) into an
     :class:`ImportResult` (lens + skipped-command list). Raises only PrescriptionError."""
+    return guarded_parse(_ZmxParser, text, path, "a Zemax .zmx lens file")
+
+
+def guarded_parse(parser, text: str | bytes, path: str | Path | None, what: str) -> ImportResult:
+    """Decode ``text`` if it is bytes and run ``parser(text, path).parse()``, so that nothing but
+    a PrescriptionError (with the file and a line) ever leaves a reader."""
     spath = None if path is None else str(path)
     if isinstance(text, bytes):
-        text = decode_text(text, spath, "a Zemax .zmx lens file")
+        text = decode_text(text, spath, what)
     try:
-        return _ZmxParser(text, spath).parse()
+        return parser(text, spath).parse()
     except PrescriptionError:
         raise
     except (ValueError, ArithmeticError, RecursionError, MemoryError) as e:  # pragma: no cover

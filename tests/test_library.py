@@ -42,7 +42,13 @@ PUBLISHED = {
 def test_library_holds_the_bundled_files() -> None:
     assert library_dir().resolve() == REPO_LENSES.resolve()
     assert bundled_names() == sorted(p.stem for p in REPO_LENSES.glob("*.toml"))
-    assert set(PUBLISHED) == set(bundled_names())
+    # every bundled lens is either checked against published data here, or is one of our derived
+    # designs, checked against its design targets in tests/test_design_*.py
+    assert set(PUBLISHED) <= set(bundled_names())
+    assert set(bundled_names()) - set(PUBLISHED) <= DESIGNED
+
+
+DESIGNED = {"topogon-like-pestrecov", "twinplex-like-55-525"}
 
 
 @pytest.mark.parametrize("name", sorted(PUBLISHED))
