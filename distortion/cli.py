@@ -409,6 +409,12 @@ def build_parser() -> argparse.ArgumentParser:
         ),
         epilog="Run 'orthoscope COMMAND --help' for each command's options.",
     )
+    p.add_argument(
+        "--threads",
+        type=int,
+        metavar="N",
+        help="Numba threads for bulk traces (default: numba's setting, NUMBA_NUM_THREADS).",
+    )
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
@@ -461,6 +467,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        if args.threads is not None:
+            _set_threads(args.threads)
         return int(args.func(args) or 0)
     except OrthoscopeError as e:
         print(f"orthoscope {args.command}: error: {e}", file=sys.stderr)
@@ -476,6 +484,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 1
+
+
+def _set_threads(n: int) -> None:
+    """--threads N: numba threads for this run (1 .. NUMBA_NUM_THREADS)."""
+    import numba
+
+    top = numba.config.NUMBA_NUM_THREADS
+    if not 1 <= n <= top:
+        raise CliError(f"--threads must be between 1 and {top} (NUMBA_NUM_THREADS), got {n}")
+    numba.set_num_threads(n)
 
 
 def _register_extras() -> None:

@@ -47,7 +47,8 @@ from .lens import Lens, pack
 from .materials import Material
 from .paraxial import ParaxialResult, paraxial, pestrecov_constants
 
-VARIABLE_KINDS = ("curvature", "thickness", "index")
+VARIABLE_KINDS = ("curvature", "thickness", "index", "conic", "A4", "A6", "A8", "A10")
+ASPHERIC_KINDS = ("A4", "A6", "A8", "A10")  # coefficients of r^4, r^6, r^8, r^10
 OPERAND_TYPES = (
     "efl",
     "m_e",
@@ -152,6 +153,11 @@ def get_value(lens: Lens, kind: str, surface: int) -> float:
         return s.thickness
     if kind == "index":
         return s.material.nd
+    if kind == "conic":
+        return s.conic
+    if kind in ASPHERIC_KINDS:
+        j = ASPHERIC_KINDS.index(kind)
+        return s.aspheric[j] if j < len(s.aspheric) else 0.0
     raise SpecError(f"unknown variable kind {kind!r} (use one of {', '.join(VARIABLE_KINDS)})")
 
 
@@ -166,6 +172,15 @@ def set_values(lens: Lens, kinds_surfaces: list[tuple[str, int]], values) -> Len
             s = replace(s, curvature=v)
         elif kind == "thickness":
             s = replace(s, thickness=v)
+        elif kind == "conic":
+            s = replace(s, conic=v)
+        elif kind in ASPHERIC_KINDS:
+            j = ASPHERIC_KINDS.index(kind)
+            a = list(s.aspheric) + [0.0] * max(0, j + 1 - len(s.aspheric))
+            a[j] = v
+            while a and a[-1] == 0.0:
+                a.pop()
+            s = replace(s, aspheric=tuple(a))
         else:
             m = s.material
             s = replace(s, material=Material("model" if m.kind == "model" else "index", v, m.vd))
@@ -174,12 +189,23 @@ def set_values(lens: Lens, kinds_surfaces: list[tuple[str, int]], values) -> Len
 
 
 def apply(lens: Lens, spec: DesignSpec, x) -> Lens:
-    """The lens with variables ``x`` and the spec's pick-ups applied."""
+    """The lens with variables ``x`` and the spec's pick-ups applied.
+
+    A start lens whose image plane is a Gaussian solve (``image_solve == "gaussian"``) keeps it:
+    the last thickness is re-solved for every new lens unless it is itself a variable or pick-up.
+    """
     ks = [(v.kind, v.surface) for v in spec.variables]
     out = set_values(lens, ks, x)
     if spec.pickups:
         vals = [p.factor * get_value(out, p.kind, p.source) + p.offset for p in spec.pickups]
         out = set_values(out, [(p.kind, p.surface) for p in spec.pickups], vals)
+    last = ("thickness", lens.n_surfaces)
+    if lens.image_solve == "gaussian" and last not in ks + [
+        (p.kind, p.surface) for p in spec.pickups
+    ]:
+        out = replace(
+            out.with_image_distance(paraxial(out).gaussian_image_distance), image_solve="gaussian"
+        )
     return out
 
 
@@ -401,11 +427,6 @@ def check_spec(lens: Lens, spec: DesignSpec) -> None:
             )
         if v.kind == "index" and lens.surfaces[v.surface - 1].material.is_air:
             raise SpecError(f"variable index {v.surface}: the medium after it is air")
-        x0 = get_value(lens, v.kind, v.surface)
-        if not v.lower <= x0 <= v.upper:
-            raise SpecError(
-                f"variable {v.kind} {v.surface}: start value {x0} is outside [{v.lower}, {v.upper}]"
-            )
     seen = {(v.kind, v.surface) for v in spec.variables}
     for pk in spec.pickups:
         if pk.kind not in VARIABLE_KINDS:
@@ -461,17 +482,29 @@ def optimize(
     hi = np.array(
         [min(v.upper, INDEX_BOUNDS[1]) if v.kind == "index" else v.upper for v in spec.variables]
     )
-    x0 = np.clip(x0, lo, hi)
+    x0 = np.clip(x0, lo, hi)  # a start value outside its bounds starts on the nearest bound
+    # The solver works on x / scale: aspheric coefficients are tiny numbers (mm^(1-k)), scaled
+    # so that a unit change is a sag change of the order of a tenth of the EFL at a tenth of the
+    # EFL; every other kind is left unscaled.
+    rref = 0.1 * abs(paraxial(lens).efl)
+    sc = np.array(
+        [
+            rref ** (1 - (4 + 2 * ASPHERIC_KINDS.index(v.kind)))
+            if v.kind in ASPHERIC_KINDS
+            else 1.0
+            for v in spec.variables
+        ]
+    )
     start_vals = evaluate(apply(lens, spec, x0), spec.operands)
     m0 = merit(start_vals)
     n_ev = [0]
     big = math.sqrt(m0 + 1.0) * 1e3
     t0 = time.perf_counter()
 
-    def fun(x):
+    def fun(xs):
         n_ev[0] += 1
         try:
-            vals = evaluate(apply(lens, spec, x), spec.operands)
+            vals = evaluate(apply(lens, spec, xs * sc), spec.operands)
         except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
             # an impossible lens in the middle of a step: a large, smooth-ish penalty
             return np.full(len(spec.operands), big)
@@ -482,8 +515,8 @@ def optimize(
 
     sol = least_squares(
         fun,
-        x0,
-        bounds=(lo, hi),
+        x0 / sc,
+        bounds=(lo / sc, hi / sc),
         method="trf",
         x_scale="jac",
         xtol=spec.tolerance,
@@ -492,7 +525,8 @@ def optimize(
         max_nfev=spec.max_evaluations,
         diff_step=1e-7,
     )
-    final = apply(lens, spec, sol.x)
+    x_final = sol.x * sc
+    final = apply(lens, spec, x_final)
     vals = evaluate(final, spec.operands)
     m = merit(vals)
     converged = sol.status > 0
@@ -504,7 +538,7 @@ def optimize(
         msg = f"stopped at the evaluation limit ({spec.max_evaluations}) before converging"
     return OptimizationResult(
         lens=final,
-        x=sol.x,
+        x=x_final,
         merit_start=m0,
         merit=m,
         operands=vals,

@@ -45,9 +45,12 @@ STATUS_NAMES = {
 }
 
 #: Batches of at least this many rays use the prange kernel (when more than one thread is
-#: allowed). Measured on the 2-core development machine (benchmarks/bench_core.py): 2 threads win
-#: from ~4k rays on a quiet machine; 8192 keeps a margin for a loaded one.
-PARALLEL_THRESHOLD = 8192
+#: allowed). Measured on the 2-core development machine (benchmarks/bench_core.py crossover,
+#: vectorised kernel: serial 1 µs per 20 rays): 2 threads win from ~4k rays when a second core is
+#: free, but when it is busy (other processes) a parallel call waits one scheduler slice (~4 ms).
+#: At 32768 rays the serial kernel takes ~1.6 ms, which bounds that penalty to ~2.5x and costs at
+#: most ~0.8 ms on a quiet machine.
+PARALLEL_THRESHOLD = 32768
 
 
 # --------------------------------------------------------------------------------------------

@@ -203,7 +203,10 @@ def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
         (["trace", "cooke-triplet-f4", "--image-from-vertex", "-3"], "before the last vertex"),
         (["trace", "cooke-triplet-f4", "--field-kind", "height", "--fields", "1"], "finite object"),
         (["distortion", "cooke-triplet-f4", "--at", "5"], "--calibrate"),
-        (["distortion", "cooke-triplet-f4", "--calibrate", "two-point", "--at", "5,99"], "90 degrees"),
+        (
+            ["distortion", "cooke-triplet-f4", "--calibrate", "two-point", "--at", "5,99"],
+            "90 degrees",
+        ),
         (["distortion", "cooke-triplet-f4", "--plot", "x.gif"], ".png"),
         (["calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,50"], "50"),
         (["calibrate", "/nonexistent.csv", "--criterion", "minimax"], "nonexistent"),

@@ -109,7 +109,7 @@ def test_existing_path_wins_over_bundled_name(tmp_path: Path, monkeypatch) -> No
 @pytest.mark.parametrize(
     ("query", "suggestion"),
     [
-        ("topogon", "topogon-us2031792-fig1"),
+        ("topogon-us2031792", "topogon-us2031792-fig1"),
         ("tesar", "tessar-fr1066698"),
         ("cooke-triplet-f5.toml", "cooke-triplet-f4"),
     ],
@@ -119,7 +119,7 @@ def test_unknown_name_lists_the_library(query: str, suggestion: str) -> None:
         resolve_lens_path(query)
     msg = str(e.value)
     assert msg.startswith(f"{query}: no such file or bundled lens")
-    assert f"did you mean '{suggestion}'" in msg
+    assert "did you mean" in msg and f"'{suggestion}'" in msg.split("did you mean")[1].split("?")[0]
     for name in bundled_names():
         assert name in msg
 

@@ -172,3 +172,20 @@ def test_read_spec_unknown_key(tmp_path: Path):
     spec.write_text('start = "x"\nvariabels = []\n')
     with pytest.raises(SpecError, match="unknown key 'variabels'"):
         read_spec(spec)
+
+
+def test_gaussian_image_solve_is_kept(tmp_path: Path):
+    # A start lens whose last thickness is a Gaussian solve keeps it through the optimization:
+    # the written file must not carry the start lens's stale image distance.
+    from raytrace.library import load_lens
+    from raytrace.prescription import read_lens
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(target=48.0))
+    out = tmp_path / "out.toml"
+    assert load_lens("cooke-triplet-f4").image_solve == "gaussian"
+    assert main(["optimize", str(spec), "-o", str(out), "--quiet"]) == 0
+    lens = read_lens(out)
+    assert lens.image_solve == "gaussian"
+    assert lens.surfaces[-1].thickness == pytest.approx(paraxial(lens).bfl, abs=1e-9)
+    assert 't = "gaussian"' in out.read_text().replace("  ", " ")
