@@ -2,10 +2,11 @@
 
 Targets (the issue): EFL = F0 = 153.706 mm (four air-spaced menisci about a central stop; the
 shipped formula has even-asphere terms on its four outer surfaces, see the spec); traced
-characteristic distortion D0 (object at infinity, Gaussian image plane) within 0.002 mm of Table I at the nine angles; the two-point calibration at
-37.5 and 45 deg gives F_c within 0.002 mm of Table II's 154.059 mm and D_c within 0.002 mm of
-Table II. Table I / II numbers: tests/data/pestrecov_table1.csv and pestrecov_table2.csv (source:
-K. Pestrecov, Photogrammetric Engineering 1958, Tables I and II).
+characteristic distortion D0 (object at infinity, Gaussian image plane) within 0.002 mm of
+Table I at the nine angles; the two-point calibration at 37.5 and 45 deg gives F_c within
+0.002 mm of Table II's 154.059 mm and D_c within 0.002 mm of Table II. Table I / II numbers:
+tests/data/pestrecov_table1.csv and pestrecov_table2.csv (source: K. Pestrecov,
+Photogrammetric Engineering 1958, Tables I and II).
 """
 
 from __future__ import annotations
