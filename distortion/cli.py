@@ -32,7 +32,7 @@ S_HELP = (
 IMAGE_HELP = (
     "Image plane as Pestrecov's s': mm from the second principal point H', positive to the right "
     "(e.g. 525). Default: the plane the lens file defines (its last thickness; a file whose last "
-    "thickness is \"gaussian\" means the Gaussian plane of whatever object is traced)."
+    'thickness is "gaussian" means the Gaussian plane of whatever object is traced).'
 )
 VERTEX_HELP = "Image plane as a distance (mm) from the LAST VERTEX, positive to the right."
 DEFOCUS_HELP = (

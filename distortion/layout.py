@@ -11,17 +11,14 @@ from __future__ import annotations
 
 import math
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from raytrace.lens import Lens, pack
+from raytrace.paraxial import paraxial
+from raytrace.trace import chief_rays, ray_paths, trace_rays
 
-from raytrace.lens import Lens, pack  # noqa: E402
-from raytrace.paraxial import paraxial  # noqa: E402
-from raytrace.trace import chief_rays, ray_paths, trace_rays  # noqa: E402
-
-from .plots import _save  # noqa: E402
+from .plots import _save
 
 
 def _rim_rays(par, cr, i, sign: float):
@@ -84,7 +81,8 @@ def plot_layout(
     paths = ray_paths(packed, 0.0, ys, zs, 0.0, Ms, Ns, clip=False)
     final = trace_rays(packed, 0.0, ys, zs, 0.0, Ms, Ns, clip=False)
 
-    fig, ax = plt.subplots(figsize=(9.0, 4.2))
+    fig = Figure(figsize=(9.0, 4.2))
+    ax = fig.subplots()
     zv = lens.vertex_z
     length = max(lens.length, 1e-3)
     z_left = -0.35 * length - 5.0

@@ -1,4 +1,4 @@
-"""Distortion charts in the style of Pestrecov 1958, Figs. 2, 3, 4 and 6 (matplotlib, Agg).
+"""Distortion charts in the style of Pestrecov 1958, Figs. 2, 3, 4 and 6 (matplotlib Figure API).
 
 Every function draws one figure, saves it when ``path`` is given (format from the extension:
 .png, .svg, .pdf) and returns the ``Figure`` (so tests and notebooks can inspect the lines).
@@ -10,16 +10,13 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from raytrace.errors import DataError
 
-from raytrace.errors import DataError  # noqa: E402
-
-from .calibration import CalibrationResult  # noqa: E402
-from .tables import DistortionCurve  # noqa: E402
+from .calibration import CalibrationResult
+from .tables import DistortionCurve
 
 FORMATS = (".png", ".svg", ".pdf")
 
@@ -29,7 +26,6 @@ def _save(fig, path) -> None:
         return
     p = Path(path)
     if p.suffix.lower() not in FORMATS:
-        plt.close(fig)
         raise DataError(f"{p}: unsupported plot format {p.suffix!r}; use {', '.join(FORMATS)}")
     try:
         fig.savefig(p, dpi=150, bbox_inches="tight")
@@ -43,7 +39,8 @@ def _title(name: str, plane: str, what: str) -> str:
 
 
 def _two_axes(x, lin, rel, xlabel, lin_label, rel_label, title):
-    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.subplots()
     ax.axhline(0.0, color="0.4", lw=0.8)
     (l1,) = ax.plot(x, lin, "-o", color="k", ms=4, label=lin_label)
     ax.set_xlabel(xlabel)
@@ -119,7 +116,8 @@ def plot_rotation(res: CalibrationResult, path=None):
     """Fig. 4: the characteristic curve rotated by −ρ_k vs the calibrated curve (D_c vs y_c')."""
     c = res.curve
     Xp, Dp = rotated_characteristic(res)
-    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.subplots()
     ax.axhline(0.0, color="0.4", lw=0.8)
     ax.plot(
         Xp,
@@ -159,7 +157,8 @@ def plot_planes(
         raise DataError("no curves to plot")
     if against not in ("field", "image"):
         raise ValueError(f"against must be 'field' or 'image', got {against!r}")
-    fig, ax = plt.subplots(figsize=(7.0, 4.6))
+    fig = Figure(figsize=(7.0, 4.6))
+    ax = fig.subplots()
     ax.axhline(0.0, color="0.4", lw=0.8)
     styles = ["-o", "--s", "-.^", ":D", "-v", "--x"]
     for i, c in enumerate(curves):
@@ -183,3 +182,12 @@ def plot_planes(
     fig.tight_layout()
     _save(fig, path)
     return fig
+
+
+def png_bytes(fig, dpi: int = 100) -> bytes:
+    """The figure as PNG bytes (for notebooks: ``IPython.display.Image(png_bytes(fig))``)."""
+    import io
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+    return buf.getvalue()

@@ -7,7 +7,7 @@
   |δr_s' − δr_s| is below the threshold dashed (weak determination, Figs. 5–6), the least-squares
   g as a thin horizontal line.
 
-Both return the matplotlib Figure; ``path`` saves a PNG. Uses the Agg backend (no display).
+Both return the matplotlib Figure (no pyplot, no backend needed); ``path`` saves a PNG.
 """
 
 from __future__ import annotations
@@ -15,20 +15,19 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from .variation import VariationAnalysis  # noqa: E402
+from .variation import VariationAnalysis
 
 
 def plot_profiles(
     a: VariationAnalysis, path: str | Path | None = None, *, title: str | None = None
 ):
     """Radial distortion profiles i×(j×) of an analysis (Figs. 1–4 style)."""
-    fig, ax = plt.subplots(figsize=(7, 5))
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(7, 5))
+    ax = fig.subplots()
+    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, p in enumerate(a.profiles):
         gauss = p.focus == p.obj
         ax.plot(
@@ -54,8 +53,9 @@ def plot_profiles(
 
 def plot_g(a: VariationAnalysis, path: str | Path | None = None, *, title: str | None = None):
     """g_ss' against radial distance (Figs. 5–7 style); weak radii dashed."""
-    fig, ax = plt.subplots(figsize=(7, 5))
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(7, 5))
+    ax = fig.subplots()
+    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
     k = 0
     finite = []
     for fs in a.focus_summaries:

@@ -203,7 +203,6 @@ def test_unknown_glass_says_what_to_do():
         assert "pip install 'orthoscope[glass]'" in msg
 
 
-@pytest.mark.skipif(not catalog_available(), reason="needs the optional glass catalogs")
 def test_ambiguous_glass_lists_candidates_and_gcat_resolves_it():
     # F2 is both Schott F2 (1.62004/36.37) and CDGM F2 (1.61293/36.96) in the vendor catalogs
     text = _flint_glass("GLAS F2 0 0 1.5 40 0 0 0 0 0 0")
