@@ -77,6 +77,19 @@ def _asphere_sag(c, k, asph, j, rho):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def _snell(LL, MM, NN, nx, ny, nz, mu, mu2):
+    """Vector Snell refraction of the unit direction (LL, MM, NN) at the unit normal (nx, ny,
+    nz), either orientation, with mu = n/n' and mu2 = mu². Returns (L', M', N', sin²θ'); the
+    caller flags TIR where sin²θ' > 1 (the direction is then meaningless)."""
+    cosi = LL * nx + MM * ny + NN * nz
+    sgn = 1.0 if cosi >= 0.0 else -1.0
+    cosi *= sgn
+    sin2t = mu2 * (1.0 - cosi * cosi)
+    g = (math.sqrt(max(1.0 - sin2t, 0.0)) - mu * cosi) * sgn
+    return mu * LL + g * nx, mu * MM + g * ny, mu * NN + g * nz, sin2t
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
     """Intersect one surface and refract. Returns (status, x, y, z, L, M, N) with the point on the
     surface (global z) and the direction after it; status != 0 leaves the values meaningless."""
@@ -148,19 +161,10 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
         nx *= inv
         ny *= inv
         nz *= inv
-        cosi = L * nx + M * ny + N * nz
-        if cosi < 0.0:
-            nx = -nx
-            ny = -ny
-            nz = -nz
-            cosi = -cosi
-        sin2t = mu * mu * (1.0 - cosi * cosi)
+        L2, M2, N2, sin2t = _snell(L, M, N, nx, ny, nz, mu, mu * mu)
         if sin2t > 1.0:
             return STATUS_TIR, x, y, z, L, M, N
-        g = math.sqrt(1.0 - sin2t) - mu * cosi
-        L = mu * L + g * nx
-        M = mu * M + g * ny
-        N = mu * N + g * nz
+        L, M, N = L2, M2, N2
         inv = 1.0 / math.sqrt(L * L + M * M + N * N)
         L *= inv
         M *= inv
@@ -274,19 +278,9 @@ def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere):
             nx *= inv
             ny *= inv
             nz = w * inv
-        cosi = LL * nx + MM * ny + NN * nz
-        sgn = 1.0 if cosi >= 0.0 else -1.0
-        nx *= sgn
-        ny *= sgn
-        nz *= sgn
-        cosi *= sgn
-        sin2t = mu2 * (1.0 - cosi * cosi)
-        g = math.sqrt(max(1.0 - sin2t, 0.0)) - mu * cosi
+        L2, M2, N2, sin2t = _snell(LL, MM, NN, nx, ny, nz, mu, mu2)
         # |d'| = 1 exactly for unit d and n̂: no renormalisation here (it cost 17 % of the bulk
         # time); the drift measured over 11 surfaces is <= 2e-15 (tests check <= 1e-14).
-        L2 = mu * LL + g * nx
-        M2 = mu * MM + g * ny
-        N2 = mu * NN + g * nz
         missed = (not (NN > 0.0)) or D < 0.0 or not (den > 0.0) or not (w > 0.0)
         clipped = xx * xx + yy * yy > sd2
         code = float(STATUS_TIR) if sin2t > 1.0 else 0.0
@@ -417,17 +411,7 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1):
         nx *= inv
         ny *= inv
         nz = inv
-        cosi = LL * nx + MM * ny + NN * nz
-        sgn = 1.0 if cosi >= 0.0 else -1.0
-        nx *= sgn
-        ny *= sgn
-        nz *= sgn
-        cosi *= sgn
-        sin2t = mu2 * (1.0 - cosi * cosi)
-        g = math.sqrt(max(1.0 - sin2t, 0.0)) - mu * cosi
-        L2 = mu * LL + g * nx
-        M2 = mu * MM + g * ny
-        N2 = mu * NN + g * nz
+        L2, M2, N2, sin2t = _snell(LL, MM, NN, nx, ny, nz, mu, mu2)
         inv = 1.0 / math.sqrt(L2 * L2 + M2 * M2 + N2 * N2)
         refract = mu != 1.0
         missed = not math.isfinite(dsag)
