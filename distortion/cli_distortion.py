@@ -71,6 +71,11 @@ def _planes(args) -> dict:
         )
         if v
     }
+    if given and args.gaussian:
+        raise CliError(
+            "--gaussian names the image plane: give it alone, or give the planes with "
+            "--image-distance / --image-from-vertex / --defocus (which may include 0)"
+        )
     if len(given) > 1:
         raise CliError(
             "give image planes with only one of --image-distance, --image-from-vertex, "
