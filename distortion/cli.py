@@ -199,34 +199,19 @@ def fmt(v: float, width: int = 12, prec: int = 4) -> str:
     return f"{v:>{width}.{prec}f}"
 
 
-def resolve_image_z(par, args, lens=None) -> tuple[float, str]:
-    """Absolute z of the image plane from --image-distance / --image-from-vertex / --defocus."""
-    given = [
-        (n, v)
-        for n, v in (
-            ("image-distance", getattr(args, "image_distance", None)),
-            ("image-from-vertex", getattr(args, "image_from_vertex", None)),
-            ("defocus", getattr(args, "defocus", None)),
-        )
-        if v is not None
-    ]
-    if len(given) > 1:
-        raise CliError("give only one of --image-distance, --image-from-vertex, --defocus")
-    if not given:
-        if lens is not None and lens.image_solve == "gaussian":
-            return par.z_gauss, "lens file: Gaussian plane of the object"
-        return par.z_image_file, "lens file"
-    name, v = given[0]
-    if isinstance(v, list):
-        if len(v) != 1:
-            raise CliError(f"--{name} takes one value here")
-        v = v[0]
-    if name == "image-distance":
-        z = par.z_from_s_prime(v)
-    elif name == "image-from-vertex":
-        z = par.z_from_last_vertex(v)
+def resolve_image_z(par, args, lens) -> tuple[float, str]:
+    """Absolute z of the image plane from --image-distance / --image-from-vertex / --defocus (an
+    argparse mutually exclusive group: at most one is given); default: the lens file's plane."""
+    if args.image_distance is not None:
+        z, name = par.z_from_s_prime(args.image_distance), "image-distance"
+    elif args.image_from_vertex is not None:
+        z, name = par.z_from_last_vertex(args.image_from_vertex), "image-from-vertex"
+    elif args.defocus is not None:
+        z, name = par.z_from_defocus(args.defocus), "defocus"
+    elif lens.image_solve == "gaussian":
+        return par.z_gauss, "lens file: Gaussian plane of the object"
     else:
-        z = par.z_from_defocus(v)
+        return par.z_image_file, "lens file"
     check_image_z(par, z)
     return z, name
 

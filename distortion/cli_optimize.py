@@ -139,7 +139,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Run a design spec (damped least squares) and write the resulting lens.",
         description=(
             "Optimize a lens from a TOML design spec: start lens, variables (curvature, thickness, "
-            "index of 1-based surfaces, with bounds), pick-ups, and operands with targets and "
+            "index, conic, A4, A6, A8, A10 of 1-based surfaces, with bounds; a start value outside "
+            "its bounds starts on the nearest bound), pick-ups, and operands with targets and "
             "weights (efl, m_e, HE0, HpE0p, distortion, distortion_rel, image_height, best_focus, "
             "rms_spot, center_thickness, edge_thickness). Progress (evaluation, merit, worst "
             "operand) goes to stderr. The lens is written with its provenance (start lens, spec, "

@@ -1,7 +1,8 @@
 """Damped-least-squares lens optimization on ``scipy.optimize.least_squares``.
 
-A design is a :class:`DesignSpec` — variables (curvatures, thicknesses, indices), pick-ups (e.g. a
-curvature that follows another with factor −1), and operands with targets and weights — usually read
+A design is a :class:`DesignSpec` — variables (curvature, thickness, index, conic and the
+even-asphere coefficients A4–A10 of 1-based surfaces, with bounds), pick-ups (e.g. a curvature that
+follows another with factor −1), and operands with targets and weights — usually read
 from a TOML spec file (:func:`read_spec`). :func:`optimize` runs it and returns a
 :class:`OptimizationResult`; nothing is written unless the caller writes the lens.
 
