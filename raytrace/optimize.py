@@ -319,6 +319,7 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
     from .trace import chief_rays, trace_rays
 
     pars: dict[float, ParaxialResult] = {}
+    packed = None
 
     def par_for(od: float) -> ParaxialResult:
         if od not in pars:
@@ -378,7 +379,8 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
             rays = _bundle(
                 lens, par, float(p.get("field", 0.0)), kind, float(p.get("aperture", 1.0))
             )
-            batch = trace_rays(pack(lens), *rays, clip=False)
+            packed = packed or pack(lens)  # once per evaluation, for every spot operand
+            batch = trace_rays(packed, *rays, clip=False)
             stats = _spot_stats(batch)
             if t == "best_focus":
                 v = _best_focus_z(stats) - par.z_Hp
