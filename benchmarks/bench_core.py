@@ -24,10 +24,10 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from raytrace import kernels as K
-from raytrace.lens import pack
-from raytrace.library import load_lens
-from raytrace.trace import _lens_arrays, chief_rays, trace_rays
+from raytrace.kernels import bulk as K
+from raytrace.files.library import load_lens
+from raytrace.packing import pack
+from raytrace.trace import chief_rays, trace_rays
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
@@ -62,7 +62,7 @@ def bulk(n: int, repeat: int) -> list[dict]:
             continue
 
         def run(threads=threads):
-            rb = trace_rays(p, *rays, threads=threads)
+            rb = trace_rays(p, rays[:3], rays[3:], threads=threads)
             rb.at_plane(p.z_image)
             return rb
 
@@ -83,7 +83,7 @@ def bulk(n: int, repeat: int) -> list[dict]:
 def crossover(repeat: int = 30) -> list[dict]:
     """Serial vs parallel kernel time for small batches (2 threads)."""
     p = pack(load_lens("cooke-triplet-f4"))
-    la = _lens_arrays(p)
+    la = p.arrays
     rows = []
     for n in (1000, 4000, 8000, 16000, 32000, 64000):
         rays = _rays(n, 1)

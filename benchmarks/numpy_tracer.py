@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from raytrace.lens import KIND_ASPHERE, KIND_PLANE, PackedLens
+from raytrace.kernels.codes import KIND_ASPHERE, KIND_PLANE
+from raytrace.packing import PackedLens
 
 OK, MISSED, TIR, CLIPPED = 0, 1, 2, 3
 

@@ -44,7 +44,7 @@ def build_optic(lens, wavelength_nm: float | None = None):
     from optiland.materials import IdealMaterial
     from optiland.optic import Optic
 
-    from raytrace.lens import pack
+    from raytrace.packing import pack
     from raytrace.paraxial import paraxial
 
     wl = lens.wavelength if wavelength_nm is None else wavelength_nm

@@ -48,9 +48,10 @@ import handwritten_numba as hw  # noqa: E402
 import numpy_tracer as npt  # noqa: E402
 import optiland_adapter as ola  # noqa: E402
 
-from raytrace.lens import Lens, Surface, pack  # noqa: E402
-from raytrace.library import load_lens  # noqa: E402
+from raytrace.files.library import load_lens  # noqa: E402
+from raytrace.lens import Lens, Surface  # noqa: E402
 from raytrace.materials import AIR, fixed_index  # noqa: E402
+from raytrace.packing import pack  # noqa: E402
 from raytrace.trace import chief_rays, trace_rays  # noqa: E402
 
 RESULTS = HERE / "results"
@@ -141,7 +142,7 @@ def agreement(a_xy, b_xy) -> tuple[float, int]:
 
 
 def project_image(p, rays, threads=None):
-    rb = trace_rays(p, *rays, threads=threads)
+    rb = trace_rays(p, rays[:3], rays[3:], threads=threads)
     return rb.at_plane(p.z_image), rb
 
 
@@ -240,7 +241,9 @@ def scaling(quick: bool, log) -> dict:
     tr = []
     for n in ns_rays:
         rays = bench_rays(lens, n)
-        tr.append(best_of(lambda r=rays: trace_rays(p, *r, threads=1), 3 if n < 10**7 else 1))
+        tr.append(
+            best_of(lambda r=rays: trace_rays(p, r[:3], r[3:], threads=1), 3 if n < 10**7 else 1)
+        )
     a = float(np.polyfit(np.log(ns_rays), np.log(tr), 1)[0])
     counts = [2, 4, 8] if quick else [4, 8, 16, 32, 64]
     ts = []
@@ -254,7 +257,7 @@ def scaling(quick: bool, log) -> dict:
         sl = Lens(name=f"stack{m}", surfaces=tuple(surfs), aperture=lens.aperture, field=lens.field)
         sp = pack(sl)
         rays = bench_rays(lens, n, frac=0.3)
-        ts.append(best_of(lambda r=rays, sp=sp: trace_rays(sp, *r, threads=1), 5))
+        ts.append(best_of(lambda r=rays, sp=sp: trace_rays(sp, r[:3], r[3:], threads=1), 5))
     b = float(np.polyfit(np.log(counts), np.log(ts), 1)[0])
     b_hi = float(np.polyfit(np.log(counts[-3:]), np.log(ts[-3:]), 1)[0])
     slope, icpt = np.polyfit(counts, ts, 1)  # t = icpt + slope * surfaces
@@ -279,6 +282,11 @@ def scaling(quick: bool, log) -> dict:
 
 
 # ----------------------------------------------------------------------------- 2 chief rays
+def fkw(fields, kind: str) -> dict:
+    """The API keyword for fields of ``kind``."""
+    return {"fields_deg": fields} if kind == "angle" else {"object_heights_mm": fields}
+
+
 def chief(quick: bool, optiland_ok: bool, log) -> dict:
     from distortion.characteristic import characteristic_distortion
 
@@ -291,11 +299,11 @@ def chief(quick: bool, optiland_ok: bool, log) -> dict:
         for kind, f, kw in (("angle", fa, {}), ("height", fh, {"object_distance": od})):
             calls = 50 if quick else 500
             med, mn = median_of(
-                lambda f=f, kw=kw, k=kind: chief_rays(lens, f, field_kind=k, **kw), calls
+                lambda f=f, kw=kw, k=kind: chief_rays(lens, **fkw(f, k), **kw), calls
             )
-            cr = chief_rays(lens, f, field_kind=kind, **kw)
+            cr = chief_rays(lens, **fkw(f, kind), **kw)
             medd, _ = median_of(
-                lambda f=f, kw=kw, k=kind: characteristic_distortion(lens, f, field_kind=k, **kw),
+                lambda f=f, kw=kw, k=kind: characteristic_distortion(lens, **fkw(f, k), **kw),
                 calls,
             )
             rows.append(
@@ -406,7 +414,7 @@ def cli(quick: bool, log) -> dict:
     except Exception:  # noqa: BLE001
         lens = "topogon-us2031792-fig1"
     exe = shutil.which("orthoscope")
-    base = [exe] if exe else [sys.executable, "-m", "distortion.cli"]
+    base = [exe] if exe else [sys.executable, "-m", "orthoscope"]
     cmd = [*base, "distortion", lens]
     env = dict(os.environ)
     out = {"lens": lens, "command": " ".join(["orthoscope", "distortion", lens])}
@@ -419,7 +427,7 @@ def cli(quick: bool, log) -> dict:
     out["warm_s"], out["warm_rc"] = _timed(cmd, env, 1 if quick else 5)
     imp = [sys.executable, "-c", "import numpy, numba"]
     out["import_numpy_numba_s"], _ = _timed(imp, env, 1 if quick else 3)
-    imp2 = [sys.executable, "-c", "import distortion.cli_distortion, raytrace.trace"]
+    imp2 = [sys.executable, "-c", "import orthoscope.cli.distortion, raytrace.trace"]
     out["import_project_s"], _ = _timed(imp2, env, 1 if quick else 3)
     out["python_startup_s"], _ = _timed([sys.executable, "-c", "pass"], env, 1 if quick else 3)
     log("  CLI done")
@@ -429,8 +437,8 @@ def cli(quick: bool, log) -> dict:
 # ----------------------------------------------------------------------------- 6 memory
 RSS_CHILD = """
 import resource, numpy as np
-from raytrace.library import load_lens
-from raytrace.lens import pack
+from raytrace.files.library import load_lens
+from raytrace.packing import pack
 from raytrace.trace import trace_rays
 
 def rss():  # current resident set (MB)
@@ -443,13 +451,13 @@ def peak():
 
 p = pack(load_lens("cooke-triplet-f4"))
 n = {n}
-trace_rays(p, np.zeros(10), np.zeros(10), -1.0, 0.0, 0.0, 1.0)
+trace_rays(p, (np.zeros(10), np.zeros(10), -1.0), (0.0, 0.0, 1.0))
 r0 = rss()
 rng = np.random.default_rng(0)
 x = rng.uniform(-5, 5, n); y = rng.uniform(-5, 5, n); z = np.full(n, -1.0)
 L = rng.uniform(-0.3, 0.3, n); M = rng.uniform(-0.3, 0.3, n); N = np.sqrt(1 - L * L - M * M)
 r1 = rss()
-rb = trace_rays(p, x, y, z, L, M, N)
+rb = trace_rays(p, (x, y, z), (L, M, N))
 xi, yi = rb.at_plane(p.z_image)
 r2 = rss()
 print(r0, r1, r2, peak())

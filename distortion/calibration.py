@@ -14,7 +14,7 @@ actual image sizes ``y' = y0' + D0`` stay the same. With ``x = tan α`` (or the 
 ``D_c`` is linear in Kc, so every criterion is a one-parameter fit of a line through the origin
 ``y' ≈ Kc·x`` (:func:`fit_scale`), which :mod:`distortion.compensation` reuses.
 
-Criteria (``CRITERIA``):
+Methods (criteria, ``METHODS``):
 
 - ``two-point``: equal magnitude and opposite sign of D_c at two chosen fields (the paper's
   example, 37.5° and 45°): ``Kc = (y'_a + y'_b)/(x_a + x_b)``.
@@ -29,23 +29,24 @@ Criteria (``CRITERIA``):
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from raytrace.errors import DataError
+from .curve import DistortionCurve
+from .errors import CalibrationError
 
-from .tables import DistortionCurve, format_columns
+if TYPE_CHECKING:
+    from .characteristic import CharacteristicDistortion
 
-CRITERIA = ("two-point", "minimax", "least-squares", "zero-at", "given")
+#: The calibration methods (criteria), in the order the docs list them.
+METHODS = ("two-point", "minimax", "least-squares", "zero-at", "given")
+CRITERIA = METHODS  # the paper's word; same tuple
 
-
-class CalibrationError(DataError, ValueError):
-    """An impossible calibration request (unknown criterion, a field not in the curve, too few
-    points, a degenerate fit). A :class:`DataError` and a :class:`ValueError`."""
-
-
-def _match_fields(fields: np.ndarray, at, what: str) -> list[int]:
+def match_fields(fields: np.ndarray, at, what: str) -> list[int]:
+    """Indices of the ``at`` field values among ``fields`` (CalibrationError naming ``what``)."""
     lo, hi = float(np.min(fields)), float(np.max(fields))
     span = max(abs(lo), abs(hi), 1.0)
     idx = []
@@ -116,55 +117,55 @@ def _minimax(x: np.ndarray, r: np.ndarray) -> float:
 def fit_scale(
     x: np.ndarray,
     r: np.ndarray,
-    criterion: str,
+    method: str,
     *,
     idx: list[int] | None = None,
     given: float | None = None,
 ) -> float:
-    """The scale K of the line ``r ≈ K·x`` by a calibration criterion (see module docstring).
+    """The scale K of the line ``r ≈ K·x`` by a calibration method (see module docstring).
 
     ``idx`` are the indices of the chosen fields for ``two-point`` (two) and ``zero-at`` (one).
-    Raises :class:`CalibrationError` for an unknown criterion or a degenerate request.
+    Raises :class:`CalibrationError` for an unknown method or a degenerate request.
     """
     x = np.asarray(x, dtype=float)
     r = np.asarray(r, dtype=float)
-    if criterion not in CRITERIA:
+    if method not in METHODS:
         raise CalibrationError(
-            f"unknown calibration criterion {criterion!r}; expected one of {', '.join(CRITERIA)}"
+            f"unknown calibration method {method!r}; expected one of {', '.join(METHODS)}"
         )
-    if criterion == "given":
+    if method == "given":
         if given is None or not math.isfinite(given) or given == 0.0:
-            raise CalibrationError("criterion 'given' needs a finite nonzero calibrated constant")
+            raise CalibrationError("method 'given' needs a finite nonzero calibrated constant")
         return float(given)
     off = x != 0.0
-    if criterion == "two-point":
+    if method == "two-point":
         if idx is None or len(idx) != 2:
-            raise CalibrationError("criterion 'two-point' needs exactly two fields (--at A,B)")
+            raise CalibrationError("method 'two-point' needs exactly two fields (at=(A, B))")
         a, b = idx
         if a == b or x[a] + x[b] == 0.0:
-            raise CalibrationError("criterion 'two-point' needs two different off-axis fields")
+            raise CalibrationError("method 'two-point' needs two different off-axis fields")
         return float((r[a] + r[b]) / (x[a] + x[b]))
-    if criterion == "zero-at":
+    if method == "zero-at":
         if idx is None or len(idx) != 1:
-            raise CalibrationError("criterion 'zero-at' needs exactly one field (--at A)")
+            raise CalibrationError("method 'zero-at' needs exactly one field (at=A)")
         a = idx[0]
         if x[a] == 0.0:
             raise CalibrationError(
-                "criterion 'zero-at' needs an off-axis field (D_c is 0 on the axis)"
+                "method 'zero-at' needs an off-axis field (D_c is 0 on the axis)"
             )
         return float(r[a] / x[a])
     if np.count_nonzero(off) < 2:
         raise CalibrationError(
-            f"criterion {criterion!r} needs at least two off-axis field points, got "
+            f"method {method!r} needs at least two off-axis field points, got "
             f"{np.count_nonzero(off)}"
         )
-    if criterion == "least-squares":
+    if method == "least-squares":
         sol, *_ = np.linalg.lstsq(x[:, None], r, rcond=None)
         return float(sol[0])
     return _minimax(x[off], r[off])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CalibrationResult:
     """A calibrated distortion curve (one row of Pestrecov's Table II per field).
 
@@ -180,7 +181,7 @@ class CalibrationResult:
     """
 
     curve: DistortionCurve
-    criterion: str
+    method: str
     at: tuple[float, ...]
     Kc: float
     k: float
@@ -244,38 +245,63 @@ class CalibrationResult:
 
 
 def calibrate(
-    curve: DistortionCurve,
-    criterion: str = "two-point",
+    distortion: DistortionCurve | CharacteristicDistortion,
+    method: str = "two-point",
     *,
-    at=None,
+    at: float | Sequence[float] | None = None,
     value: float | None = None,
     k: float = 200.0,
+    plane: int = 0,
 ) -> CalibrationResult:
-    """Calibrate a characteristic distortion curve (Eqs. 10–15) by a criterion (module docstring).
+    """Calibrate a characteristic distortion curve (Pestrecov Eqs. 10–15).
 
-    ``at``: the field values (same kind and unit as ``curve.fields``) for ``two-point`` (two) and
-    ``zero-at`` (one); they must be field points of the curve. ``value``: F_c (mm) or M_c for
-    ``given``. ``k``: the plot exaggeration for ρ_k (Eq. 14; the paper's Fig. 2 uses 200).
+    Parameters
+    ----------
+    distortion : DistortionCurve or CharacteristicDistortion
+        The characteristic curve: a table (:func:`distortion.tablefile.read_distortion_table`)
+        or a traced result (its image plane number ``plane``, 0-based).
+    method : {"two-point", "minimax", "least-squares", "zero-at", "given"}
+        How the calibrated constant K_c (F_c in mm, or M_c) is chosen (module docstring):
+        equal and opposite D_c at the two ``at`` fields (the paper's example), the smallest
+        maximum |D_c| (exact), least squares, D_c = 0 at the ``at`` field, or ``value``.
+    at : float or sequence of float, optional
+        Field values (same kind and unit as the curve's fields: degrees or mm) for
+        ``two-point`` (two) and ``zero-at`` (one); they must be field points of the curve.
+    value : float, optional
+        F_c (mm) or M_c for ``given``.
+    k : float
+        Plot exaggeration for ρ_k (Eq. 14; the paper's Fig. 2 uses 200).
+    plane : int
+        Which image plane of a traced result (0-based).
+
+    Returns
+    -------
+    CalibrationResult
+        K_c, D_c (mm), D_rc (fraction), ρ, ρ_k and spreads (one row of Table II per field).
     """
-    what = f"calibration ({criterion})"
-    if criterion not in CRITERIA:
+    curve = _as_curve(distortion, plane)
+    what = f"calibration ({method})"
+    if method not in METHODS:
         raise CalibrationError(
-            f"unknown calibration criterion {criterion!r}; expected one of {', '.join(CRITERIA)}"
+            f"unknown calibration method {method!r}; expected one of {', '.join(METHODS)}"
         )
     if curve.fields.size < 2:
         raise CalibrationError(f"{what}: a curve needs at least two field points")
-    need = {"two-point": 2, "zero-at": 1}.get(criterion, 0)
-    at_t: tuple[float, ...] = tuple(float(a) for a in (at or ()))
+    need = {"two-point": 2, "zero-at": 1}.get(method, 0)
+    if at is None:
+        at_t: tuple[float, ...] = ()
+    elif np.ndim(at) == 0:
+        at_t = (float(at),)  # type: ignore[arg-type]
+    else:
+        at_t = tuple(float(a) for a in at)  # type: ignore[union-attr]
     if need and len(at_t) != need:
-        raise CalibrationError(
-            f"{what} needs exactly {need} field(s) given with --at, got {len(at_t)}"
-        )
+        raise CalibrationError(f"{what} needs exactly {need} field(s) in at=, got {len(at_t)}")
     if not need and at_t:
-        raise CalibrationError(f"{what} takes no --at fields")
-    idx = _match_fields(curve.fields, at_t, what) if need else None
-    if criterion == "given" and value is None:
-        raise CalibrationError(f"{what} needs the calibrated constant {curve.symbol}_c")
-    Kc = fit_scale(curve.x, curve.yp, criterion, idx=idx, given=value)
+        raise CalibrationError(f"{what} takes no at= fields")
+    idx = match_fields(curve.fields, at_t, what) if need else None
+    if method == "given" and value is None:
+        raise CalibrationError(f"{what} needs the calibrated constant {curve.symbol}_c (value=)")
+    Kc = fit_scale(curve.x, curve.yp, method, idx=idx, given=value)
     if not math.isfinite(Kc) or Kc == 0.0:
         raise CalibrationError(f"{what} gave a degenerate constant {Kc!r}")
     ycp = Kc * curve.x
@@ -286,68 +312,18 @@ def calibrate(
         Drc = np.where(
             ycp != 0.0, curve.yp / np.where(ycp != 0.0, ycp, 1.0) - 1.0, curve.constant / Kc - 1.0
         )
-    return CalibrationResult(curve, criterion, at_t, float(Kc), float(k), ycp, Dc, Drc)
+    return CalibrationResult(curve, method, at_t, float(Kc), float(k), ycp, Dc, Drc)
 
 
-def format_calibration(
-    res: CalibrationResult, *, layout: str = "auto", decimals: int | None = None
-) -> str:
-    """Pestrecov's Table II layout: the calibrated constant, then per field y_c', D_c and D_rc (%),
-    followed by the summary (scale error, ρ, ρ_k, D_rc on the axis, max |D_c|, spreads)."""
-    c = res.curve
-    dec = c.decimals if decimals is None else decimals
-    s = res.symbol
-    unit = " mm" if not c.finite else ""
-    at = f" at {', '.join(f'{a:g}' for a in res.at)}" if res.at else ""
-    title = [
-        " ".join(p for p in (c.name, c.plane) if p) + " — calibrated distortion data",
-        f"{s}_c = {res.Kc:.{max(dec, 3)}f}{unit}   ({res.criterion}{at}; {s}0 = "
-        f"{res.K0:.{max(dec, 3)}f}{unit})",
-    ]
-    q = [
-        ("Yc' (mm)", res.ycp, dec, False),
-        ("Dc (mm)", res.Dc, dec, True),
-        ("Drc (%)", 100.0 * res.Drc, dec, True),
-    ]
-    table = format_columns(title, c.field_label, c.fields, q, layout=layout)
-    summary = [
-        "",
-        f"{s}_c/{s}0 - 1 = tan rho = {res.scale_error:+.6e}   rho = {res.rho_deg:.4f} deg   "
-        f"rho_k = {res.rho_k_deg:.2f} deg (k = {res.k:g})",
-        f"Drc on the axis (Eq. 15) = {100 * res.Drc_axis:+.{dec}f} %",
-        f"max |D0| = {res.D0_max_abs:.{dec}f} mm, spread {res.D0_spread:.{dec}f} mm;  "
-        f"max |Dc| = {res.Dc_max_abs:.{dec}f} mm, spread {res.Dc_spread:.{dec}f} mm",
-        f"spread of Dr = {100 * res.Dr_spread:.{dec}f} %, "
-        f"of Drc = {100 * res.Drc_spread:.{dec}f} %",
-    ]
-    return table + "\n".join(summary)
-
-
-def calibration_to_dict(res: CalibrationResult) -> dict:
-    """JSON-ready dict of a calibration (relative quantities as fractions and in per cent)."""
-    from .tables import curve_to_dict
-
-    s = res.symbol
-    return {
-        "criterion": res.criterion,
-        "at": list(res.at),
-        f"{s}0": res.K0,
-        f"{s}c": res.Kc,
-        "scale_error": res.scale_error,
-        "rho_deg": res.rho_deg,
-        "k": res.k,
-        "rho_k_deg": res.rho_k_deg,
-        "Drc_axis": res.Drc_axis,
-        "Drc_axis_pct": 100.0 * res.Drc_axis,
-        "Dc_max_abs_mm": res.Dc_max_abs,
-        "Dc_spread_mm": res.Dc_spread,
-        "D0_max_abs_mm": res.D0_max_abs,
-        "D0_spread_mm": res.D0_spread,
-        "Dr_spread": res.Dr_spread,
-        "Drc_spread": res.Drc_spread,
-        "ycp_mm": res.ycp.tolist(),
-        "Dc_mm": res.Dc.tolist(),
-        "Drc": res.Drc.tolist(),
-        "Drc_pct": (100.0 * res.Drc).tolist(),
-        "characteristic": curve_to_dict(res.curve),
-    }
+def _as_curve(d, plane: int) -> DistortionCurve:
+    if isinstance(d, DistortionCurve):
+        return d
+    if hasattr(d, "curve") and hasattr(d, "n_planes"):
+        if not 0 <= int(plane) < d.n_planes:
+            raise CalibrationError(
+                f"plane={plane}: the result has {d.n_planes} image plane(s) (0-based index)"
+            )
+        return d.curve(int(plane))
+    raise CalibrationError(
+        f"expected a DistortionCurve or a CharacteristicDistortion, got {type(d).__name__}"
+    )

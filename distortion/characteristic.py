@@ -4,8 +4,9 @@ One trace of the real chief rays (``raytrace.trace.chief_rays``) serves any numb
 planes: the final segment is moved analytically to each plane. Image planes may be given as
 
 - ``s_prime``: distance s' from the second principal point H' (Pestrecov's convention),
-- ``image_distance``: distance from the last vertex,
-- ``defocus``: distance from the Gaussian image plane of the object (+ = away from the lens);
+- ``from_last_vertex``: distance from the last vertex,
+- ``defocus``: distance from the Gaussian image plane of the object (+ = away from the lens),
+- or ``plane=`` :class:`~raytrace.paraxial.ImagePlane` objects (docs/design.md, "Vocabulary");
 
 none of them = the Gaussian plane. Distances in mm; planes before the last vertex are refused.
 
@@ -40,20 +41,28 @@ Reference definitions (``REFERENCES``), never mixed silently:
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from raytrace.errors import TraceError
 from raytrace.lens import Lens
+from raytrace.paraxial import (
+    ImagePlane,
+    ParaxialResult,
+    orthoscopy_abscissa,
+    pestrecov_constants,
+)
 
-from .tables import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve, format_columns
+from .curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 
 REFERENCES = ("characteristic", "distortion-focal-length", "real-chief-transport")
 DFL_EPSILON = 1e-3  # near-axis reference field as a fraction of the largest |field|
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CharacteristicDistortion:
     """Distortion of one lens and object distance in several image planes (arrays: planes × fields).
 
@@ -61,7 +70,7 @@ class CharacteristicDistortion:
     ``"nominal-angle"``; fields (n,): as given (deg or mm); object_distance: positive magnitude
     from the object plane to the first vertex (``inf`` for infinity).
     x (n,): ``tan α`` or the object height y (mm); y (n,): object heights (mm; NaN at infinity).
-    z_planes, s_prime, image_distance, defocus (p,): the planes as absolute z, from H', from the
+    z_planes, s_prime, from_last_vertex, defocus (p,): the planes as absolute z, from H', from the
     last vertex and from the Gaussian plane (mm). constant (p,): K0 of Eq. (8) in each plane
     (F0 in mm or M0); scale (p,): the reference's linear scale (= K0 for ``characteristic``).
     gaussian_constant: f or m0.  y0p, yp, D0 (p, n) in mm; Dr (p, n) a fraction (0 on the axis).
@@ -78,7 +87,7 @@ class CharacteristicDistortion:
     y: np.ndarray
     z_planes: np.ndarray
     s_prime: np.ndarray
-    image_distance: np.ndarray
+    from_last_vertex: np.ndarray
     defocus: np.ndarray
     constant: np.ndarray
     scale: np.ndarray
@@ -88,7 +97,7 @@ class CharacteristicDistortion:
     D0: np.ndarray
     Dr: np.ndarray
     status: np.ndarray
-    paraxial: object
+    paraxial: ParaxialResult
 
     @property
     def finite(self) -> bool:
@@ -111,6 +120,23 @@ class CharacteristicDistortion:
         )
         return f"s' = {self.s_prime[i]:.4f} mm ({g})"
 
+    def __repr__(self) -> str:
+        unit = "mm" if self.field_kind == HEIGHT else "deg"
+        obj = "inf" if math.isinf(self.object_distance) else f"{self.object_distance:g} mm"
+        planes = ", ".join(f"{v:.4g}" for v in self.s_prime[:4]) + (
+            ", ..." if self.n_planes > 4 else ""
+        )
+        with np.errstate(invalid="ignore"):
+            worst = float(np.nanmax(np.abs(self.D0))) if np.isfinite(self.D0).any() else math.nan
+        bad = int(np.count_nonzero(self.status != 0))
+        return (
+            f"CharacteristicDistortion({self.name!r}, {self.fields.size} fields "
+            f"{self.fields.min():g}..{self.fields.max():g} {unit}, object {obj}, "
+            f"s' = [{planes}] mm, max |D0| = {worst:.6g} mm, reference {self.reference}"
+            + (f", {bad} fields failed" if bad else "")
+            + ")"
+        )
+
     def curve(self, i: int = 0) -> DistortionCurve:
         """Plane ``i`` as a :class:`DistortionCurve` (fields with status != OK dropped) for
         calibration, tables and plots. Its constant is K0 of Eq. (8) in that plane."""
@@ -129,92 +155,99 @@ class CharacteristicDistortion:
         )
 
 
-def _planes(par, s_prime, image_distance, defocus) -> np.ndarray:
-    given = [
-        (k, v)
-        for k, v in (("s_prime", s_prime), ("image_distance", image_distance), ("defocus", defocus))
-        if v is not None
-    ]
-    if len(given) > 1:
-        raise TraceError("give the image planes one way: s_prime, image_distance or defocus")
-    if not given:
-        z = np.array([par.z_gauss], dtype=float)
-    else:
-        kind, v = given[0]
-        arr = np.atleast_1d(np.asarray(v, dtype=float)).ravel()
-        if arr.size == 0 or not np.all(np.isfinite(arr)):
-            raise TraceError(f"image planes ({kind}) must be finite numbers")
-        conv = {
-            "s_prime": par.z_from_s_prime,
-            "image_distance": par.z_from_last_vertex,
-            "defocus": par.z_from_defocus,
-        }
-        z = np.atleast_1d(np.asarray(conv[kind](arr), dtype=float))
-    if not math.isfinite(par.z_gauss) and not given:
-        raise TraceError("the Gaussian image is at infinity; give the image plane explicitly")
-    bad = np.nonzero(z <= par.z_last)[0]
-    if bad.size:
-        i = int(bad[0])
-        raise TraceError(
-            f"image plane at {z[i] - par.z_last:+.4f} mm from the last vertex lies on or before "
-            "the "
-            "last surface; an image plane must be behind the lens"
-        )
-    return z
-
-
 def characteristic_distortion(
     lens: Lens,
-    fields,
+    fields_deg: npt.ArrayLike | None = None,
     *,
-    field_kind: str | None = None,
-    object_distance: float | None = None,
-    s_prime=None,
-    image_distance=None,
-    defocus=None,
+    object_heights_mm: npt.ArrayLike | None = None,
+    plane: ImagePlane | Sequence[ImagePlane] | str | None = None,
+    s_prime: npt.ArrayLike | None = None,
+    from_last_vertex: npt.ArrayLike | None = None,
+    defocus: npt.ArrayLike | None = None,
+    object_distance: float | str | None = None,
+    object_s: float | None = None,
+    object_scale: float | None = None,
     reference: str = "characteristic",
     wavelength: float | None = None,
     clip: bool = True,
 ) -> CharacteristicDistortion:
-    """Distortion of ``lens`` at ``fields`` in one or more image planes (module docstring).
+    """Distortion of ``lens`` at the given fields in one or more image planes (Pestrecov 1958,
+    Eqs. 8–9; the module docstring defines the three references).
 
-    fields: angles (deg) or object heights (mm), see ``field_kind`` (default: the lens's field kind;
-        ``"angle"`` with a finite object means nominal angles, ``y = p0 tan α``).
-    object_distance: positive magnitude from the object plane to the first vertex (``inf``);
-        default the lens's.
-    s_prime / image_distance / defocus: the image plane(s), scalar or array (mm); at most one.
-    reference: ``characteristic`` | ``distortion-focal-length`` | ``real-chief-transport``.
-    Raises TraceError / LensError for impossible requests; fields the lens cannot pass get a
-    status code and NaN values.
+    Parameters
+    ----------
+    lens : Lens
+    fields_deg : array_like, optional
+        Field angles α in degrees (object-space chief-ray slope angle). With a finite object they
+        are Pestrecov's nominal angles: object heights ``y = p0 tan α``. Default: 11 fields from
+        0 to the lens's field.
+    object_heights_mm : array_like, optional
+        Object heights in mm instead of angles (finite objects only).
+    plane : ImagePlane, list of ImagePlane, "gaussian" or "file", optional
+        The image plane(s); or give ONE of ``s_prime`` (mm from H'), ``from_last_vertex`` (mm
+        from the last vertex), ``defocus`` (mm from the Gaussian plane, + away from the lens),
+        each a number or a sequence. Default: the Gaussian image plane of the object. All
+        planes come from one trace.
+    object_distance, object_s, object_scale
+        The object plane (at most one): mm from the first vertex (or ``inf`` / ``"12x"``),
+        Pestrecov's signed s from H (mm, negative), or an image scale N ("N×", magnification
+        −1/N). Default: the lens file's object.
+    reference : {"characteristic", "distortion-focal-length", "real-chief-transport"}
+        The reference the ideal image is measured from (module docstring).
+    wavelength : float, optional
+        nm; default the lens's.
+    clip : bool
+        Apply the lens's semi-diameters to the chief rays.
+
+    Returns
+    -------
+    CharacteristicDistortion
+        Arrays (planes × fields) of y0', y', D0 (mm) and Dr (fraction); a field the lens cannot
+        pass has a status code and NaN values.
+
+    Raises
+    ------
+    TraceError, LensError
+        For impossible requests (a plane before the last vertex, heights with an object at
+        infinity, an unknown reference, ...).
     """
-    from raytrace.paraxial import paraxial, pestrecov_constants
-    from raytrace.trace import STATUS_OK, chief_rays
+    from raytrace.paraxial import ideal_heights, image_planes, paraxial, plane_z
+    from raytrace.paraxial import resolve_object_distance
+    from raytrace.trace import STATUS_OK, aim
 
     if reference not in REFERENCES:
         raise TraceError(
             f"unknown distortion reference {reference!r}; expected one of {', '.join(REFERENCES)}"
         )
-    par = paraxial(lens, object_distance=object_distance, wavelength=wavelength)
-    fk = lens.field.kind if field_kind is None else field_kind
-    if fk not in ("angle", "height"):
-        raise TraceError(f"field_kind must be 'angle' or 'height', got {fk!r}")
-    f = np.atleast_1d(np.asarray(fields, dtype=float)).ravel()
+    od = resolve_object_distance(
+        lens,
+        object_distance=object_distance,
+        object_s=object_s,
+        object_scale=object_scale,
+        wavelength=wavelength,
+    )
+    par = paraxial(lens, object_distance=od, wavelength=wavelength)
+    if fields_deg is not None and object_heights_mm is not None:
+        raise TraceError("give fields_deg or object_heights_mm, not both")
+    if object_heights_mm is not None:
+        fk = "height"
+        f = np.atleast_1d(np.asarray(object_heights_mm, dtype=float)).ravel()
+    elif fields_deg is not None:
+        fk = "angle"
+        f = np.atleast_1d(np.asarray(fields_deg, dtype=float)).ravel()
+    else:
+        fk = lens.field.kind if not (par.infinite and lens.field.kind == "height") else "angle"
+        f = np.linspace(0.0, lens.field.value, 11)
     if f.size == 0:
         raise TraceError("no fields given")
     infinite = par.infinite
     if fk == "height" and infinite:
-        raise TraceError("object-height fields need a finite object distance")
+        raise TraceError("object heights need a finite object distance")
     kind = ANGLE if infinite else (HEIGHT if fk == "height" else NOMINAL_ANGLE)
-    if kind == ANGLE:
-        x = np.tan(np.radians(f))
-        yobj = np.full(f.shape, np.nan)
-    elif kind == HEIGHT:
-        x = f.copy()
-        yobj = x
-    else:
-        x = par.p0 * np.tan(np.radians(f))
-        yobj = x
-    z = _planes(par, s_prime, image_distance, defocus)
+    x = orthoscopy_abscissa(par, f, fk)
+    yobj = np.full(f.shape, np.nan) if kind == ANGLE else x
+    planes = image_planes(plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus)
+    z = plane_z(par, planes)
     sp = np.asarray(par.s_prime_of(z), dtype=float)
     K0 = np.array([pestrecov_constants(par, float(v)).scale for v in sp])
     KG = par.efl if infinite else par.m0
@@ -224,14 +257,7 @@ def characteristic_distortion(
         fmax = float(np.max(np.abs(f)))
         eps = DFL_EPSILON * (fmax if fmax > 0 else 1.0)
         extra = np.array([eps, 2.0 * eps])
-    cr = chief_rays(
-        lens,
-        np.concatenate([f, extra]),
-        field_kind=fk,
-        object_distance=par.object_distance,
-        wavelength=wavelength,
-        clip=clip,
-    )
+    cr = aim(lens, np.concatenate([f, extra]), fk, par.object_distance, wavelength, clip)
     n = f.size
     status = cr.status[:n].copy()
     ok = status == STATUS_OK
@@ -240,15 +266,13 @@ def characteristic_distortion(
 
     if reference == "characteristic":
         scale = K0.copy()
-        y0p = K0[:, None] * x[None, :]
+        y0p = ideal_heights(par, x, sp)
     elif reference == "distortion-focal-length":
         if not np.all(cr.status[n:] == STATUS_OK):
             raise TraceError(
                 "the near-axis reference chief ray for the distortion focal length failed"
             )
-        xe = extra if kind != ANGLE else np.tan(np.radians(extra))
-        if kind == NOMINAL_ANGLE:
-            xe = par.p0 * np.tan(np.radians(extra))
+        xe = orthoscopy_abscissa(par, extra, fk)
         k1 = H[:, n] / xe[0]
         k2 = H[:, n + 1] / xe[1]
         scale = (4.0 * k1 - k2) / 3.0
@@ -272,7 +296,7 @@ def characteristic_distortion(
         y=yobj,
         z_planes=z,
         s_prime=sp,
-        image_distance=z - par.z_last,
+        from_last_vertex=z - par.z_last,
         defocus=z - par.z_gauss,
         constant=K0,
         scale=np.asarray(scale, dtype=float),
@@ -284,83 +308,3 @@ def characteristic_distortion(
         status=status,
         paraxial=par,
     )
-
-
-def format_characteristic(
-    res: CharacteristicDistortion, *, decimals: int = 4, layout: str = "auto"
-) -> str:
-    """Text table. One plane: Pestrecov's Table I layout (y, y0', y', D0, Dr per field). Several
-    planes: Table V layout — D0 (mm) per field (rows) and plane (columns, headed by s')."""
-    from raytrace.trace import STATUS_NAMES
-
-    s = res.symbol
-    unit = " mm" if not res.finite else ""
-    head = [
-        f"{res.name} — distortion ({res.reference}); object distance {res.object_distance:g} mm"
-    ]
-    flabel = {ANGLE: "α (deg)", HEIGHT: "y (mm)", NOMINAL_ANGLE: "nominal α (deg)"}[res.field_kind]
-    bad = [
-        f"{v:g}: {STATUS_NAMES.get(int(c), c)}"
-        for v, c in zip(res.fields, res.status, strict=True)
-        if c != 0
-    ]
-    tail = ["fields not traced: " + ", ".join(bad)] if bad else []
-    if res.n_planes == 1:
-        head.append(
-            f"{res.plane_label(0)};  {s}0 = {res.constant[0]:.6f}{unit};  "
-            f"scale = {res.scale[0]:.6f}{unit}"
-        )
-        q = []
-        if res.finite:
-            q.append(("y (mm)", res.x, decimals, True))
-        q += [
-            ("y0' (mm)", res.y0p[0], decimals, True),
-            ("y' (mm)", res.yp[0], decimals, True),
-            ("D0 (mm)", res.D0[0], decimals, True),
-            ("Dr (%)", 100.0 * res.Dr[0], decimals, True),
-        ]
-        return "\n".join([format_columns(head, flabel, res.fields, q, layout=layout)] + tail)
-    head.append("Linear distortion D0 (mm) in image planes at s' (mm from H'):")
-    for i in range(res.n_planes):
-        head.append(f"  {res.plane_label(i)}: {s}0 = {res.constant[i]:.6f}{unit}")
-    q = [(f"s'={res.s_prime[i]:.1f}", res.D0[i], decimals, True) for i in range(res.n_planes)]
-    return "\n".join([format_columns(head, flabel, res.fields, q, layout="rows")] + tail)
-
-
-def characteristic_to_dict(res: CharacteristicDistortion) -> dict:
-    """JSON-ready dict (NaN → None)."""
-
-    def lst(a):
-        return [
-            None if not math.isfinite(v) else float(v) for v in np.asarray(a, dtype=float).ravel()
-        ]
-
-    from raytrace.trace import STATUS_NAMES
-
-    return {
-        "lens": res.name,
-        "reference": res.reference,
-        "field_kind": res.field_kind,
-        "object_distance_mm": "inf" if math.isinf(res.object_distance) else res.object_distance,
-        "fields": lst(res.fields),
-        "x": lst(res.x),
-        "y_mm": lst(res.y),
-        "status": [STATUS_NAMES.get(int(c), str(int(c))) for c in res.status],
-        "gaussian_constant": res.gaussian_constant,
-        "planes": [
-            {
-                "z_mm": float(res.z_planes[i]),
-                "s_prime_mm": float(res.s_prime[i]),
-                "from_last_vertex_mm": float(res.image_distance[i]),
-                "defocus_mm": float(res.defocus[i]),
-                "F0_mm" if res.symbol == "F" else "M0": float(res.constant[i]),
-                "scale": float(res.scale[i]),
-                "y0p_mm": lst(res.y0p[i]),
-                "yp_mm": lst(res.yp[i]),
-                "D0_mm": lst(res.D0[i]),
-                "Dr": lst(res.Dr[i]),
-                "Dr_pct": lst(100.0 * res.Dr[i]),
-            }
-            for i in range(res.n_planes)
-        ],
-    }

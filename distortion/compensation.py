@@ -29,13 +29,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from raytrace.errors import DataError
+from .calibration import METHODS, fit_scale, match_fields
+from .curve import DistortionCurve
+from .errors import CalibrationError, DataError
 
-from .calibration import CRITERIA, CalibrationError, _match_fields, fit_scale
-from .tables import DistortionCurve, format_columns
 
-
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CompensationResult:
     """Residual distortion of the print (Section VI).
 
@@ -51,7 +50,7 @@ class CompensationResult:
     F1: float
     M2: float
     M: float
-    criterion: str
+    method: str
     y1: np.ndarray
     yp: np.ndarray
     D1: np.ndarray
@@ -103,8 +102,8 @@ def compensate(
     camera: DistortionCurve,
     printer: DistortionCurve,
     *,
-    criterion: str = "given",
-    M: float | None = None,
+    method: str = "given",
+    magnification: float | None = None,
     at=None,
 ) -> CompensationResult:
     """Residual distortion of the print of ``camera``'s negative by ``printer`` (Eq. 16).
@@ -112,16 +111,14 @@ def compensate(
     camera: object at infinity (field angles, constant F1 in mm, D1 in the negative).
     printer: finite conjugates with the negative as its object (object heights in mm, constant M2,
         D0 in the print plane).
-    criterion: how M is chosen: ``given`` (``M``, default M2 — the paper's compensation condition
-        for characteristic curves) or any calibration criterion over the camera's fields
+    method: how M is chosen: ``given`` (``magnification``, default M2 — the paper's compensation condition
+        for characteristic curves) or any calibration method over the camera's fields
         (``two-point`` / ``zero-at`` with ``at`` angles, ``minimax``, ``least-squares``).
     """
     if camera.finite:
         raise DataError("the camera curve must be for an object at infinity (field angles, F1)")
-    if criterion not in CRITERIA:
-        raise CalibrationError(
-            f"unknown criterion {criterion!r}; expected one of {', '.join(CRITERIA)}"
-        )
+    if method not in METHODS:
+        raise CalibrationError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
     F1, M2 = camera.constant, printer.constant
     y1 = camera.y0p
     yp = camera.yp
@@ -129,53 +126,20 @@ def compensate(
     D2 = printer_negative_distortion(printer, yp)
     x = y1 / M2
     r = D1 - D2 + y1
-    need = {"two-point": 2, "zero-at": 1}.get(criterion, 0)
-    idx = _match_fields(camera.fields, at or (), f"compensation ({criterion})") if need else None
+    need = {"two-point": 2, "zero-at": 1}.get(method, 0)
+    idx = match_fields(camera.fields, at or (), f"compensation ({method})") if need else None
     if need and (idx is None or len(idx) != need):
-        raise CalibrationError(f"criterion {criterion!r} needs {need} field(s) with --at")
+        raise CalibrationError(f"method {method!r} needs {need} field(s) in at=")
     Mv = fit_scale(
-        x, r, criterion, idx=idx, given=M2 if (criterion == "given" and M is None) else M
+        x,
+        r,
+        method,
+        idx=idx,
+        given=M2 if (method == "given" and magnification is None) else magnification,
     )
     if not math.isfinite(Mv):
         raise CalibrationError("compensation gave a degenerate magnification")
     R = D1 - D2 - (Mv / M2 - 1.0) * y1
     return CompensationResult(
-        camera.fields.copy(), F1, M2, float(Mv), criterion, y1, yp, D1, D2, R, M2 * R
+        camera.fields.copy(), F1, M2, float(Mv), method, y1, yp, D1, D2, R, M2 * R
     )
-
-
-def format_compensation(res: CompensationResult, *, layout: str = "auto", decimals: int = 4) -> str:
-    """Text table: per camera field D1, D2 (negative plane), residual R, the print's distortion."""
-    title = [
-        "Distortion compensation (Pestrecov Eq. 16): camera F1 = "
-        f"{res.F1:.4f} mm, printer M2 = {res.M2:.6f}, M = {res.M:.6f} ({res.criterion})",
-        f"max |R| = {res.max_abs:.{decimals}f} mm (negative plane), "
-        f"spread {res.spread:.{decimals}f} mm",
-    ]
-    q = [
-        ("F1 tan α (mm)", res.y1, 3, False),
-        ("D1 (mm)", res.D1, decimals, True),
-        ("D2 (mm)", res.D2, decimals, True),
-        ("R (mm)", res.residual, decimals, True),
-        ("print (mm)", res.print_residual, decimals, True),
-    ]
-    return format_columns(title, "α (deg)", res.alpha_deg, q, layout=layout)
-
-
-def compensation_to_dict(res: CompensationResult) -> dict:
-    """JSON-ready dict of a compensation result."""
-    return {
-        "F1": res.F1,
-        "M2": res.M2,
-        "M": res.M,
-        "criterion": res.criterion,
-        "alpha_deg": res.alpha_deg.tolist(),
-        "y1_mm": res.y1.tolist(),
-        "yp_mm": res.yp.tolist(),
-        "D1_mm": res.D1.tolist(),
-        "D2_mm": res.D2.tolist(),
-        "residual_mm": res.residual.tolist(),
-        "print_residual_mm": res.print_residual.tolist(),
-        "max_abs_mm": res.max_abs,
-        "spread_mm": res.spread,
-    }

@@ -2,7 +2,8 @@
 
 Every error a person can cause (a broken file, an impossible lens, a field the lens cannot pass)
 is one of these, with a message that names the file, line and surface where they are known.
-The CLI turns them into one line on stderr and exit status 2.
+The CLI turns them into one line on stderr and exit status 2. Errors of distortion data tables
+are :class:`distortion.errors.DataError`, also an :class:`OrthoscopeError`.
 """
 
 from __future__ import annotations
@@ -54,5 +55,6 @@ class TraceError(OrthoscopeError):
     """A trace request is invalid (bad field, image plane behind the last surface, ...)."""
 
 
-class DataError(OrthoscopeError):
-    """A data table (CSV of distortion values, profiles, ...) is missing columns or is invalid."""
+class OutputError(OrthoscopeError):
+    """An output file cannot or must not be written (it is an input, it exists and overwriting
+    was not asked for, its folder is missing or read-only, the disk is full)."""

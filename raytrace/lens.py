@@ -1,6 +1,6 @@
-"""The validated, immutable lens model and its packing into contiguous arrays for the kernels.
+"""The validated, immutable lens model (packed into arrays for the kernels by :mod:`.packing`).
 
-Conventions (DESIGN.md §3): millimetres; light travels toward +z; a radius is positive when its
+Conventions (docs/design.md, "Conventions"): millimetres; light travels toward +z; a radius is positive when its
 centre of curvature lies after the vertex; ``thickness`` is the axial distance from a surface's
 vertex to the next vertex (for the last surface: to the image plane the file defines). The first
 vertex is at z = 0. ``Surface.material`` is the medium *after* the surface; the object space is
@@ -21,13 +21,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .errors import LensError
+from .kernels.codes import KIND_ASPHERE, KIND_PLANE, KIND_QUADRIC
 from .materials import AIR, LAMBDA_D, Material
-
-# Surface kind codes used by the kernels.
-KIND_PLANE = 0
-KIND_QUADRIC = 1  # sphere or conic: closed-form intersection
-KIND_ASPHERE = 2  # even asphere: Newton iteration from the quadric solution
-
 
 @dataclass(frozen=True)
 class Surface:
@@ -244,61 +239,3 @@ def validate(lens: Lens) -> None:
         raise LensError(f"{lens.name}: field angle must be below 90 degrees")
     if lens.field.kind == "height" and not math.isfinite(lens.object_distance):
         raise LensError(f"{lens.name}: an object-height field needs a finite object distance")
-
-
-@dataclass(frozen=True)
-class PackedLens:
-    """Contiguous float64/int64 arrays the numba kernels read (one entry per surface).
-
-    kind:   int64 surface kind (KIND_PLANE, KIND_QUADRIC, KIND_ASPHERE)
-    c, k:   curvature (1/mm) and conic constant
-    asph:   (n, m) even-asphere coefficients of r⁴, r⁶, ... (m >= 1, zero padded)
-    zv:     vertex z (mm), first vertex at 0
-    n_in:   index before each surface; n_out: index after it (at ``wavelength``)
-    sd:     semi-diameters (mm; inf = unlimited)
-    stop:   0-based stop index;  z_image: image-plane z the file defines
-    """
-
-    kind: np.ndarray
-    c: np.ndarray
-    k: np.ndarray
-    asph: np.ndarray
-    zv: np.ndarray
-    n_in: np.ndarray
-    n_out: np.ndarray
-    sd: np.ndarray
-    stop: int
-    z_image: float
-    wavelength: float
-
-    @property
-    def n_surfaces(self) -> int:
-        return int(self.c.shape[0])
-
-
-def pack(lens: Lens, wavelength: float | None = None) -> PackedLens:
-    """Pack ``lens`` into contiguous arrays at ``wavelength`` nm (default: the lens's)."""
-    wl = lens.wavelength if wavelength is None else float(wavelength)
-    ss = lens.surfaces
-    n = len(ss)
-    m = max([1] + [len(s.aspheric) for s in ss])
-    asph = np.zeros((n, m))
-    for i, s in enumerate(ss):
-        asph[i, : len(s.aspheric)] = s.aspheric
-    n_out = np.array([s.material.index(wl) for s in ss], dtype=np.float64)
-    n_in = np.empty(n)
-    n_in[0] = lens.object_material.index(wl)
-    n_in[1:] = n_out[:-1]
-    return PackedLens(
-        kind=np.array([s.kind for s in ss], dtype=np.int64),
-        c=np.array([s.curvature for s in ss], dtype=np.float64),
-        k=np.array([s.conic for s in ss], dtype=np.float64),
-        asph=np.ascontiguousarray(asph),
-        zv=np.ascontiguousarray(lens.vertex_z, dtype=np.float64),
-        n_in=np.ascontiguousarray(n_in),
-        n_out=n_out,
-        sd=np.array([s.semi_diameter for s in ss], dtype=np.float64),
-        stop=lens.stop_index,
-        z_image=float(lens.image_z),
-        wavelength=wl,
-    )

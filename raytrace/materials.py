@@ -1,71 +1,245 @@
-"""Optical materials: air, a fixed index, or an nd/vd model glass.
+"""Optical materials: air, a fixed index, an nd/vd model glass, or a catalog material.
 
-Wavelengths are in nanometres. The model glass follows the usual two-parameter convention:
-``nd`` at the helium d line (587.5618 nm) and Abbe number ``vd = (nd - 1) / (nF - nC)`` with the
-hydrogen F (486.1327 nm) and C (656.2725 nm) lines. Its dispersion is a two-term Cauchy law
-``n(λ) = A + B / λ²`` fitted so that ``n(λd) = nd`` and ``n(λF) - n(λC) = (nd - 1) / vd`` exactly.
-At the d line the index is exactly ``nd``.
+Wavelengths are in nanometres. ``index(λ)`` accepts a scalar (returns a float) or a numpy array
+(returns an array of its shape).
+
+Catalog materials (``kind="catalog"``) carry their vendor's dispersion formula and coefficients
+(:mod:`raytrace.glass.formulas`), valid wavelength range, index basis and reference conditions.
+``index(λ)`` is the index **relative to air at the material's reference conditions** (the vendor
+catalogs: 20 °C, 1 atm) — the basis lens programs trace in. Data given as absolute (vacuum)
+indices are divided by the air index (:func:`raytrace.glass.air.air_index`) at the material's
+reference temperature and pressure. Other temperatures and pressures:
+:func:`raytrace.glass.thermal.index_at`. A wavelength outside the valid range gives an
+:class:`OutOfRangeWarning` (``strict=True``, or ``warnings.simplefilter("error",
+OutOfRangeWarning)``, turns it into an error).
+
+Model glasses (``kind="model"``) are fictitious glasses given by ``nd`` (helium d line,
+587.5618 nm) and Abbe number ``vd = (nd − 1)/(nF − nC)`` (hydrogen F 486.1327 nm, C 656.2725 nm).
+``model`` names the dispersion law:
+
+``"cauchy2"`` (default, orthoscope's own)
+    ``n(λ) = A + B/λ²`` with ``n(λd) = nd`` and ``n(λF) − n(λC) = (nd − 1)/vd`` exactly.
+``"buchdahl-rayoptics"``
+    the quadratic Buchdahl model ray-optics/opticalglass use for a glass given by nd/vd
+    (``opticalglass.buchdahl.Buchdahl2``, opticalglass 1.1.1): ``n = nd + ν1 ω + ν2 ω²``,
+    ``ω = Δλ/(1 + 2.5 Δλ)``, ``Δλ = λ − λd`` (µm), ``ν1 = b + m ν2`` on the line
+    ``b = −0.064667, m = −1.604048`` fitted to catalog glasses, and
+    ``ν2 = ((nd − 1)/vd − b δω)/(m δω − δω²)`` with ``δω = ωF − ωC``, ``δω² = ωF² − ωC²`` —
+    reproduced as opticalglass publishes it, which does not make ``nF − nC`` exactly
+    ``(nd − 1)/vd`` (the Abbe number comes out ~2 % high: 61.7 for 1.62/60.3).
+``"buchdahl-optiland"``
+    optiland's ``AbbeMaterial(model="buchdahl")`` (``BuchdahlDModel``, optiland 0.6.3), the
+    model optiland uses for a Zemax model glass: ``n = nd + ν1 ω + ν2 ω² + ν3 ω³`` with the same
+    ω and ν1..ν3 regressions in 1/vd, 1/vd², nd, nd², nd/vd (coefficients below).
+
+Zemax's MODEL glass and CODE V's fictitious glass use their vendors' own dispersion laws; no
+published definition of either was available to this project, so neither is implemented (the
+two Buchdahl models are what two open tools do, named as such).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import TraceError
 
 LAMBDA_D = 587.5618
 LAMBDA_F = 486.1327
 LAMBDA_C = 656.2725
 
+MODELS = ("cauchy2", "buchdahl-rayoptics", "buchdahl-optiland")
+KINDS = ("air", "index", "model", "catalog")
+BASES = ("relative", "absolute")
+
+
+class OutOfRangeWarning(UserWarning):
+    """A catalog material was evaluated outside the wavelength range its data are valid for."""
+
+
+class OutOfRangeError(TraceError):
+    """A catalog material was evaluated outside its valid range with strict checking on."""
+
 
 @dataclass(frozen=True)
 class Material:
-    """A homogeneous isotropic medium.
+    """A homogeneous isotropic medium (frozen and hashable).
 
-    ``kind`` is ``"air"`` (index 1 at every wavelength), ``"index"`` (a fixed, non-dispersive
-    index ``nd``) or ``"model"`` (an nd/vd model glass, see the module docstring).
+    kind:
+        ``"air"`` (index 1), ``"index"`` (a fixed index ``nd``), ``"model"`` (nd/vd model glass,
+        dispersion law ``model``) or ``"catalog"`` (a vendor formula; see the module docstring).
+    nd, vd:
+        d-line index and Abbe number (for a catalog material: the catalog's values, for
+        information and searching).
+    model:
+        model-glass dispersion law, one of :data:`MODELS` (``kind="model"`` only).
+    name, catalog:
+        the material's name as its vendor spells it and the catalog (``kind="catalog"``).
+    formula, coefficients:
+        dispersion formula id (:data:`raytrace.glass.formulas.FORMULAS`) and its coefficients.
+    wavelength_range_nm:
+        (min, max) wavelength in nm where the data are valid.
+    basis, temperature_c, pressure_atm:
+        ``"relative"`` (to air at ``temperature_c`` °C and ``pressure_atm`` atm) or
+        ``"absolute"`` (vacuum) index data, and the reference conditions of the data.
+    dndt:
+        Schott dn/dT constants (D0, D1, D2, E0, E1, λ_TK[µm]) or ``()``.
     """
 
     kind: str
     nd: float = 1.0
     vd: float = math.inf
+    model: str = ""
+    name: str = ""
+    catalog: str = ""
+    formula: int | str = 0
+    coefficients: tuple[float, ...] = ()
+    wavelength_range_nm: tuple[float, float] = (0.0, math.inf)
+    basis: str = "relative"
+    temperature_c: float = 20.0
+    pressure_atm: float = 1.0
+    dndt: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        if self.kind not in ("air", "index", "model"):
+        if self.kind not in KINDS:
             raise ValueError(f"unknown material kind {self.kind!r}")
-        if not (math.isfinite(self.nd) and self.nd > 0.0):
+        if self.kind != "catalog" and not (math.isfinite(self.nd) and self.nd > 0.0):
             raise ValueError(f"refractive index must be a positive finite number, got {self.nd}")
-        if self.kind == "model" and not (math.isfinite(self.vd) and self.vd > 0.0):
-            raise ValueError(f"Abbe number must be a positive finite number, got {self.vd}")
+        if self.kind == "model":
+            if not (math.isfinite(self.vd) and self.vd > 0.0):
+                raise ValueError(f"Abbe number must be a positive finite number, got {self.vd}")
+            if self.model == "":
+                object.__setattr__(self, "model", "cauchy2")
+            if self.model not in MODELS:
+                raise ValueError(
+                    f"unknown model-glass law {self.model!r} (use {', '.join(MODELS)})"
+                )
+        if self.kind == "catalog":
+            if self.basis not in BASES:
+                raise ValueError(
+                    f"index basis must be 'relative' or 'absolute', got {self.basis!r}"
+                )
+            if not self.coefficients:
+                raise ValueError(f"catalog material {self.name!r} has no dispersion coefficients")
 
     @property
     def is_air(self) -> bool:
         return self.kind == "air"
 
-    def index(self, wavelength_nm: float = LAMBDA_D) -> float:
-        """Refractive index at ``wavelength_nm`` (nm)."""
-        if self.kind == "air":
-            return 1.0
-        if self.kind == "index":
-            return self.nd
-        dn = (self.nd - 1.0) / self.vd  # nF - nC
-        b = dn / (LAMBDA_F**-2 - LAMBDA_C**-2)
-        return self.nd + b * (wavelength_nm**-2 - LAMBDA_D**-2)
+    def in_range(self, wavelength_nm) -> bool:
+        """True when every wavelength (nm) lies in the material's valid range."""
+        lo, hi = self.wavelength_range_nm
+        w = np.asarray(wavelength_nm, dtype=float)
+        return bool(np.all((w >= lo) & (w <= hi)))
+
+    def check_range(self, wavelength_nm, *, strict: bool = False) -> None:
+        """Warn (:class:`OutOfRangeWarning`) or, with ``strict``, raise
+        :class:`OutOfRangeError` when a wavelength lies outside the valid range."""
+        if self.kind != "catalog" or self.in_range(wavelength_nm):
+            return
+        lo, hi = self.wavelength_range_nm
+        w = np.atleast_1d(np.asarray(wavelength_nm, dtype=float))
+        bad = w[(w < lo) | (w > hi)]
+        msg = (
+            f"glass {self.name} ({self.catalog}) evaluated at {bad[0]:g} nm, outside its data "
+            f"range {lo:g}–{hi:g} nm: the index is extrapolated"
+        )
+        if strict:
+            raise OutOfRangeError(msg + "; use wavelengths inside the range or another material")
+        warnings.warn(msg, OutOfRangeWarning, stacklevel=3)
+
+    def index(self, wavelength_nm=LAMBDA_D, *, strict: bool = False):
+        """Refractive index at ``wavelength_nm`` (nm; scalar or array).
+
+        For a catalog material: relative to air at the material's reference conditions (see the
+        module docstring); outside the valid range a warning, or with ``strict`` an
+        :class:`OutOfRangeError`.
+        """
+        scalar = np.ndim(wavelength_nm) == 0
+        if self.kind == "air" or self.kind == "index":
+            v = 1.0 if self.kind == "air" else self.nd
+            return v if scalar else np.full(np.shape(wavelength_nm), v)
+        if self.kind == "model":
+            n = _MODEL_LAWS[self.model](self.nd, self.vd, np.asarray(wavelength_nm, dtype=float))
+        else:
+            self.check_range(wavelength_nm, strict=strict)
+            n = _catalog_index(self, np.asarray(wavelength_nm, dtype=float))
+        return float(n) if scalar else n
 
     def describe(self) -> str:
-        """Short text for listings: ``air``, ``n=1.5``, ``1.6201/60.4``."""
+        """Short text for listings: ``air``, ``n=1.5``, ``1.6201/60.4``, ``N-BK7 (Schott)``."""
         if self.kind == "air":
             return "air"
         if self.kind == "index":
             return f"n={self.nd:g}"
-        return f"{self.nd:g}/{self.vd:g}"
+        if self.kind == "catalog":
+            return f"{self.name} ({self.catalog})"
+        law = "" if self.model == "cauchy2" else f" [{self.model}]"
+        return f"{self.nd:g}/{self.vd:g}{law}"
 
+
+def _catalog_index(m: Material, wavelength_nm: np.ndarray) -> np.ndarray:
+    # deferred import: raytrace.glass imports this module
+    from .glass.air import air_index
+    from .glass.formulas import evaluate
+
+    lam_um = wavelength_nm / 1000.0
+    n = evaluate(m.formula, m.coefficients, lam_um)
+    if m.basis == "absolute":
+        n = n / air_index(lam_um, m.temperature_c, m.pressure_atm)
+    return n
+
+
+# --------------------------------------------------------------------------- model-glass laws
+
+
+def _cauchy2(nd: float, vd: float, lam_nm: np.ndarray) -> np.ndarray:
+    dn = (nd - 1.0) / vd  # nF - nC
+    b = dn / (LAMBDA_F**-2 - LAMBDA_C**-2)
+    return nd + b * (lam_nm**-2 - LAMBDA_D**-2)
+
+
+def _omega(lam_nm, alpha: float = 2.5):
+    d = (np.asarray(lam_nm, dtype=float) - LAMBDA_D) / 1000.0
+    return d / (1.0 + alpha * d)
+
+
+def _buchdahl_rayoptics(nd: float, vd: float, lam_nm: np.ndarray) -> np.ndarray:
+    # opticalglass 1.1.1, buchdahl.Buchdahl2: the (ν1, ν2) line b, m
+    b, m = -0.064667, -1.604048
+    om_f, om_c = _omega(LAMBDA_F), _omega(LAMBDA_C)
+    d_om, d_om2 = om_f - om_c, om_f**2 - om_c**2
+    v2 = ((nd - 1.0) / vd - b * d_om) / (m * d_om - d_om2)
+    v1 = b + m * v2
+    om = _omega(lam_nm)
+    return nd + v1 * om + v2 * om**2
+
+
+def _buchdahl_optiland(nd: float, vd: float, lam_nm: np.ndarray) -> np.ndarray:
+    # optiland 0.6.3, materials/abbe.py, BuchdahlDModel (reference 0.5875618 µm, alpha 2.5)
+    iv, iv2, n2, nv = 1.0 / vd, 1.0 / vd**2, nd * nd, nd / vd
+    v1 = 0.004160 + 4.462559 * iv + 2.326660 * iv2 + 0.002330 * nd - 0.003697 * n2 - 4.697604 * nv
+    v2 = 0.066434 - 7.636396 * iv + 12.597434 * iv2 - 0.037014 * n2 + 5.551013 * nv
+    v3 = -0.032218 + 2.230357 * iv - 103.318994 * iv2 - 0.009654 * n2 + 1.934983 * nv
+    om = _omega(lam_nm)
+    return nd + v1 * om + v2 * om**2 + v3 * om**3
+
+
+_MODEL_LAWS = {
+    "cauchy2": _cauchy2,
+    "buchdahl-rayoptics": _buchdahl_rayoptics,
+    "buchdahl-optiland": _buchdahl_optiland,
+}
 
 AIR = Material("air")
 
 
-def model_glass(nd: float, vd: float) -> Material:
-    """An nd/vd model glass."""
-    return Material("model", float(nd), float(vd))
+def model_glass(nd: float, vd: float, model: str = "cauchy2") -> Material:
+    """An nd/vd model glass with dispersion law ``model`` (see :data:`MODELS`)."""
+    return Material("model", float(nd), float(vd), model=model)
 
 
 def fixed_index(n: float) -> Material:

@@ -42,8 +42,8 @@ def test_agreement_logic(run):
 
 @pytest.mark.parametrize("name", ["cooke-triplet-f4", "cooke-asphere-bench"])
 def test_numpy_baseline_agrees_with_project(run, name):
-    from raytrace.lens import pack
-    from raytrace.library import load_lens
+    from raytrace.files.library import load_lens
+    from raytrace.packing import pack
 
     lens = load_lens(run.LENSES[name])
     p = pack(lens)
@@ -56,8 +56,8 @@ def test_numpy_baseline_agrees_with_project(run, name):
 
 
 def test_handwritten_loop_agrees_with_project(run):
-    from raytrace.lens import pack
-    from raytrace.library import load_lens
+    from raytrace.files.library import load_lens
+    from raytrace.packing import pack
 
     lens = load_lens("cooke-triplet-f4")
     p = pack(lens)

@@ -14,14 +14,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from distortion.calibration import (
-    CRITERIA,
-    CalibrationError,
-    calibrate,
-    fit_scale,
-    format_calibration,
-)
-from distortion.constants import (
+from distortion.calibration import CRITERIA, calibrate, fit_scale
+from distortion.curve import make_curve
+from distortion.errors import CalibrationError, DataError
+from distortion.tablefile import read_distortion_table
+from orthoscope.report.distortion import format_calibration
+from raytrace.errors import OrthoscopeError
+from raytrace.paraxial.orthoscopy import (
     exit_pupil_to_gaussian_image,
     gaussian_image_distance,
     gaussian_magnification,
@@ -29,8 +28,6 @@ from distortion.constants import (
     object_distance_for_plane_magnification,
     plane_constants,
 )
-from distortion.tables import make_curve, read_distortion_table
-from raytrace.errors import DataError, OrthoscopeError
 
 DATA = Path(__file__).parent / "data"
 F0_TABLE1 = 153.706  # Table I heading: "F0 = EFL = 153.706 mm."
@@ -178,7 +175,7 @@ def test_finite_conjugates_use_M():
 
 
 def test_bad_requests(table1):
-    with pytest.raises(CalibrationError, match="unknown calibration criterion"):
+    with pytest.raises(CalibrationError, match="unknown calibration method"):
         calibrate(table1, "best")
     with pytest.raises(CalibrationError, match="outside"):
         calibrate(table1, "two-point", at=(37.5, 50))
@@ -328,10 +325,11 @@ def test_table_reader_infers_constant_and_roundtrips(tmp_path, table1):
     inferred = read_distortion_table(DATA / "pestrecov_table1.csv")
     assert abs(inferred.constant - F0_TABLE1) <= 0.0005
     # CSV writer -> reader round trip, and the finite (height) table kind
-    from distortion.tables import curve_to_csv, curve_to_dict, format_curve
+    from distortion.tablefile import dumps_table
+    from orthoscope.report.distortion import curve_to_dict, format_curve
 
     q = tmp_path / "rt.csv"
-    q.write_text(curve_to_csv(table1))
+    q.write_text(dumps_table(table1))
     back = read_distortion_table(q, table1.constant)
     np.testing.assert_allclose(back.D0, table1.D0, atol=1e-9)
     np.testing.assert_allclose(back.fields, table1.fields)

@@ -5,7 +5,7 @@ Sources of the expected facts:
 - Classical orthoscopy (symmetry principle): a lens symmetric about its stop used at −1× has zero
   distortion — the chief ray crosses the stop centre, and by symmetry leaves at the angle it came
   in with, at the mirror height, so y' = −y exactly.
-- DESIGN.md §4: the named reference definitions agree in the Gaussian plane and differ away from it.
+- docs/design.md, "Equations": the named reference definitions agree in the Gaussian plane and differ away from it.
 """
 
 from __future__ import annotations
@@ -18,17 +18,13 @@ import pytest
 from scipy.optimize import brentq
 
 from distortion.calibration import calibrate
-from distortion.characteristic import (
-    REFERENCES,
-    characteristic_distortion,
-    characteristic_to_dict,
-    format_characteristic,
-)
+from distortion.characteristic import REFERENCES, characteristic_distortion
+from orthoscope.report.distortion import characteristic_to_dict, format_characteristic
 from raytrace.errors import TraceError
+from raytrace.files.native import read_lens
 from raytrace.lens import Aperture, Field, Lens, Surface
 from raytrace.materials import model_glass
 from raytrace.paraxial import paraxial
-from raytrace.prescription import read_lens
 
 LENSES = Path(__file__).resolve().parents[1] / "lenses"
 
@@ -71,16 +67,14 @@ def test_symmetric_lens_at_unit_magnification_is_orthoscopic():
     par = paraxial(lens, object_distance=d)
     assert par.m0 == pytest.approx(-1.0, abs=1e-12)
     heights = np.linspace(0.0, 12.0, 13)
-    res = characteristic_distortion(lens, heights, field_kind="height", object_distance=d)
+    res = characteristic_distortion(lens, object_heights_mm=heights, object_distance=d)
     assert np.all(res.status == 0)
     assert res.constant[0] == pytest.approx(-1.0, abs=1e-12)
     # y' = -y and D0 = 0 to 1e-9 of the image height, at every field
     assert np.max(np.abs(res.D0[0])) <= 1e-9 * np.max(np.abs(res.yp[0]))
     np.testing.assert_allclose(res.yp[0], -heights, rtol=0, atol=1e-9 * 12.0)
     # the same lens at infinity is not orthoscopic: the test can fail
-    inf = characteristic_distortion(
-        lens, [0.0, 10.0, 20.0], field_kind="angle", object_distance=math.inf
-    )
+    inf = characteristic_distortion(lens, [0.0, 10.0, 20.0], object_distance=math.inf)
     assert abs(inf.D0[0][-1]) > 1e-4
 
 
@@ -96,7 +90,10 @@ def test_gaussian_plane_constants_and_references_agree(triplet, od):
         kind = "height"
     res = {
         ref: characteristic_distortion(
-            triplet, fields, field_kind=kind, object_distance=od, reference=ref
+            triplet,
+            **({"fields_deg": fields} if kind == "angle" else {"object_heights_mm": fields}),
+            object_distance=od,
+            reference=ref,
         )
         for ref in REFERENCES
     }
@@ -143,7 +140,7 @@ def test_many_planes_from_one_trace_equal_separate_traces(triplet):
         assert many.s_prime[i] == pytest.approx(v, abs=1e-12)
     # the three ways of naming a plane agree
     par = many.paraxial
-    a = characteristic_distortion(triplet, fields, image_distance=sp + par.z_Hp - par.z_last)
+    a = characteristic_distortion(triplet, fields, from_last_vertex=sp + par.z_Hp - par.z_last)
     b = characteristic_distortion(triplet, fields, defocus=sp + par.z_Hp - par.z_gauss)
     np.testing.assert_allclose(a.D0, many.D0, rtol=0, atol=1e-11)
     np.testing.assert_allclose(b.D0, many.D0, rtol=0, atol=1e-11)
@@ -151,10 +148,10 @@ def test_many_planes_from_one_trace_equal_separate_traces(triplet):
 
 def test_nominal_angle_fields_for_finite_object(triplet):
     od = 400.0
-    a = characteristic_distortion(triplet, [0.0, 5.0, 10.0], field_kind="angle", object_distance=od)
+    a = characteristic_distortion(triplet, [0.0, 5.0, 10.0], object_distance=od)
     par = a.paraxial
-    y = par.p0 * np.tan(np.radians([0.0, 5.0, 10.0]))  # y = p0 tan α (DESIGN.md §3)
-    h = characteristic_distortion(triplet, y, field_kind="height", object_distance=od)
+    y = par.p0 * np.tan(np.radians([0.0, 5.0, 10.0]))  # y = p0 tan α (docs/design.md, "Conventions")
+    h = characteristic_distortion(triplet, object_heights_mm=y, object_distance=od)
     assert a.field_kind == "nominal-angle"
     np.testing.assert_allclose(a.x, y, rtol=1e-15)
     np.testing.assert_allclose(a.D0, h.D0, rtol=0, atol=1e-10)
@@ -167,7 +164,7 @@ def test_curve_calibration_and_output(triplet):
     text = format_characteristic(res)
     assert "s'=" in text and "Gaussian plane" in text
     d = characteristic_to_dict(res)
-    from raytrace.trace import STATUS_NAMES, STATUS_OK
+    from raytrace.kernels.codes import STATUS_NAMES, STATUS_OK
 
     assert len(d["planes"]) == 2 and d["status"] == [STATUS_NAMES[STATUS_OK]] * 5
 
@@ -176,8 +173,8 @@ def test_bad_requests(triplet):
     with pytest.raises(TraceError, match="unknown distortion reference"):
         characteristic_distortion(triplet, [10.0], reference="zemax")
     with pytest.raises(TraceError, match="behind the lens"):
-        characteristic_distortion(triplet, [10.0], image_distance=-1.0)
+        characteristic_distortion(triplet, [10.0], from_last_vertex=-1.0)
     with pytest.raises(TraceError, match="one way"):
         characteristic_distortion(triplet, [10.0], s_prime=50.0, defocus=0.0)
     with pytest.raises(TraceError, match="finite object"):
-        characteristic_distortion(triplet, [1.0], field_kind="height")
+        characteristic_distortion(triplet, object_heights_mm=[1.0])

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from distortion.cli import main
+from orthoscope.cli import main
 
 DATA = Path(__file__).parent / "data"
 TABLE1 = DATA / "pestrecov_table1.csv"
@@ -91,14 +91,14 @@ def test_calibrate_prints_table_II(capsys):
     # Acceptance (issue 3): Table I with two-point calibration at 37.5 and 45 deg prints Table II
     # (Pestrecov 1958): Fc = 154.059, Yc' and Dc per field.
     rc, out, _ = run(
-        capsys, "calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,45"
+        capsys, "calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,45"
     )
     assert rc == 0
     assert "F_c = 154.059 mm" in out
     assert "27.165" in out and "154.059" in out  # Yc' at 10 and 45 deg
     assert "-0.045" in out and "+0.081" in out and "-0.081" in out  # Dc at 10, 37.5, 45 deg
     rc, out, _ = run(
-        capsys, "calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,45", "--json"
+        capsys, "calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,45", "--json"
     )
     d = json.loads(out)
     assert d["Fc"] == pytest.approx(154.059, abs=5e-4)
@@ -111,9 +111,9 @@ def test_distortion_several_planes_and_fig6_plot(capsys, tmp_path):
         capsys,
         "distortion",
         "topogon-us2031792-fig1",
-        "--image-distance",
+        "--s-prime",
         "65.5",
-        "--image-distance",
+        "--s-prime",
         "66.5",
         "--plot",
         str(png),
@@ -200,7 +200,7 @@ def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
         (["trace", "no-such-lens"], "no-such-lens"),
         (["trace", "cooke-triplet-f4", "--fields", "0,abc"], "expected a number"),
         (["trace", "cooke-triplet-f4", "--object-distance", "-5"], "positive magnitude"),
-        (["trace", "cooke-triplet-f4", "--image-from-vertex", "-3"], "before the last vertex"),
+        (["trace", "cooke-triplet-f4", "--from-last-vertex", "-3"], "before the last surface"),
         (["trace", "cooke-triplet-f4", "--field-kind", "height", "--fields", "1"], "finite object"),
         (["distortion", "cooke-triplet-f4", "--at", "5"], "--calibrate"),
         (
@@ -209,10 +209,10 @@ def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
         ),
         (["distortion", "cooke-triplet-f4", "--plot", "x.gif"], ".png"),
         (["distortion", "cooke-triplet-f4", "--gaussian", "--defocus", "1"], "--gaussian"),
-        (["calibrate", str(TABLE1), "--criterion", "two-point", "--at", "37.5,50"], "50"),
-        (["calibrate", "/nonexistent.csv", "--criterion", "minimax"], "nonexistent"),
+        (["calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,50"], "50"),
+        (["calibrate", "/nonexistent.csv", "--method", "minimax"], "nonexistent"),
         (["convert", "cooke-triplet-f4", "out.seq"], ".seq"),
-        (["paraxial", "cooke-triplet-f4", "--s", "10"], "negative"),
+        (["paraxial", "cooke-triplet-f4", "--object-s", "10"], "negative"),
     ],
 )
 def test_bad_input_exit_2_one_line(capsys, argv, needle):

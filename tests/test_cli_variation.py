@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from distortion.cli import main
+from orthoscope.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 PENTAX = ROOT / "lenses" / "fraser-shortis-1992-table1-pentax.csv"

@@ -18,15 +18,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from raytrace.codev import loads_seq, parse_seq, read_seq
-from raytrace.convert import convert
 from raytrace.errors import PrescriptionError
+from raytrace.files import convert
+from raytrace.files.codev import loads_seq, parse_seq, read_seq
+from raytrace.files.library import load_lens
+from raytrace.files.text import InteropWarning
 from raytrace.glass import catalog_available
-from raytrace.library import load_lens
 from raytrace.materials import model_glass
 from raytrace.paraxial import paraxial
 from raytrace.trace import chief_rays
-from raytrace.zemax import InteropWarning
 
 DATA = Path(__file__).parent / "data"
 
@@ -51,12 +51,26 @@ GO
 
 @pytest.mark.parametrize("stem", ["cooke-triplet-f4", "topogon-us2031792-fig1"])
 def test_hand_written_seq_equals_native(stem):
-    if stem == "cooke-triplet-f4" and not catalog_available():
-        pytest.fail("the Cooke fixture names NSK16_SCHOTT: install the 'glass' extra")
     native = load_lens(stem)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the fixtures are clean files: no warning
         lens = read_seq(DATA / f"{stem}.seq")
+    # NSK16_SCHOTT is the Schott catalog glass; the native file has its nd/vd as a model glass
+    # (same d-line index to the catalog's printed digits); compare exactly with that model.
+    assert any(s.material.kind == "catalog" for s in lens.surfaces) == (stem == "cooke-triplet-f4")
+    lens = replace(
+        lens,
+        surfaces=tuple(
+            replace(s, material=model_glass(s.material.nd, s.material.vd))
+            if s.material.kind == "catalog"
+            else s
+            for s in lens.surfaces
+        ),
+    )
+    # the file's image solve ran with the catalog glasses: solve it again for the model glasses
+    lens = replace(
+        lens.with_image_distance(paraxial(lens).gaussian_image_distance), image_solve="gaussian"
+    )
     assert lens.name == native.name
     assert tuple(replace(s, label="") for s in lens.surfaces) == native.surfaces
     assert lens.image_solve == "gaussian"
@@ -136,14 +150,12 @@ def test_unknown_and_ambiguous_glass_messages():
     with pytest.raises(PrescriptionError) as e:
         loads_seq(TRIPLET.replace("1.61659:36.63", "NOSUCH99"))
     assert e.value.line == 10 and "NOSUCH99" in str(e.value)
-    if not catalog_available():
-        assert "pip install 'orthoscope[glass]'" in str(e.value)
-        return
     assert "1.620:60.3" in str(e.value)  # tells the CODE V user how to write a model glass
     with pytest.raises(PrescriptionError, match="ambiguous glass 'F2'.*F2_SCHOTT"):
         loads_seq(TRIPLET.replace("1.61659:36.63", "F2"))
     lens = loads_seq(TRIPLET.replace("1.61659:36.63", "F2_SCHOTT"))
-    assert lens.surfaces[2].material == model_glass(1.62004, 36.37)  # Schott catalog F2
+    m = lens.surfaces[2].material  # Schott catalog F2: nd 1.62004, vd 36.37 (SCHOTT.xls)
+    assert (m.kind, m.catalog, m.name, m.nd, m.vd) == ("catalog", "Schott", "F2", 1.62004, 36.37)
 
 
 def test_seq_to_native_to_zmx_conversion(tmp_path):

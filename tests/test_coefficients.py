@@ -18,15 +18,17 @@ from distortion.coefficients import (
     brown_to_opencv,
     evaluate_radial,
     fit_radial,
-    format_opencv,
-    format_radial_fit,
     gaussian_to_balanced,
     opencv_model,
     opencv_to_brown,
+)
+from distortion.errors import DataError
+from orthoscope.report.coefficients import (
+    format_opencv,
+    format_radial_fit,
     opencv_to_dict,
     radial_fit_to_dict,
 )
-from raytrace.errors import DataError
 
 # An N120-like Gaussian profile: K in mm units (≈ 60 µm at r = 100 mm).
 K_TRUE = (4.0e-8, -3.0e-12, 1.5e-16)

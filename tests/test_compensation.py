@@ -13,15 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from distortion.calibration import CalibrationError
-from distortion.compensation import (
-    compensate,
-    compensation_to_dict,
-    format_compensation,
-    printer_negative_distortion,
-)
-from distortion.tables import DistortionCurve, make_curve, read_distortion_table
-from raytrace.errors import DataError
+from distortion.compensation import compensate, printer_negative_distortion
+from distortion.curve import DistortionCurve, make_curve
+from distortion.errors import CalibrationError, DataError
+from distortion.tablefile import read_distortion_table
+from orthoscope.report.distortion import compensation_to_dict, format_compensation
 
 DATA = Path(__file__).parent / "data"
 M2 = -2.5  # made-up printer magnification (negative -> print)
@@ -63,7 +59,7 @@ def test_residual_is_eq16_and_print_is_invariant_under_recalibration(camera):
     # a printer that compensates only the cubic part of the camera's curve
     y = camera.yp
     printer = matched_printer(camera, 0.272 * (y / 153.706) ** 3)
-    base = compensate(camera, printer, criterion="given", M=M2 * 1.001)
+    base = compensate(camera, printer, method="given", magnification=M2 * 1.001)
     # Eq. (16): R = D1 - D2 - (M/M2 - 1) F1 tan α
     tan_a = np.tan(np.radians(camera.fields))
     R = base.D1 - base.D2 - (base.M / M2 - 1.0) * camera.constant * tan_a
@@ -78,7 +74,7 @@ def test_residual_is_eq16_and_print_is_invariant_under_recalibration(camera):
             printer.fields, printer.yp - M2p * printer.x, field_kind="height", constant=M2p
         )
         Mp = base.M * camera.constant / F1p
-        new = compensate(cam2, pr2, criterion="given", M=Mp)
+        new = compensate(cam2, pr2, method="given", magnification=Mp)
         # Eq. (17): the print itself (M2 R, print plane) is unchanged
         np.testing.assert_allclose(new.print_residual, base.print_residual, rtol=0, atol=1e-12)
         # and the residual in the negative plane scales with 1/M2 only
@@ -88,7 +84,7 @@ def test_residual_is_eq16_and_print_is_invariant_under_recalibration(camera):
 def test_best_M_by_calibration_criteria(camera):
     printer = matched_printer(camera, 0.5 * camera.D0)
     results = {
-        c: compensate(camera, printer, criterion=c, at=a)
+        c: compensate(camera, printer, method=c, at=a)
         for c, a in (
             ("minimax", None),
             ("least-squares", None),
@@ -120,5 +116,5 @@ def test_bad_input(camera):
     short = make_curve([0.0, 10.0, 20.0], [0.0, 0.01, 0.02], field_kind="height", constant=M2)
     with pytest.raises(DataError, match="only covers object heights up to 20"):
         compensate(camera, short)
-    with pytest.raises(CalibrationError, match="unknown criterion"):
-        compensate(camera, printer, criterion="magic")
+    with pytest.raises(CalibrationError, match="unknown method"):
+        compensate(camera, printer, method="magic")

@@ -18,8 +18,8 @@ import pytest
 
 from distortion.calibration import calibrate
 from distortion.characteristic import characteristic_distortion
-from distortion.tables import read_distortion_table
-from raytrace.library import load_lens
+from distortion.tablefile import read_distortion_table
+from raytrace.files.library import load_lens
 from raytrace.optimize import evaluate, merit, optimize, read_spec, start_lens
 from raytrace.paraxial import paraxial
 

@@ -25,16 +25,17 @@ import numpy as np
 import pytest
 
 from distortion.characteristic import characteristic_distortion
-from distortion.constants import (
+from raytrace.files.library import load_lens
+from raytrace.kernels.codes import STATUS_OK
+from raytrace.optimize import Operand, evaluate, optimize, read_spec, start_lens
+from raytrace.packing import pack
+from raytrace.paraxial import paraxial
+from raytrace.paraxial.orthoscopy import (
     object_distance_for_magnification,
     object_distance_for_plane_magnification,
     plane_constants,
 )
-from raytrace.lens import pack
-from raytrace.library import load_lens
-from raytrace.optimize import Operand, evaluate, optimize, read_spec, start_lens
-from raytrace.paraxial import paraxial
-from raytrace.trace import STATUS_OK, trace_rays
+from raytrace.trace import trace_rays
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "lenses" / "specs" / "twinplex-like-55-525.toml"
@@ -105,7 +106,10 @@ def test_gaussian_plane_distortion_within_pestrecov_maximum(lens):
     # Pestrecov Section V: in the Gaussian plane the maximum |D0| is 21 µm (spread 35 µm) over
     # the nominal field 10-45 deg. Checked on a 1-deg grid, not only the spec's fields.
     fields = np.arange(10.0, 45.0 + 1e-9, 1.0)
-    res = characteristic_distortion(lens, fields, field_kind="angle")
+    res = characteristic_distortion(
+        lens,
+        fields,
+    )
     assert np.all(res.status == STATUS_OK)
     d0 = res.D0[0]
     assert np.max(np.abs(d0)) <= 0.021
@@ -146,8 +150,8 @@ def test_best_focus_by_brute_force_and_undercorrected_spherical_aberration(lens,
     dx, dy, dz = px, py, pp.z_E0 - z0
     n = np.sqrt(dx * dx + dy * dy + dz * dz)
     batch = trace_rays(
-        pack(lens), np.zeros_like(px), np.zeros_like(py), np.full_like(px, z0),
-        dx / n, dy / n, dz / n, clip=False,
+        pack(lens), (np.zeros_like(px), np.zeros_like(py), np.full_like(px, z0)),
+        (dx / n, dy / n, dz / n), clip=False,
     )  # fmt: skip
     assert np.all(batch.status == STATUS_OK)
     sp = np.linspace(515.0, 535.0, 201)
@@ -197,9 +201,8 @@ def test_table_iv_constants_agree_with_the_real_near_axis_chief_ray(lens, par):
     _, od_p = projection_setting(lens, par)
     for od, planes in ((od_p, list(PROJECTION_PLANES)), (lens.object_distance, None)):
         kw = {} if planes is None else {"s_prime": planes}
-        a = characteristic_distortion(lens, [45.0], field_kind="angle", object_distance=od, **kw)
-        b = characteristic_distortion(
-            lens, [45.0], field_kind="angle", object_distance=od,
+        a = characteristic_distortion(lens, [45.0], object_distance=od, **kw)
+        b = characteristic_distortion(lens, [45.0], object_distance=od,
             reference="distortion-focal-length", **kw,
         )  # fmt: skip
         np.testing.assert_allclose(b.scale, a.constant, rtol=1e-7)
@@ -209,9 +212,12 @@ def test_table_iv_constants_agree_with_the_real_near_axis_chief_ray(lens, par):
 def test_table_v_analog_one_trace(lens, par):
     s_p, od_p = projection_setting(lens, par)
     proj = characteristic_distortion(
-        lens, NOMINAL_ANGLES, field_kind="angle", object_distance=od_p, s_prime=PROJECTION_PLANES
+        lens, NOMINAL_ANGLES, object_distance=od_p, s_prime=PROJECTION_PLANES
     )
-    gauss = characteristic_distortion(lens, NOMINAL_ANGLES, field_kind="angle")
+    gauss = characteristic_distortion(
+        lens,
+        NOMINAL_ANGLES,
+    )
     assert np.all(proj.status == STATUS_OK) and np.all(gauss.status == STATUS_OK)
     np.testing.assert_allclose(proj.constant, [-7.727571, -9.545455, -11.363342], atol=1e-5)
     # straight final segments and M0 linear in s' (Eq. 8): D0 is linear in s' for one object
@@ -219,9 +225,7 @@ def test_table_v_analog_one_trace(lens, par):
     np.testing.assert_allclose(proj.D0[1], 0.5 * (proj.D0[0] + proj.D0[2]), atol=1e-9)
     # one trace of many planes = separate traces of each plane
     for i, sp in enumerate(PROJECTION_PLANES):
-        one = characteristic_distortion(
-            lens, NOMINAL_ANGLES, field_kind="angle", object_distance=od_p, s_prime=sp
-        )
+        one = characteristic_distortion(lens, NOMINAL_ANGLES, object_distance=od_p, s_prime=sp)
         np.testing.assert_allclose(one.D0[0], proj.D0[i], atol=1e-10)
     # the Gaussian column (Gaussian setting) meets Pestrecov's 21 µm maximum
     assert np.max(np.abs(gauss.D0[0])) <= 0.021

@@ -16,12 +16,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from raytrace.codev import parse_seq
 from raytrace.errors import PrescriptionError
+from raytrace.files.codev import parse_seq
+from raytrace.files.library import load_lens
+from raytrace.files.zemax import dumps_zmx, parse_zmx
 from raytrace.glass import catalog_available, find_glass
 from raytrace.lens import Lens
-from raytrace.library import load_lens
-from raytrace.zemax import dumps_zmx, parse_zmx
 
 DATA = Path(__file__).parent / "data"
 N_MUTANTS = 1200

@@ -8,18 +8,17 @@ from pathlib import Path
 
 import pytest
 
+from orthoscope.report.lenses import format_lens_table, lens_infos_to_dict
 from raytrace.errors import PrescriptionError
-from raytrace.library import (
+from raytrace.files.library import (
     bundled_names,
-    format_lens_table,
-    lens_infos_to_dict,
     library_dir,
     list_lenses,
     load_lens,
     resolve_lens_path,
 )
+from raytrace.files.native import PROVENANCES, provenance
 from raytrace.paraxial import paraxial
-from raytrace.prescription import PROVENANCES, provenance
 
 REPO_LENSES = Path(__file__).resolve().parent.parent / "lenses"
 

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from distortion.cli import main
+from orthoscope.cli import main
 from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index
 from raytrace.optimize import (
     DesignSpec,
@@ -111,7 +111,7 @@ def test_distortion_operand_matches_definition():
     # D0 = y' - F0 tan(alpha) in the Gaussian plane (Pestrecov Eq. 9): cross-check against the
     # distortion module, which is written independently of the optimizer.
     from distortion.characteristic import characteristic_distortion
-    from raytrace.library import load_lens
+    from raytrace.files.library import load_lens
 
     lens = load_lens("cooke-triplet-f4")
     vals = evaluate(lens, (Operand("distortion", 0.0, 1.0, {"field": 20.0}),))
@@ -134,7 +134,7 @@ def test_cli_optimize_writes_lens_with_provenance(tmp_path: Path, capsys):
     spec.write_text(SPEC.format(target=48.0))
     out = tmp_path / "out.toml"
     assert main(["optimize", str(spec), "-o", str(out), "--quiet"]) == 0
-    from raytrace.prescription import provenance, read_lens
+    from raytrace.files.native import provenance, read_lens
 
     lens = read_lens(out)
     assert paraxial(lens).efl == pytest.approx(48.0, abs=1e-9)
@@ -177,8 +177,8 @@ def test_read_spec_unknown_key(tmp_path: Path):
 def test_gaussian_image_solve_is_kept(tmp_path: Path):
     # A start lens whose last thickness is a Gaussian solve keeps it through the optimization:
     # the written file must not carry the start lens's stale image distance.
-    from raytrace.library import load_lens
-    from raytrace.prescription import read_lens
+    from raytrace.files.library import load_lens
+    from raytrace.files.native import read_lens
 
     spec = tmp_path / "s.toml"
     spec.write_text(SPEC.format(target=48.0))

@@ -5,7 +5,8 @@ import math
 import pytest
 
 from raytrace import AIR, Aperture, Field, Lens, LensError, Surface, fixed_index, model_glass
-from raytrace.paraxial import paraxial, paraxial_chief_heights, pestrecov_constants
+from raytrace.paraxial import paraxial
+from raytrace.paraxial.orthoscopy import paraxial_chief_heights, pestrecov_constants
 
 F4 = Aperture("fnumber", 4.0)
 FIELD10 = Field("angle", 10.0)

@@ -10,15 +10,17 @@ import numpy as np
 import pytest
 
 from distortion.calibration import calibrate
-from distortion.plots import (
+from distortion.curve import make_curve
+from distortion.tablefile import read_distortion_table
+from orthoscope.plots.distortion import (
     plot_calibrated,
     plot_characteristic,
     plot_planes,
     plot_rotation,
     rotated_characteristic,
 )
-from distortion.tables import make_curve, read_distortion_table
-from raytrace.errors import DataError
+from orthoscope.plots.save import save_figure
+from raytrace.errors import OutputError
 
 DATA = Path(__file__).parent / "data"
 
@@ -36,7 +38,8 @@ def lines(fig):
 @pytest.mark.parametrize("ext", [".png", ".svg", ".pdf"])
 def test_characteristic_plot(tmp_path, cal, ext):
     p = tmp_path / f"fig2{ext}"
-    fig = plot_characteristic(cal.curve, p)
+    fig = plot_characteristic(cal.curve)
+    save_figure(fig, p)
     assert p.stat().st_size > 1000
     a, b = lines(fig)
     np.testing.assert_array_equal(a.get_xdata(), cal.curve.y0p)
@@ -49,7 +52,8 @@ def test_characteristic_plot(tmp_path, cal, ext):
 
 def test_calibrated_plot(tmp_path, cal):
     p = tmp_path / "fig3.png"
-    fig = plot_calibrated(cal, p)
+    fig = plot_calibrated(cal)
+    save_figure(fig, p)
     assert p.stat().st_size > 1000
     a, b = lines(fig)
     np.testing.assert_array_equal(a.get_xdata(), cal.ycp)
@@ -59,7 +63,8 @@ def test_calibrated_plot(tmp_path, cal):
 
 def test_rotation_plot(tmp_path, cal):
     p = tmp_path / "fig4.svg"
-    fig = plot_rotation(cal, p)
+    fig = plot_rotation(cal)
+    save_figure(fig, p)
     assert p.stat().st_size > 1000
     rot, calc = lines(fig)
     Xp, Dp = rotated_characteristic(cal)
@@ -99,7 +104,8 @@ def test_planes_plot_table5(tmp_path):
         for j in range(4)
     ]
     p = tmp_path / "fig6.png"
-    fig = plot_planes(curves, p)
+    fig = plot_planes(curves)
+    save_figure(fig, p)
     assert p.stat().st_size > 1000
     got = lines(fig)
     assert len(got) == 4
@@ -107,10 +113,10 @@ def test_planes_plot_table5(tmp_path):
         np.testing.assert_array_equal(ln.get_xdata(), t[:, 0])
         np.testing.assert_array_equal(ln.get_ydata(), t[:, j + 1])
         assert ln.get_label() == f"s' = {sp[j]} mm"
-    fig2 = plot_planes(curves, None, against="image")
+    fig2 = plot_planes(curves, against="image")
     np.testing.assert_array_equal(lines(fig2)[2].get_xdata(), curves[2].y0p)
 
 
 def test_bad_format(tmp_path, cal):
-    with pytest.raises(DataError, match="unsupported plot format"):
-        plot_characteristic(cal.curve, tmp_path / "x.bmpx")
+    with pytest.raises(OutputError, match="unsupported plot format"):
+        save_figure(plot_characteristic(cal.curve), tmp_path / "x.bmpx")

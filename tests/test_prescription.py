@@ -12,10 +12,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from raytrace.errors import PrescriptionError
+from raytrace.files.native import dumps, loads, provenance, read_lens, write_lens
 from raytrace.lens import Aperture, Field, Lens, Surface
 from raytrace.materials import AIR, fixed_index, model_glass
 from raytrace.paraxial import paraxial
-from raytrace.prescription import dumps, loads, provenance, read_lens, write_lens
 
 LENSES = Path(__file__).resolve().parent.parent / "lenses"
 COOKE = (LENSES / "cooke-triplet-f4.toml").read_text()
@@ -269,7 +269,7 @@ def test_negative_air_thickness() -> None:
 
 
 def test_unknown_material() -> None:
-    _surface_case('"1.61659/36.63"', '"BK7"', 3, "unknown material 'BK7'")
+    _surface_case('"1.61659/36.63"', '"BK7"', 3, "unknown glass 'BK7'")
 
 
 def test_gaussian_only_on_last_surface() -> None:
@@ -428,3 +428,19 @@ surfaces = [
 """
     lens = loads(text)
     assert [s.line for s in lens.surfaces] == [7, 9, 10]
+
+
+def test_catalog_glasses_round_trip_by_name(tmp_path: Path) -> None:
+    """A catalog glass is written by name and catalog (TOML) or name + GCAT (.zmx) and read back
+    as the same material; its d-line index is the catalog's printed nd (Schott N-SK16: nd 1.62041,
+    SCHOTT.xls as shipped by opticalglass 1.1.1) to the printed 5 decimals."""
+    from raytrace.files.zemax import dumps_zmx, loads_zmx, read_zmx
+
+    lens = read_zmx(Path(__file__).parent / "data" / "cooke-triplet-f4.zmx")
+    m = lens.surfaces[0].material
+    assert (m.kind, m.catalog, m.name) == ("catalog", "Schott", "N-SK16")
+    assert m.index(587.5618) == pytest.approx(1.62041, abs=5e-6)
+    text = dumps(lens)
+    assert 'glass = "N-SK16"' in text and 'catalog = "Schott"' in text
+    assert loads(text) == lens
+    assert loads_zmx(dumps_zmx(lens)) == lens

@@ -15,20 +15,19 @@ import numpy as np
 import pytest
 
 from raytrace.errors import TraceError
-from raytrace.lens import Aperture, Field, Lens, Surface, pack
-from raytrace.library import load_lens
-from raytrace.materials import AIR, fixed_index
-from raytrace.trace import (
-    PARALLEL_THRESHOLD,
+from raytrace.files.library import load_lens
+from raytrace.kernels.codes import (
     STATUS_AIM_FAILED,
     STATUS_CLIPPED,
     STATUS_MISSED,
     STATUS_NAMES,
     STATUS_OK,
     STATUS_TIR,
-    chief_rays,
-    trace_rays,
 )
+from raytrace.lens import Aperture, Field, Lens, Surface
+from raytrace.materials import AIR, fixed_index
+from raytrace.packing import pack
+from raytrace.trace import PARALLEL_THRESHOLD, chief_rays, trace_rays
 
 TOPOGON = "topogon-us2031792-fig1"
 
@@ -48,7 +47,7 @@ def _lens(surfaces, *, object_material=AIR, object_distance=math.inf, field=NO_F
 
 
 def _one(packed, y, z, M, N, x=0.0, L=0.0, clip=True):
-    return trace_rays(packed, [x], [y], [z], [L], [M], [N], clip=clip)
+    return trace_rays(packed, ([x], [y], [z]), ([L], [M], [N]), clip=clip)
 
 
 def _truncated(p, j):
@@ -120,7 +119,7 @@ def test_sphere_aplanatic_points_exact_for_all_rays():
     s = R * (1.0 + npr / n)
     sp = R * (1.0 + n / npr)
     u = np.radians(np.linspace(-20.0, 20.0, 41))
-    rb = trace_rays(pack(lens), 0.0, 0.0, s, 0.0, np.sin(u), np.cos(u))
+    rb = trace_rays(pack(lens), (0.0, 0.0, s), (0.0, np.sin(u), np.cos(u)))
     assert np.all(rb.status == STATUS_OK)
     _, y = rb.at_plane(sp)
     assert np.max(np.abs(y)) <= 1e-12 * abs(R)
@@ -150,7 +149,7 @@ def test_ball_lens_paraxial_focus():
         [Surface(1 / R, D, fixed_index(n), stop=True), Surface(-1 / R, 20.0)],
     )
     h = np.array([1e-5, -2e-5]) * R
-    rb = trace_rays(pack(lens), 0.0, h, -1.0, 0.0, 0.0, 1.0)
+    rb = trace_rays(pack(lens), (0.0, h, -1.0), (0.0, 0.0, 1.0))
     assert np.all(rb.ok)
     z_cross = rb.z - rb.y * rb.N / rb.M
     efl = n * D / (4 * (n - 1))
@@ -183,7 +182,7 @@ def _check_lens_rays(lens, x, y, z, L, M, N):
     d_prev = np.stack([L, M, N]) / np.sqrt(L * L + M * M + N * N)
     alive = np.ones(x.shape, bool)
     for j, surf in enumerate(lens.surfaces):
-        rb = trace_rays(_truncated(p, j), x, y, z, L, M, N, clip=False)
+        rb = trace_rays(_truncated(p, j), (x, y, z), (L, M, N), clip=False)
         alive &= rb.ok
         assert alive.sum() > 0.5 * x.size
         xs, ys, zs = rb.x[alive], rb.y[alive], rb.z[alive]
@@ -247,7 +246,7 @@ def test_status_tir_beyond_critical_angle():
     lens = _lens([Surface(0.0, 5.0, AIR, stop=True)], object_material=fixed_index(n))
     crit = math.asin(1 / n)
     a = np.array([crit - 0.01, crit + 0.01])
-    rb = trace_rays(pack(lens), 0.0, 0.0, -1.0, 0.0, np.sin(a), np.cos(a))
+    rb = trace_rays(pack(lens), (0.0, 0.0, -1.0), (0.0, np.sin(a), np.cos(a)))
     assert rb.status.tolist() == [STATUS_OK, STATUS_TIR]
     assert rb.surface.tolist() == [0, 1]
 
@@ -257,10 +256,10 @@ def test_status_clipped_by_semi_diameter():
         [Surface(0.02, 3.0, fixed_index(1.5), semi_diameter=2.0, stop=True), Surface(0.0, 5.0)]
     )
     p = pack(lens)
-    rb = trace_rays(p, 0.0, [1.9, 2.1], -1.0, 0.0, 0.0, 1.0)
+    rb = trace_rays(p, (0.0, [1.9, 2.1], -1.0), (0.0, 0.0, 1.0))
     assert rb.status.tolist() == [STATUS_OK, STATUS_CLIPPED]
     assert rb.surface.tolist() == [0, 1]
-    rb = trace_rays(p, 0.0, [1.9, 2.1], -1.0, 0.0, 0.0, 1.0, clip=False)
+    rb = trace_rays(p, (0.0, [1.9, 2.1], -1.0), (0.0, 0.0, 1.0), clip=False)
     assert rb.status.tolist() == [STATUS_OK, STATUS_OK]
 
 
@@ -276,8 +275,8 @@ def test_no_nan_without_status_and_parallel_equals_serial():
     x, y = rng.uniform(-12, 12, (2, n))
     a, b = np.radians(rng.uniform(-60, 60, (2, n)))
     L, M, N = np.sin(a), np.sin(b) * np.cos(a), np.cos(a) * np.cos(b)
-    par = trace_rays(p, x, y, -3.0, L, M, N)
-    ser = trace_rays(p, x, y, -3.0, L, M, N, threads=1)
+    par = trace_rays(p, (x, y, -3.0), (L, M, N))
+    ser = trace_rays(p, (x, y, -3.0), (L, M, N), threads=1)
     codes = set(np.unique(par.status).tolist())
     assert {STATUS_OK, STATUS_CLIPPED} <= codes
     assert codes <= set(STATUS_NAMES)
@@ -296,7 +295,7 @@ def test_no_nan_without_status_and_parallel_equals_serial():
 def test_trace_rays_rejects_bad_shapes():
     p = pack(load_lens("cooke-triplet-f4"))
     with pytest.raises(TraceError):
-        trace_rays(p, np.zeros(3), np.zeros(4), 0.0, 0.0, 0.0, 1.0)
+        trace_rays(p, (np.zeros(3), np.zeros(4), 0.0), (0.0, 0.0, 1.0))
 
 
 # --------------------------------------------------------------------------------------------
@@ -309,7 +308,7 @@ def _stop_heights(lens, cr):
     lens cut at the stop and return their heights at the stop surface."""
     p = pack(lens)
     cut = _truncated(p, p.stop)
-    rb = trace_rays(cut, 0.0, cr.y_start, cr.z_start, 0.0, cr.M_start, cr.N_start, clip=False)
+    rb = trace_rays(cut, (0.0, cr.y_start, cr.z_start), (0.0, cr.M_start, cr.N_start), clip=False)
     assert np.all(rb.ok)
     return rb.y
 
@@ -336,7 +335,7 @@ def test_chief_ray_aim_finite_object_and_equivalent_angles():
     give the same chief rays."""
     lens = load_lens(TOPOGON).with_object_distance(400.0)
     heights = np.array([-150.0, -40.0, 0.0, 60.0, 200.0])
-    crh = chief_rays(lens, heights, field_kind="height")
+    crh = chief_rays(lens, object_heights_mm=heights)
     assert np.all(crh.status == STATUS_OK)
     assert np.max(np.abs(crh.stop_residual)) <= 1e-12 * crh.stop_radius
     assert np.max(np.abs(_stop_heights(lens, crh))) <= 1e-12 * crh.stop_radius
@@ -344,7 +343,7 @@ def test_chief_ray_aim_finite_object_and_equivalent_angles():
     assert np.all(crh.z_start == -400.0)
     p0 = -400.0 - _ynu_z_e0(lens)
     alpha = np.degrees(np.arctan(heights / p0))
-    cra = chief_rays(lens, alpha, field_kind="angle")
+    cra = chief_rays(lens, alpha)
     assert np.all(cra.status == STATUS_OK)
     np.testing.assert_allclose(cra.y_start, heights, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(cra.heights_at(lens.image_z), crh.heights_at(lens.image_z),
@@ -365,7 +364,7 @@ def test_field_beyond_lens_gets_status_not_crash():
     with pytest.raises(TraceError):
         chief_rays(lens, [90.0])
     with pytest.raises(TraceError):
-        chief_rays(lens, [1.0], field_kind="height")  # object at infinity
+        chief_rays(lens, object_heights_mm=[1.0])  # object at infinity
 
 
 def test_chief_rays_paraxial_limit():
@@ -383,7 +382,7 @@ def test_chief_rays_paraxial_limit():
     fin = lens.with_object_distance(300.0)
     z_e0 = _ynu_z_e0(fin)
     h = 1e-4 * 100.0
-    cr = chief_rays(fin, [h], field_kind="height")
+    cr = chief_rays(fin, object_heights_mm=[h])
     u = -h / (z_e0 + 300.0)  # slope of the paraxial ray from (h, −300) through E0
     y_par = _ynu(fin, h + 300.0 * u, u, fin.image_z)
     assert cr.heights_at(fin.image_z)[0] == pytest.approx(y_par, rel=1e-9)

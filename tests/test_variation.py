@@ -14,28 +14,29 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from distortion.profiles import analyze_csv, read_profiles_csv
-from distortion.variation import (
-    Conjugate,
+from distortion.errors import DataError
+from distortion.variation.analysis import (
     Profile,
     ProfileSet,
     analyze_variation,
+    brown_implied_gaussian,
+    estimate_g,
+    summarize_g,
+)
+from distortion.variation.models import (
+    Conjugate,
     brown_alpha,
     brown_alpha_scales,
     brown_gamma,
     brown_gamma_scales,
-    brown_implied_gaussian,
     brown_interpolate,
     distance_from_scale,
-    estimate_g,
-    format_g_table,
-    format_variation,
     fs_predict,
     scale_from_distance,
-    summarize_g,
-    variation_to_dict,
 )
-from raytrace.errors import DataError
+from distortion.variation.profiles import analyze_csv, read_profiles_csv
+from orthoscope.plots.save import save_figure
+from orthoscope.report.variation import format_g_table, format_variation, variation_to_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(__file__).parent / "data"
@@ -322,12 +323,14 @@ def test_pentax_table1_one_focus_setting():
 
 
 def test_plots_written(tmp_path):
-    from distortion.variation_plots import plot_g, plot_profiles
+    from orthoscope.plots.variation import plot_g, plot_profiles
 
     a = analyze_csv(_write_csv(tmp_path / "n.csv", _synthetic_rows(0.45, noise=0.2)))
     p1, p2 = tmp_path / "profiles.png", tmp_path / "g.png"
-    fig1 = plot_profiles(a, p1)
-    fig2 = plot_g(a, p2)
+    fig1 = plot_profiles(a)
+    save_figure(fig1, p1)
+    fig2 = plot_g(a)
+    save_figure(fig2, p2)
     assert p1.stat().st_size > 10_000 and p2.stat().st_size > 10_000
     assert fig1.axes[0].get_xlabel() == "radial distance r (mm)"
     assert "µm" in fig1.axes[0].get_ylabel()

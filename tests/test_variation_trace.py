@@ -15,18 +15,17 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 from distortion.characteristic import characteristic_distortion
-from distortion.variation import Conjugate, brown_alpha_scales
-from distortion.variation_trace import (
+from distortion.errors import DataError
+from distortion.variation.models import Conjugate, brown_alpha_scales
+from distortion.variation.traced import (
     conjugate_geometry,
-    format_traced_variation,
     parse_conjugate,
     trace_setting,
     trace_variation,
-    traced_variation_to_dict,
 )
-from raytrace.errors import DataError
+from orthoscope.report.variation import format_traced_variation, traced_variation_to_dict
+from raytrace.files.library import load_lens
 from raytrace.lens import Aperture, Field, Lens, Surface
-from raytrace.library import load_lens
 from raytrace.materials import model_glass
 from raytrace.paraxial import paraxial
 
@@ -58,7 +57,7 @@ def test_parse_conjugate():
 
 
 def test_image_scale_is_gaussian_magnification(s65):
-    # "12x" means Gaussian magnification -1/12 (DESIGN.md §4); Pestrecov Eq. (5) m0 = f/(f + s).
+    # "12x" means Gaussian magnification -1/12 (docs/design.md, "Vocabulary"); Pestrecov Eq. (5) m0 = f/(f + s).
     for n in (8.0, 12.0, 20.0):
         geo = conjugate_geometry(s65, Conjugate.scale(n))
         par = paraxial(s65, geo.object_distance)
@@ -83,7 +82,7 @@ def test_same_object_and_focus_is_the_gaussian_profile_exactly(s65):
     st = trace_setting(s65, Conjugate.scale(12), Conjugate.scale(12), fields)
     geo = conjugate_geometry(s65, Conjugate.scale(12))
     cd = characteristic_distortion(
-        s65, fields, field_kind="angle", object_distance=geo.object_distance
+        s65, fields, object_distance=geo.object_distance
     )  # default plane: the Gaussian plane
     assert st.gaussian and st.defocus == pytest.approx(0.0, abs=1e-12)
     np.testing.assert_allclose(st.r_mm, np.abs(cd.yp[0]), rtol=0, atol=1e-12)
@@ -93,9 +92,9 @@ def test_same_object_and_focus_is_the_gaussian_profile_exactly(s65):
 def test_non_gaussian_plane_is_the_focus_plane(s65_study):
     # Unit focusing: every profile at focus 12x uses the Gaussian image plane of 12x.
     st = {s.label: s for s in s65_study.settings}
-    z = st["12×"].image_distance
+    z = st["12×"].from_last_vertex
     for lab in ("8×(12×)", "16×(12×)", "20×(12×)"):
-        assert st[lab].image_distance == z
+        assert st[lab].from_last_vertex == z
         assert st[lab].defocus != 0.0
     # an object closer than the focus (8x) images behind the plane: the plane is before it
     assert st["8×(12×)"].defocus < 0 < st["20×(12×)"].defocus

@@ -1,0 +1,240 @@
+"""Measured-data mode: read radial distortion profiles from a CSV file.
+
+File format (UTF-8 text)::
+
+    # source: who measured it, where it was published        <- free comments start with '#'
+    # focal_length_mm: 45                                     <- optional metadata, 'key: value'
+    r_mm, dr_um, focus, object                                <- header (any column order)
+    4, 2.4, 8, 1.5
+    ...
+
+Columns (names case-insensitive):
+
+* ``r_mm`` — radial distance in the image, millimetres.
+* ``dr_um`` or ``dr_mm`` — radial distortion δr, micrometres or millimetres (the unit must be in
+  the name), positive outward. Stored in µm.
+* ``focus`` — the distance the lens is focused on; ``object`` — the object-plane distance.
+  Each value is either metres from the lens (``1.5``, ``inf``) or an image scale ``12x``
+  (also ``12X``, ``12×``: Gaussian magnification −1/12). One unit per column: a column mixing
+  image scales and metres is an error. ``focus_m``/``object_m`` force metres,
+  ``focus_x``/``object_x`` force image scales (values may then omit the ``x``).
+
+Rows with the same (focus, object) form one profile (radii sorted; duplicates are an error).
+Metadata keys: ``focal_length_mm`` (needed for distances in metres), ``source``, ``lens``.
+Errors raise :class:`raytrace.errors.DataError` as ``path:line: message``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataError
+from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
+from .models import WEAK_THRESHOLD_UM, Conjugate
+
+_SCALE_SUFFIXES = ("x", "X", "×")
+
+
+def _err(path, line, msg) -> DataError:
+    where = f"{path}:{line}" if line is not None else f"{path}"
+    return DataError(f"{where}: {msg}")
+
+
+def _parse_number(text: str, col: str, path, line) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise _err(path, line, f"column {col!r}: {text!r} is not a number") from None
+    if math.isnan(v):
+        raise _err(path, line, f"column {col!r}: NaN is not allowed")
+    return v
+
+
+def _parse_conjugate(text: str, col: str, forced: str | None, path, line) -> Conjugate:
+    t = text.strip()
+    is_scale = t.endswith(_SCALE_SUFFIXES)
+    if forced == "m" and is_scale:
+        raise _err(path, line, f"column {col!r} is in metres but {t!r} is an image scale")
+    if is_scale or forced == "x":
+        num = t[:-1].strip() if is_scale else t
+        v = _parse_number(num, col, path, line)
+        if not (v > 0 and math.isfinite(v)):
+            raise _err(path, line, f"column {col!r}: image scale {t!r} must be positive, finite")
+        return Conjugate(v, "x", t)
+    v = _parse_number(t, col, path, line)
+    if not v > 0:
+        raise _err(path, line, f"column {col!r}: distance {t!r} m must be positive")
+    return Conjugate(v, "m", t)
+
+
+def read_profiles_csv(
+    path: str | Path, *, focal_length_mm: float | None = None, min_profiles: int = 2
+) -> ProfileSet:
+    """Read a CSV of radial distortion profiles (format in the module docstring).
+
+    ``min_profiles`` (default 2, what a variation analysis needs; 1 for a coefficient fit of a
+    single profile) is the fewest profiles the file must hold.
+
+    ``focal_length_mm`` overrides the file's ``# focal_length_mm:`` metadata. Raises DataError
+    (naming the file and line) for a missing header, missing columns, units not stated,
+    non-numeric values, a column mixing image scales and metres, duplicate radii, profiles of
+    fewer than two points, or fewer than two profiles.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise DataError(f"{path}: not a UTF-8 text file") from None
+    meta: dict[str, str] = {}
+    notes: list[str] = []
+    header: list[str] | None = None
+    header_line = 0
+    rows: list[tuple[int, list[str]]] = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        s = raw.strip()
+        if not s:
+            continue
+        if s.startswith("#"):
+            body = s.lstrip("#").strip()
+            k, sep, v = body.partition(":")
+            if sep and k.strip().lower() in ("focal_length_mm", "source", "lens"):
+                meta[k.strip().lower()] = v.strip()
+            elif body:
+                notes.append(body)
+            continue
+        cells = [c.strip() for c in next(csv.reader([s]))]
+        if header is None:
+            header, header_line = [c.lower() for c in cells], lineno
+            continue
+        rows.append((lineno, cells))
+    if header is None:
+        raise _err(path, None, "no header line (expected e.g. 'r_mm, dr_um, focus, object')")
+
+    def find(*names: str) -> tuple[int, str] | None:
+        for n in names:
+            if n in header:
+                return header.index(n), n
+        return None
+
+    r_col = find("r_mm")
+    dr_col = find("dr_um", "dr_mm")
+    f_col = find("focus", "focus_m", "focus_x")
+    o_col = find("object", "object_m", "object_x")
+    missing = []
+    if r_col is None:
+        hint = " (state the unit: 'r_mm')" if find("r", "radius") else ""
+        missing.append("'r_mm'" + hint)
+    if dr_col is None:
+        hint = " (state the unit: 'dr_um' or 'dr_mm')" if find("dr", "distortion") else ""
+        missing.append("'dr_um' or 'dr_mm'" + hint)
+    if f_col is None:
+        missing.append("'focus'")
+    if o_col is None:
+        missing.append("'object'")
+    if missing:
+        raise _err(
+            path,
+            header_line,
+            "missing column(s) " + ", ".join(missing) + f" in header {header!r}; each row needs "
+            "r_mm, dr_um, and the profile's focused distance 'focus' and object distance "
+            "'object' (metres, or image scale like '12x')",
+        )
+    dr_scale = 1000.0 if dr_col[1] == "dr_mm" else 1.0
+    forced = {
+        "focus": "m" if f_col[1].endswith("_m") else "x" if f_col[1].endswith("_x") else None,
+        "object": "m" if o_col[1].endswith("_m") else "x" if o_col[1].endswith("_x") else None,
+    }
+    f_mm = focal_length_mm
+    if f_mm is None and "focal_length_mm" in meta:
+        f_mm = _parse_number(meta["focal_length_mm"], "focal_length_mm", path, None)
+    if f_mm is not None and not (f_mm > 0 and math.isfinite(f_mm)):
+        raise _err(path, None, f"focal length must be positive, got {f_mm!r}")
+
+    groups: dict[tuple, dict] = {}
+    first_unit: dict[str, tuple[str, int, str]] = {}
+    ncols = len(header)
+    for lineno, cells in rows:
+        if len(cells) != ncols:
+            raise _err(path, lineno, f"{len(cells)} values, the header has {ncols}")
+        r = _parse_number(cells[r_col[0]], r_col[1], path, lineno)
+        dr = _parse_number(cells[dr_col[0]], dr_col[1], path, lineno) * dr_scale
+        if not (math.isfinite(r) and r >= 0):
+            raise _err(path, lineno, f"radial distance {cells[r_col[0]]!r} must be >= 0, finite")
+        if not math.isfinite(dr):
+            raise _err(path, lineno, f"distortion {cells[dr_col[0]]!r} must be finite")
+        conj = {}
+        for name, (idx, col) in (("focus", f_col), ("object", o_col)):
+            c = _parse_conjugate(cells[idx], col, forced[name], path, lineno)
+            if name not in first_unit:
+                first_unit[name] = (c.unit, lineno, cells[idx])
+            elif first_unit[name][0] != c.unit:
+                u0, l0, t0 = first_unit[name]
+                kind = {"x": "image scales", "m": "metres"}
+                raise _err(
+                    path,
+                    lineno,
+                    f"column {col!r} mixes units: {kind[c.unit]} ({cells[idx]!r}) here, "
+                    f"{kind[u0]} ({t0!r}) on line {l0}; use one unit per column",
+                )
+            conj[name] = c
+        k = (conj["focus"].unit, conj["focus"].value, conj["object"].unit, conj["object"].value)
+        g = groups.setdefault(
+            k, {"focus": conj["focus"], "object": conj["object"], "line": lineno, "pts": []}
+        )
+        g["pts"].append((r, dr, lineno))
+
+    profiles = []
+    for g in groups.values():
+        pts = sorted(g["pts"])
+        rr = np.array([p[0] for p in pts])
+        dd = np.array([p[1] for p in pts])
+        label = f"focus {g['focus'].text}, object {g['object'].text}"
+        dup = np.nonzero(np.diff(rr) == 0)[0]
+        if dup.size:
+            raise _err(
+                path, pts[dup[0] + 1][2], f"profile ({label}): radius {rr[dup[0]]:g} mm twice"
+            )
+        if rr.size < 2:
+            raise _err(path, g["line"], f"profile ({label}) has only one point")
+        profiles.append(Profile(g["focus"], g["object"], rr, dd, g["line"]))
+    if len(profiles) < min_profiles:
+        only = (
+            f" (focus {profiles[0].focus.text}, object {profiles[0].obj.text})" if profiles else ""
+        )
+        raise _err(
+            path,
+            header_line,
+            f"{len(profiles)} profile(s){only}: a variation analysis needs at least two "
+            "profiles (different object planes and/or focus settings)",
+        )
+    if f_mm is not None:
+        for p in profiles:
+            for c in (p.focus, p.obj):
+                if c.unit == "m" and not c.value * 1000.0 > f_mm:
+                    raise _err(
+                        path, p.line, f"distance {c.text} m is inside the focal length {f_mm:g} mm"
+                    )
+    src = meta.get("source", "")
+    return ProfileSet(
+        tuple(profiles), f_mm, str(path), tuple(([f"source: {src}"] if src else []) + notes)
+    )
+
+
+def analyze_csv(
+    path: str | Path,
+    *,
+    focal_length_mm: float | None = None,
+    r_min: float | None = None,
+    r_max: float | None = None,
+    threshold_um: float = WEAK_THRESHOLD_UM,
+    method: str = "lsq",
+) -> VariationAnalysis:
+    """Read ``path`` (:func:`read_profiles_csv`) and run :func:`analyze_variation` on it."""
+    ps = read_profiles_csv(path, focal_length_mm=focal_length_mm)
+    return analyze_variation(ps, r_min=r_min, r_max=r_max, threshold_um=threshold_um, method=method)

@@ -1,0 +1,153 @@
+"""orthoscope: lens design for image geometry — real chief rays to any image plane and Pestrecov's
+characteristic and calibrated distortion, its variation with object distance (Fraser & Shortis),
+compensation, and plots.
+
+The shortest path::
+
+    import orthoscope as osc
+    lens = osc.load_lens("topogon-us2031792-fig1")        # bundled name or .toml/.zmx/.seq path
+    p = osc.paraxial(lens)                                 # p.efl, p.bfl, pupils, m_e, ...
+    rays = osc.chief_rays(lens, fields_deg=[0, 10, 20])    # named arrays, a status per ray
+    d = osc.characteristic_distortion(lens, fields_deg=[0, 10, 20, 30, 40])
+    cal = osc.calibrate(d, method="minimax")
+    fig = osc.plot_distortion(d, cal)
+
+Units: millimetres, wavelengths in nm, angles in degrees; light travels toward +z; signs follow
+Pestrecov (1958) Fig. 1. The object plane is given as ``object_distance`` (mm from the first
+vertex), ``object_s`` (signed, from H) or ``object_scale`` (N of "N×"); the image plane as
+``s_prime`` (from H'), ``from_last_vertex`` or ``defocus`` (from the Gaussian plane) — the same
+words as the command line's flags and the JSON keys (docs/design.md, "Vocabulary").
+
+Names load on first use, so ``import orthoscope`` is cheap and the command line starts fast.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: public name -> module that defines it
+_API: dict[str, str] = {
+    # lenses and files
+    "Lens": "raytrace.lens",
+    "Surface": "raytrace.lens",
+    "Aperture": "raytrace.lens",
+    "Field": "raytrace.lens",
+    "Material": "raytrace.materials",
+    "model_glass": "raytrace.materials",
+    "fixed_index": "raytrace.materials",
+    "load_lens": "raytrace.files.library",
+    "list_lenses": "raytrace.files.library",
+    "save_lens": "raytrace.files",
+    "convert": "raytrace.files",
+    # paraxial optics and the vocabulary of planes
+    "paraxial": "raytrace.paraxial",
+    "ParaxialResult": "raytrace.paraxial",
+    "ImagePlane": "raytrace.paraxial",
+    "pestrecov_constants": "raytrace.paraxial",
+    # real rays
+    "chief_rays": "raytrace.trace",
+    "ChiefRays": "raytrace.trace",
+    "trace_rays": "raytrace.trace",
+    "RayBatch": "raytrace.trace",
+    # distortion (Pestrecov 1958)
+    "characteristic_distortion": "distortion.characteristic",
+    "CharacteristicDistortion": "distortion.characteristic",
+    "calibrate": "distortion.calibration",
+    "CalibrationResult": "distortion.calibration",
+    "compensate": "distortion.compensation",
+    "CompensationResult": "distortion.compensation",
+    "DistortionCurve": "distortion.curve",
+    "make_curve": "distortion.curve",
+    "read_distortion_table": "distortion.tablefile",
+    # variation with object distance (Fraser & Shortis 1992) and coefficients
+    "trace_variation": "distortion.variation",
+    "analyze_variation": "distortion.variation",
+    "analyze_csv": "distortion.variation",
+    "Conjugate": "distortion.variation",
+    "fit_radial": "distortion.coefficients",
+    "opencv_model": "distortion.coefficients",
+    # design
+    "read_spec": "raytrace.optimize",
+    "optimize": "raytrace.optimize",
+    # plots (matplotlib loads with the first of these)
+    "plot_distortion": "orthoscope.plots.distortion",
+    "plot_characteristic": "orthoscope.plots.distortion",
+    "plot_calibrated": "orthoscope.plots.distortion",
+    "plot_planes": "orthoscope.plots.distortion",
+    "plot_rotation": "orthoscope.plots.distortion",
+    "plot_layout": "orthoscope.plots.layout",
+    "save_figure": "orthoscope.plots.save",
+    # errors
+    "OrthoscopeError": "raytrace.errors",
+    "PrescriptionError": "raytrace.errors",
+    "LensError": "raytrace.errors",
+    "TraceError": "raytrace.errors",
+    "OutputError": "raytrace.errors",
+    "DataError": "distortion.errors",
+    "CalibrationError": "distortion.errors",
+}
+
+__all__ = sorted([*_API, "__version__"])
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import PackageNotFoundError, version
+    except ImportError:  # pragma: no cover
+        return "0+unknown"
+    try:
+        return version("orthoscope")
+    except PackageNotFoundError:
+        return "0+unknown"
+
+
+__version__ = _version()
+
+
+def __getattr__(name: str) -> Any:
+    mod = _API.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'orthoscope' has no attribute {name!r}")
+    value = getattr(importlib.import_module(mod), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_API))
+
+
+if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
+    from distortion.calibration import CalibrationResult, calibrate
+    from distortion.characteristic import CharacteristicDistortion, characteristic_distortion
+    from distortion.coefficients import fit_radial, opencv_model
+    from distortion.compensation import CompensationResult, compensate
+    from distortion.curve import DistortionCurve, make_curve
+    from distortion.errors import CalibrationError, DataError
+    from distortion.tablefile import read_distortion_table
+    from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
+    from raytrace.errors import (
+        LensError,
+        OrthoscopeError,
+        OutputError,
+        PrescriptionError,
+        TraceError,
+    )
+    from raytrace.files import convert, save_lens
+    from raytrace.files.library import list_lenses, load_lens
+    from raytrace.lens import Aperture, Field, Lens, Surface
+    from raytrace.materials import Material, fixed_index, model_glass
+    from raytrace.optimize import optimize, read_spec
+    from raytrace.paraxial import ImagePlane, ParaxialResult, paraxial, pestrecov_constants
+    from raytrace.trace import ChiefRays, RayBatch, chief_rays, trace_rays
+
+    from .plots.distortion import (
+        plot_calibrated,
+        plot_characteristic,
+        plot_distortion,
+        plot_planes,
+        plot_rotation,
+    )
+    from .plots.layout import plot_layout
+    from .plots.save import save_figure

@@ -1,0 +1,78 @@
+"""``orthoscope calibrate``: recalibrate a distortion table with no lens (Table I -> Table II)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import add_output_args
+from .distortion import add_calibration_args, add_force_arg, add_table_layout_arg
+
+TABLE_HELP = (
+    "Distortion table CSV: a header with the field column (alpha_deg or y_mm), y0p_mm, D0_mm and "
+    "optionally Dr_pct; '#' lines are comments (see README)."
+)
+
+
+def cmd_calibrate(args) -> int:
+    from distortion.calibration import calibrate
+    from distortion.tablefile import read_distortion_table
+
+    from ..report.distortion import calibration_csv, calibration_to_dict, format_calibration
+    from .common import print_json
+    from .distortion import at_fields, check_plot_path
+
+    args._inputs = [args.table]
+    for flag in ("plot", "plot_rotation"):
+        check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
+    curve = read_distortion_table(args.table, constant=args.constant)
+    res = calibrate(
+        curve, args.method, at=at_fields(args.at), value=args.value, k=args.exaggeration
+    )
+    if args.json:
+        print_json(calibration_to_dict(res))
+    elif args.csv:
+        print(calibration_csv(res))
+    else:
+        print(format_calibration(res, layout=args.table_layout))
+    if args.plot or args.plot_rotation:
+        from ..plots.distortion import plot_calibrated, plot_rotation
+        from ..plots.save import save_figure
+
+        if args.plot:
+            save_figure(plot_calibrated(res), args.plot, overwrite=args.force, inputs=[args.table])
+        if args.plot_rotation:
+            save_figure(
+                plot_rotation(res), args.plot_rotation, overwrite=args.force, inputs=[args.table]
+            )
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser(
+        "calibrate",
+        help="Recalibrate a distortion table (CSV) with no lens: Table I -> Table II.",
+        description=(
+            "Calibrated distortion from a data table alone (Pestrecov Eqs. 10-15): the calibrated "
+            "constant Fc (or Mc), tan rho = Fc/F0 - 1, rho_k, Dc, Drc, yc', max |Dc|, spreads and "
+            "Drc on the axis. F0 (M0) is inferred from y0'/tan(alpha) (y0'/y) unless --constant "
+            "gives it."
+        ),
+        epilog="Example: orthoscope calibrate tests/data/pestrecov_table1.csv --method two-point "
+        "--at 37.5,45",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument("table", metavar="TABLE.csv", help=TABLE_HELP)
+    add_calibration_args(q, required=True)
+    q.add_argument(
+        "--constant",
+        type=float,
+        metavar="K0",
+        help="F0 (mm) or M0 of the table (default: inferred from the table).",
+    )
+    add_table_layout_arg(q)
+    g = q.add_argument_group("plots")
+    g.add_argument("--plot", metavar="FILE", help="Save Fig. 3 (calibrated distortion).")
+    g.add_argument("--plot-rotation", metavar="FILE", help="Save Fig. 4 (rotated curve).")
+    add_force_arg(q)
+    add_output_args(q)
+    q.set_defaults(func=cmd_calibrate)

@@ -1,0 +1,289 @@
+"""What every subcommand shares: the one vocabulary of flags (docs/design.md, "Vocabulary"),
+their help texts, loading a lens, and printing results.
+
+Handlers raise :class:`CliError` (or any project error) for what a person can get wrong;
+:func:`orthoscope.cli.main` prints it as one line and exits with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Any
+
+import numpy as np
+
+from raytrace.errors import OrthoscopeError
+
+OBJECT_HELP = (
+    "Object plane, one of: --object-distance D (mm from the object plane to the FIRST VERTEX, a "
+    "positive magnitude as in lens files; 'inf'; or an image scale 'Nx'), --object-s S "
+    "(Pestrecov's signed s: mm from the first principal point H, NEGATIVE for a real object), "
+    "--object-scale N (Gaussian magnification -1/N). Default: the lens file's object."
+)
+PLANE_HELP = (
+    "Image plane, one of: --s-prime S' (mm from the second principal point H', Pestrecov's s'), "
+    "--from-last-vertex D (mm from the last vertex), --defocus DZ (mm from the Gaussian image "
+    "plane, + away from the lens), --gaussian (the Gaussian plane of the object). Default: the "
+    "lens file's image plane (a file whose last thickness is \"gaussian\" means the Gaussian "
+    "plane of whatever object is traced)."
+)
+FIELDS_HELP = (
+    "Comma-separated fields: half-field angles in degrees (object-space chief-ray slope angle; "
+    "with a finite object, Pestrecov's nominal angles, y = p0 tan(alpha)) or object heights in mm, "
+    "as --field-kind says. Signed values are fine: --fields -10,0,10."
+)
+
+
+class CliError(OrthoscopeError):
+    """A usage error detected after argparse (bad combination of flags, bad value)."""
+
+
+class DeprecatedAlias(argparse.Action):
+    """An old flag spelling that still works for one release, with a warning on stderr."""
+
+    def __init__(self, option_strings, dest, new: str = "", **kw) -> None:
+        self.new = new
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        warn(f"{option_string} is deprecated and will be removed; use {self.new}")
+        if self.nargs == 0:
+            setattr(namespace, self.dest, self.const)
+        elif isinstance(getattr(namespace, self.dest, None), list) or self.default == []:
+            cur = list(getattr(namespace, self.dest, None) or [])
+            cur.append(values)
+            setattr(namespace, self.dest, cur)
+        else:
+            setattr(namespace, self.dest, values)
+
+
+def warn(message: str) -> None:
+    """One warning line on stderr."""
+    print(f"orthoscope: warning: {message}", file=sys.stderr)
+
+
+def number(text: str, what: str) -> float:
+    """A finite float from ``text``; CliError naming ``what`` otherwise."""
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        raise CliError(f"{what}: expected a number, got {text!r}") from None
+    if not math.isfinite(v):
+        raise CliError(f"{what}: expected a finite number, got {text!r}")
+    return v
+
+
+def parse_list(text: str, what: str) -> np.ndarray:
+    """``'0,10,20'`` → array; a clear error on garbage."""
+    parts = [p.strip() for p in str(text).split(",") if p.strip()]
+    if not parts:
+        raise CliError(f"{what}: empty list")
+    return np.array([number(p, what) for p in parts])
+
+
+def signed_list(text: str) -> str:
+    """argparse type for lists that may start with a minus sign (kept as text)."""
+    return text
+
+
+def load(name: str):
+    """Load a lens by bundled name or path (every reader the project has)."""
+    from raytrace.files.library import load_lens
+
+    return load_lens(name)
+
+
+def load_scaled(args):
+    """The lens of ``--lens``, scaled to ``--scale-to-efl`` mm when given."""
+    from raytrace.files.library import load_lens
+    from raytrace.paraxial import paraxial
+
+    lens = load_lens(args.lens)
+    if args.scale_to_efl is not None:
+        if not (args.scale_to_efl > 0 and math.isfinite(args.scale_to_efl)):
+            raise CliError(
+                f"--scale-to-efl must be a positive focal length in mm, got {args.scale_to_efl}"
+            )
+        efl = paraxial(lens, math.inf).efl
+        if not efl > 0:
+            raise CliError(f"{lens.name}: EFL {efl:g} mm is not positive; cannot scale it")
+        lens = lens.scaled(args.scale_to_efl / efl)
+    return lens
+
+
+# ----------------------------------------------------------------------------- objects
+def add_object_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("object plane (give at most one)", OBJECT_HELP)
+    g.add_argument(
+        "--object-distance", metavar="D", help="mm from the object plane to the first vertex."
+    )
+    g.add_argument("--object-s", metavar="S", help="Pestrecov's s: mm from H, negative.")
+    g.add_argument("--object-scale", metavar="N", help="image scale N (Nx): magnification -1/N.")
+    g.add_argument(
+        "--s",
+        dest="object_s",
+        metavar="S",
+        action=DeprecatedAlias,
+        new="--object-s",
+        help=argparse.SUPPRESS,
+    )
+
+
+def resolve_object(lens, args) -> float:
+    """The object distance (mm from the first vertex, or inf) from the object flags."""
+    from raytrace.paraxial import resolve_object_distance
+
+    s = None if args.object_s is None else number(args.object_s, "--object-s")
+    scale = None
+    if args.object_scale is not None:
+        t = str(args.object_scale).strip().rstrip("xX×")
+        scale = number(t, "--object-scale")
+    return resolve_object_distance(
+        lens, object_distance=args.object_distance, object_s=s, object_scale=scale
+    )
+
+
+# ----------------------------------------------------------------------------- image planes
+def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> None:
+    g = p.add_argument_group(
+        "image plane" + (" (each flag repeatable; one kind per call)" if repeatable else ""),
+        PLANE_HELP,
+    )
+    act = "append" if repeatable else "store"
+    g.add_argument("--s-prime", type=str, action=act, metavar="S'", help="mm from H'.")
+    g.add_argument("--from-last-vertex", type=str, action=act, metavar="D", help="mm from the last vertex.")
+    g.add_argument("--defocus", type=str, action=act, metavar="DZ", help="mm from the Gaussian plane.")
+    g.add_argument("--gaussian", action="store_true", help="the Gaussian image plane of the object.")
+    for old, new, dest in (
+        ("--image-distance", "--s-prime", "s_prime"),
+        ("--image-from-vertex", "--from-last-vertex", "from_last_vertex"),
+    ):
+        g.add_argument(
+            old,
+            dest=dest,
+            metavar="X",
+            action=DeprecatedAlias,
+            new=new,
+            default=[] if repeatable else None,
+            help=argparse.SUPPRESS,
+        )
+
+
+def resolve_planes(lens, args) -> list:
+    """The :class:`~raytrace.paraxial.ImagePlane` list the plane flags ask for (default: the lens
+    file's plane, or the Gaussian plane when the file solves its image to the Gaussian plane)."""
+    from raytrace.paraxial import ImagePlane
+
+    given = {}
+    for key, flag in (
+        ("s_prime", "--s-prime"),
+        ("from_last_vertex", "--from-last-vertex"),
+        ("defocus", "--defocus"),
+    ):
+        v = getattr(args, key, None)
+        if v in (None, []):
+            continue
+        vals = v if isinstance(v, list) else [v]
+        nums = []
+        for item in vals:
+            nums.extend(parse_list(item, flag).tolist())
+        given[key] = nums
+    if len(given) > 1:
+        flags = ", ".join("--" + k.replace("_", "-") for k in given)
+        raise CliError(f"give the image planes one way, not {flags}")
+    if given and args.gaussian:
+        raise CliError(
+            "--gaussian names the image plane: give it alone, or give the planes with "
+            "--s-prime / --from-last-vertex / --defocus (which may include 0)"
+        )
+    if given:
+        ((kind, vals),) = given.items()
+        return [ImagePlane(kind, float(v)) for v in vals]
+    if args.gaussian or lens.image_solve == "gaussian":
+        return [ImagePlane("gaussian")]
+    return [ImagePlane("file")]
+
+
+def plane_origin(args) -> str:
+    """How the image plane was given, for the report."""
+    for key in ("s_prime", "from_last_vertex", "defocus"):
+        if getattr(args, key, None) not in (None, []):
+            return "--" + key.replace("_", "-")
+    return "--gaussian" if getattr(args, "gaussian", False) else "lens file"
+
+
+# ----------------------------------------------------------------------------- fields
+def add_field_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("fields")
+    g.add_argument("--fields", metavar="F1,F2,...", help=FIELDS_HELP)
+    g.add_argument(
+        "--max-field", type=float, metavar="F", help="Largest field (default: the lens's)."
+    )
+    g.add_argument(
+        "--steps",
+        type=int,
+        default=None,
+        metavar="N",
+        help="Number of equal field steps from 0 to --max-field (default 10).",
+    )
+    g.add_argument(
+        "--field-kind",
+        choices=["angle", "height"],
+        help="What the fields are: 'angle' (deg) or 'height' (object mm). Default: the lens "
+        "file's kind.",
+    )
+
+
+MAX_FIELDS = 100_000
+
+
+def resolve_fields(lens, args) -> tuple[np.ndarray, str]:
+    """(fields, kind) from --fields or --max-field/--steps (default: the lens's field, 10 steps)."""
+    kind = args.field_kind or lens.field.kind
+    if args.fields is not None:
+        if args.max_field is not None or args.steps is not None:
+            raise CliError("give either --fields or --max-field/--steps, not both")
+        return parse_list(args.fields, "--fields"), kind
+    fmax = args.max_field
+    if fmax is None:
+        if kind != lens.field.kind:
+            raise CliError(f"--field-kind {kind} needs --fields or --max-field")
+        fmax = lens.field.value
+    steps = 10 if args.steps is None else args.steps
+    if steps < 1:
+        raise CliError("--steps must be at least 1")
+    if steps > MAX_FIELDS:
+        raise CliError(f"--steps {steps}: at most {MAX_FIELDS} fields per call")
+    if not math.isfinite(fmax):
+        raise CliError("--max-field must be finite")
+    return np.linspace(0.0, fmax, steps + 1), kind
+
+
+def field_keyword(fields: np.ndarray, kind: str) -> dict[str, Any]:
+    """The API keyword for fields of ``kind``: ``fields_deg`` or ``object_heights_mm``."""
+    return {"fields_deg": fields} if kind == "angle" else {"object_heights_mm": fields}
+
+
+# ----------------------------------------------------------------------------- output
+def add_output_args(p: argparse.ArgumentParser, *, csv: bool = True) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--json", action="store_true", help="Print JSON (keys carry units; README).")
+    if csv:
+        g.add_argument("--csv", action="store_true", help="Print CSV.")
+
+
+def add_wavelength_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--wavelength",
+        type=float,
+        metavar="NM",
+        help="Wavelength in nm (default: the lens file's).",
+    )
+
+
+def print_json(obj) -> None:
+    from ..report.jsonout import dumps
+
+    print(dumps(obj))

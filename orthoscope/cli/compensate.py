@@ -1,0 +1,101 @@
+"""``orthoscope compensate``: residual distortion of a print (Pestrecov Section VI)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+
+def _curve_from(arg: str, role: str, args, camera_curve=None):
+    """A DistortionCurve from a CSV table or from a lens (traced)."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from distortion.characteristic import characteristic_distortion
+    from distortion.tablefile import read_distortion_table
+
+    from .common import CliError, load, parse_list
+
+    if Path(arg).suffix.lower() == ".csv":
+        return read_distortion_table(arg)
+    lens = load(arg)
+    if role == "camera":
+        if lens.field.kind != "angle" and not args.fields:
+            raise CliError(f"camera {arg}: give --fields (angles in degrees)")
+        fields = (
+            parse_list(args.fields, "--fields")
+            if args.fields
+            else np.linspace(0.0, lens.field.value, 11)
+        )
+        return characteristic_distortion(lens, fields, object_distance=math.inf).curve(0)
+    # printer: finite conjugates, object heights covering the camera's negative
+    if math.isinf(lens.object_distance):
+        raise CliError(f"printer {arg}: the lens file must define a finite object distance")
+    hmax = float(np.max(np.abs(camera_curve.yp))) * 1.02
+    h = np.linspace(0.0, hmax, 41)
+    return characteristic_distortion(lens, object_heights_mm=h).curve(0)
+
+
+def cmd_compensate(args) -> int:
+    from distortion.compensation import compensate
+
+    from ..report.distortion import compensation_to_dict, format_compensation
+    from .common import print_json
+    from .distortion import at_fields
+
+    cam = _curve_from(args.camera, "camera", args)
+    prn = _curve_from(args.printer, "printer", args, camera_curve=cam)
+    res = compensate(
+        cam, prn, method=args.method, magnification=args.magnification, at=at_fields(args.at)
+    )
+    if args.json:
+        print_json(compensation_to_dict(res))
+    else:
+        print(format_compensation(res))
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from distortion.calibration import METHODS
+
+    from .common import DeprecatedAlias
+
+    q = sub.add_parser(
+        "compensate",
+        help="Residual distortion of a print: camera distortion compensated by a printer.",
+        description=(
+            "Pestrecov Section VI: a camera (object at infinity; F1, D1) and a printer (finite "
+            "conjugates; M2, D2 referred to the negative). Prints the residual "
+            "R = D1 - D2 - (M/M2 - 1) F1 tan(alpha) (Eq. 16) and the print magnification factor M "
+            "chosen by --method. CAMERA and PRINTER are distortion tables (.csv) or lenses "
+            "(files or bundled names; the printer file must define its finite object distance)."
+        ),
+        epilog="Example: orthoscope compensate tests/data/pestrecov_table1.csv printer.csv",
+    )
+    q.add_argument("camera", metavar="CAMERA", help="Camera distortion table (.csv) or lens.")
+    q.add_argument("printer", metavar="PRINTER", help="Printer distortion table (.csv) or lens.")
+    q.add_argument(
+        "--method",
+        default="given",
+        choices=METHODS,
+        help="How M is chosen: 'given' (--magnification, default M2: Pestrecov's condition for "
+        "characteristic curves) or a calibration method over the camera fields.",
+    )
+    q.add_argument(
+        "--criterion", dest="method", choices=METHODS, action=DeprecatedAlias, new="--method",
+        help=argparse.SUPPRESS,
+    )
+    q.add_argument(
+        "--magnification", type=float, metavar="M", help="Print magnification factor M for 'given'."
+    )
+    q.add_argument(
+        "--M", dest="magnification", type=float, action=DeprecatedAlias, new="--magnification",
+        help=argparse.SUPPRESS,
+    )
+    q.add_argument("--at", metavar="A[,B]", help="Field(s) for two-point or zero-at (degrees).")
+    q.add_argument(
+        "--fields", metavar="F1,F2,...", help="Camera field angles (deg) when CAMERA is a lens."
+    )
+    q.add_argument("--json", action="store_true", help="Print JSON.")
+    q.set_defaults(func=cmd_compensate)

@@ -1,0 +1,48 @@
+"""``orthoscope convert IN OUT`` between native .toml, Zemax .zmx and CODE V .seq (read)."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def cmd_convert(args) -> int:
+    import sys
+    import warnings
+
+    from raytrace.files import convert
+    from raytrace.files.library import resolve_lens_path
+    from raytrace.files.text import InteropWarning
+
+    src = resolve_lens_path(args.input)  # a path, or the name of a bundled lens
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", InteropWarning)
+        lens = convert(src, args.output, overwrite=args.force, flag="--force")
+    for w in caught:
+        if issubclass(w.category, InteropWarning):
+            print(f"orthoscope convert: warning: {w.message}", file=sys.stderr)
+    print(f"wrote {args.output}: {lens.name} ({lens.n_surfaces} surfaces)")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser(
+        "convert",
+        help="Convert a lens between .toml, .zmx (read/write) and .seq (read).",
+        description=(
+            "Convert a lens file: IN (.toml, .zmx or .seq, or a bundled lens name) to OUT (.toml "
+            "or .zmx), formats chosen by the suffixes. Numbers are written at full double "
+            "precision, so .toml -> .zmx -> .toml reproduces the lens exactly. OUT is never the "
+            "same file as IN; an existing OUT is replaced only with --force."
+        ),
+        epilog="Example: orthoscope convert cooke-triplet-f4 cooke.zmx",
+    )
+    q.add_argument(
+        "input",
+        metavar="IN",
+        help="Lens to read: a .toml, .zmx or .seq file, or a bundled lens name.",
+    )
+    q.add_argument("output", metavar="OUT", help="Lens file to write (.toml or .zmx).")
+    q.add_argument(
+        "--force", action="store_true", help="Replace an existing OUT (never the input)."
+    )
+    q.set_defaults(func=cmd_convert)

@@ -1,0 +1,39 @@
+"""``orthoscope paraxial``: first-order data of a lens (no numba, no scipy: it starts fast)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import add_object_args, add_wavelength_arg
+
+
+def cmd_paraxial(args) -> int:
+    from raytrace.paraxial import paraxial
+
+    from ..report.paraxial import format_paraxial, paraxial_to_dict
+    from .common import load, print_json, resolve_object
+
+    lens = load(args.lens)
+    od = resolve_object(lens, args)
+    par = paraxial(lens, od, args.wavelength)
+    if args.json:
+        print_json(paraxial_to_dict(lens, par))
+    else:
+        print(format_paraxial(lens, par))
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser(
+        "paraxial",
+        help="First-order data: EFL, BFL, cardinal points, pupils, m_e, Gaussian image.",
+        description="Paraxial (first-order) listing of a lens, Pestrecov's HE0, H'E0', m_e "
+        "(Eq. 6), and for a finite object s, p0, s' and m0 (Eqs. 5, 7). Positions are z from the "
+        "first vertex.",
+        epilog="Example: orthoscope paraxial twinplex-like-55-525 --object-s -55.0009",
+    )
+    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_object_args(q)
+    add_wavelength_arg(q)
+    q.add_argument("--json", action="store_true", help="Print JSON (keys as in the README).")
+    q.set_defaults(func=cmd_paraxial)

@@ -1,0 +1,67 @@
+"""``orthoscope trace``: real chief rays to an image plane."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import (
+    add_field_args,
+    add_object_args,
+    add_output_args,
+    add_plane_args,
+    add_wavelength_arg,
+)
+
+
+def cmd_trace(args) -> int:
+    from raytrace.paraxial import paraxial, plane_z
+    from raytrace.trace import aim
+
+    from ..report.trace import format_trace, image_plane_dict, trace_csv, trace_to_dict
+    from .common import (
+        CliError,
+        load,
+        plane_origin,
+        print_json,
+        resolve_fields,
+        resolve_object,
+        resolve_planes,
+    )
+
+    lens = load(args.lens)
+    od = resolve_object(lens, args)
+    fields, kind = resolve_fields(lens, args)
+    par = paraxial(lens, od, args.wavelength)
+    planes = resolve_planes(lens, args)
+    if len(planes) != 1:
+        raise CliError("trace takes one image plane; 'orthoscope distortion' takes several")
+    z_img = float(plane_z(par, planes)[0])
+    if kind == "height" and par.infinite:
+        raise CliError("object-height fields need a finite object (--object-distance)")
+    cr = aim(lens, fields, kind, od, args.wavelength)
+    plane = image_plane_dict(par, z_img, plane_origin(args))
+    if args.json:
+        print_json(trace_to_dict(lens, par, cr, plane))
+    elif args.csv:
+        print(trace_csv(cr, z_img))
+    else:
+        print(format_trace(lens, par, cr, plane))
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser(
+        "trace",
+        help="Real chief rays: image height, landing angle, real entrance pupil, status.",
+        description="Trace the real chief rays (aimed at the centre of the real stop) and report "
+        "per field the real image height y' on the image plane, the landing angle, the real "
+        "entrance-pupil position (z from the first vertex) and the ray status.",
+        epilog="Example: orthoscope trace topogon-us2031792-fig1 --max-field 50 --steps 10 --json",
+    )
+    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_object_args(q)
+    add_field_args(q)
+    add_plane_args(q)
+    add_wavelength_arg(q)
+    add_output_args(q)
+    q.set_defaults(func=cmd_trace)

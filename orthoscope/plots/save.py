@@ -1,0 +1,36 @@
+"""Saving figures: the format from the file suffix, written atomically through
+:func:`raytrace.files.output.write_atomic` (never onto an input, never over an existing file
+unless asked)."""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+from raytrace.errors import OutputError
+
+FORMATS = (".png", ".svg", ".pdf")
+
+
+def save_figure(
+    fig,
+    path: str | os.PathLike,
+    *,
+    overwrite: bool = False,
+    inputs: Iterable[str | os.PathLike] = (),
+    dpi: int = 150,
+    flag: str = "--force",
+) -> Path:
+    """Render ``fig`` in the format of ``path``'s suffix (.png, .svg, .pdf) and write it."""
+    from raytrace.files.output import check_output, write_atomic
+
+    p = Path(path)
+    fmt = p.suffix.lower()
+    if fmt not in FORMATS:
+        raise OutputError(f"{p}: unsupported plot format {p.suffix!r}; use {', '.join(FORMATS)}")
+    check_output(p, inputs=inputs, overwrite=overwrite, flag=flag)
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt[1:], dpi=dpi, bbox_inches="tight")
+    return write_atomic(p, buf.getvalue(), inputs=inputs, overwrite=overwrite, flag=flag)

@@ -1,0 +1,85 @@
+"""Plain-text tables: one number formatter and one table layout for every command."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def fmt(v: float | None, width: int = 12, prec: int = 4) -> str:
+    """A right-aligned number: ``-`` for None/NaN, ``inf``/``-inf`` for infinities."""
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return f"{'-':>{width}}"
+    if isinstance(v, float) and math.isinf(v):
+        return f"{('inf' if v > 0 else '-inf'):>{width}}"
+    return f"{v:>{width}.{prec}f}"
+
+
+def _cell(v: float, dec: int, signed: bool) -> str:
+    if not math.isfinite(v):
+        return "nan"
+    s = f"{v:+.{dec}f}" if signed else f"{v:.{dec}f}"
+    if signed and float(s) == 0.0:
+        s = f"{0.0:.{dec}f}"
+    return s
+
+
+def format_columns(
+    title: list[str],
+    field_label: str,
+    fields: np.ndarray,
+    quantities: list[tuple[str, np.ndarray, int, bool]],
+    *,
+    layout: str = "rows",
+) -> str:
+    """A table with one line per field (``layout="rows"``, the default of every command) or one
+    column per field and one line per quantity (``layout="paper"``: Pestrecov's Tables I, II, V).
+
+    ``quantities`` items are ``(label, values, decimals, signed)``.
+    """
+    if layout == "auto":  # the old spelling: rows are the one default orientation now
+        layout = "rows"
+    if layout not in ("paper", "rows"):
+        raise ValueError(f"unknown table layout {layout!r}; expected rows or paper")
+    fcells = [f"{v:g}" for v in fields]
+    qcells = [[_cell(float(v), dec, sg) for v in vals] for _, vals, dec, sg in quantities]
+    labels = [field_label] + [q[0] for q in quantities]
+    lw = max(len(s) for s in labels)
+    out = list(title)
+    if layout == "paper":
+        cw = max([len(c) for c in fcells] + [len(c) for row in qcells for c in row]) + 2
+        out.append(labels[0].ljust(lw) + "".join(c.rjust(cw) for c in fcells))
+        out.append("-" * (lw + cw * len(fcells)))
+        for lab, row in zip(labels[1:], qcells, strict=True):
+            out.append(lab.ljust(lw) + "".join(c.rjust(cw) for c in row))
+    else:
+        widths = [max(len(labels[0]), *(len(c) for c in fcells))] + [
+            max(len(labels[j + 1]), *(len(c) for c in qcells[j])) for j in range(len(qcells))
+        ]
+        out.append("  ".join(lab.rjust(w) for lab, w in zip(labels, widths, strict=True)))
+        out.append("  ".join("-" * w for w in widths))
+        for i, fc in enumerate(fcells):
+            cells = [fc] + [qcells[j][i] for j in range(len(qcells))]
+            out.append("  ".join(c.rjust(w) for c, w in zip(cells, widths, strict=True)))
+    return "\n".join(out)
+
+
+def csv_text(header: list[str], rows: list[list]) -> str:
+    """CSV text: floats at full precision (``repr``), None/NaN as empty cells."""
+    import csv
+    import io
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for r in rows:
+        w.writerow(
+            [
+                ""
+                if v is None or (isinstance(v, float) and math.isnan(v))
+                else (repr(float(v)) if isinstance(v, (float, np.floating)) else v)
+                for v in r
+            ]
+        )
+    return buf.getvalue().rstrip("\n")

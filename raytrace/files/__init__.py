@@ -1,0 +1,82 @@
+"""Lens files: the native TOML format (:mod:`.native`), Zemax ``.zmx`` (:mod:`.zemax`, read and
+write), CODE V ``.seq`` (:mod:`.codev`, read), the bundled library (:mod:`.library`) and the one
+atomic writer (:mod:`.output`). The format is chosen by the file suffix.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..errors import PrescriptionError
+from ..lens import Lens
+
+READ_SUFFIXES = (".toml", ".zmx", ".seq")
+WRITE_SUFFIXES = (".toml", ".zmx")
+
+
+def read_lens_file(path: str | Path) -> Lens:
+    """Read a lens file of any supported format (by suffix; anything else is read as native
+    TOML). Raises :class:`PrescriptionError`."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".zmx":
+        from .zemax import read_zmx
+
+        return read_zmx(path)
+    if suffix == ".seq":
+        from .codev import read_seq
+
+        return read_seq(path)
+    from .native import read_lens
+
+    return read_lens(path)
+
+
+def _check_suffix(path: str | Path) -> str:
+    suffix = Path(path).suffix.lower()
+    if suffix not in WRITE_SUFFIXES:
+        raise PrescriptionError(
+            f"cannot write {suffix or 'a file without suffix'}: the output must end in "
+            f"{' or '.join(WRITE_SUFFIXES)} (CODE V .seq files can be read, not written)",
+            path=str(path),
+        )
+    return suffix
+
+
+def write_lens_file(lens: Lens, path: str | Path, **options: Any) -> None:
+    """Write ``lens`` in the format of ``path``'s suffix (``.toml`` or ``.zmx``), atomically;
+    ``options`` (``overwrite``, ``inputs``, ``flag``) as in
+    :func:`raytrace.files.output.write_atomic`."""
+    if _check_suffix(path) == ".zmx":
+        from .zemax import write_zmx
+
+        write_zmx(lens, path, **options)
+    else:
+        from .native import write_lens
+
+        write_lens(lens, path, **options)
+
+
+def save_lens(lens: Lens, path: str | Path, *, overwrite: bool = False) -> None:
+    """Save ``lens`` to ``path``: native TOML (``.toml``, full precision, so reading it back gives
+    the same lens) or Zemax ``.zmx``, chosen by the suffix. Written atomically; an existing file
+    is replaced only with ``overwrite=True``, and never when it is the lens's own source file."""
+    inputs = [lens.path] if lens.path else []
+    write_lens_file(lens, path, overwrite=overwrite, inputs=inputs)
+
+
+def convert(in_path: str | Path, out_path: str | Path, *, overwrite: bool = False, **options) -> Lens:
+    """Convert a lens file: IN (.toml, .zmx or .seq) to OUT (.toml or .zmx), formats chosen by
+    the suffixes. Zemax .zmx files may be ASCII or UTF-16 (written: UTF-16, as OpticStudio
+    does); numbers are written at full double precision, so .toml -> .zmx -> .toml reproduces
+    the lens exactly. Commands that cannot be converted stop the conversion with a message naming
+    the file and line; skipped non-optical ones are listed in a warning. OUT is never the same
+    file as IN, and an existing OUT is replaced only with ``overwrite``.
+    Returns the lens that was written."""
+    from .output import check_output
+
+    _check_suffix(out_path)
+    check_output(out_path, inputs=[in_path], overwrite=overwrite, **options)
+    lens = read_lens_file(in_path)
+    write_lens_file(lens, out_path, inputs=[in_path], overwrite=overwrite, **options)
+    return lens

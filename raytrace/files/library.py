@@ -1,0 +1,136 @@
+"""The bundled lens library: the prescription files in the repository's ``lenses/`` directory,
+installed as the package ``orthoscope_lenses``.
+
+``load_lens("topogon-us2031792-fig1")`` loads a bundled lens by name (with or without ``.toml``);
+any existing file path is read as it is. ``list_lenses()`` summarises the library.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib.resources
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import LensError, PrescriptionError
+from ..lens import Field, Lens
+from .native import provenance
+
+PACKAGE = "orthoscope_lenses"
+
+
+@dataclass(frozen=True)
+class LensInfo:
+    """One bundled lens.
+
+    name:      the library name (file stem), what ``load_lens`` takes.
+    title:     the lens's own ``name`` field.
+    path:      the file.
+    efl:       paraxial equivalent focal length, mm (at the lens's wavelength).
+    fnumber:   infinite-conjugate f-number (EFL / EPD), None for an NA aperture.
+    field:     the lens's field (``kind`` "angle" in degrees or "height" in mm).
+    source:    provenance text (the patent or publication).
+    kind:      "patent" | "derived" | "rescaled" (None if the file gives none).
+    """
+
+    name: str
+    title: str
+    path: Path
+    efl: float
+    fnumber: float | None
+    field: Field
+    source: str
+    kind: str | None
+
+
+def library_dir() -> Path:
+    """Directory holding the bundled prescription files."""
+    return Path(str(importlib.resources.files(PACKAGE)))
+
+
+def bundled_names() -> list[str]:
+    """Names of the bundled lenses (file stems), sorted."""
+    return sorted(p.stem for p in library_dir().glob("*.toml"))
+
+
+def _suggestions(query: str, names: list[str]) -> list[str]:
+    """Bundled names that start with / contain the query, else the closest by spelling (whole
+    name, its leading part, or one of its dash-separated words)."""
+    q = Path(query).name.lower().removesuffix(".toml")
+    hits = [n for n in names if n.startswith(q) or (len(q) >= 3 and q in n)]
+    if hits or not q:
+        return hits
+
+    def score(n: str) -> float:
+        parts = [n, n[: len(q)], *n.split("-")]
+        return max(difflib.SequenceMatcher(None, q, x).ratio() for x in parts)
+
+    scored = sorted(((score(n), n) for n in names), reverse=True)
+    return [n for s, n in scored if s >= 0.75][:3]
+
+
+def resolve_lens_path(name_or_path: str | Path) -> Path:
+    """The file for ``name_or_path``: an existing file path wins; otherwise a bundled lens name,
+    with or without ``.toml``. Raises :class:`PrescriptionError` listing the bundled names."""
+    p = Path(name_or_path)
+    if p.is_file():
+        return p
+    if p.is_dir():
+        raise PrescriptionError("is a directory, not a lens file", path=str(p))
+    names = bundled_names()
+    key = str(name_or_path)
+    stem = key.removesuffix(".toml")
+    if stem in names:
+        return library_dir() / f"{stem}.toml"
+    sugg = _suggestions(key, names)
+    did = f" (did you mean {', '.join(repr(s) for s in sugg)}?)" if sugg else ""
+    raise PrescriptionError(
+        f"no such file or bundled lens{did}; bundled lenses: {', '.join(names)}", path=key
+    )
+
+
+def load_lens(name_or_path: str | Path) -> Lens:
+    """Load a lens: a bundled lens by name (``"topogon-us2031792-fig1"``, with or without
+    ``.toml``; see ``orthoscope lenses``) or a file path (``.toml``, Zemax ``.zmx``, CODE V
+    ``.seq``, chosen by suffix). An existing file path wins over a bundled name.
+
+    Raises :class:`~raytrace.errors.PrescriptionError` naming the file, line and surface for a
+    broken file, or listing the bundled names (with "did you mean") for an unknown one."""
+    from . import read_lens_file
+
+    return read_lens_file(resolve_lens_path(name_or_path))
+
+
+def lens_info(lens: Lens, name: str | None = None) -> LensInfo:
+    """Summary of ``lens`` (paraxial EFL and f-number at its own wavelength)."""
+    from ..paraxial import paraxial
+
+    try:
+        par = paraxial(lens)
+        efl = float(par.efl)
+        epd = float(par.epd)
+    except LensError:
+        efl, epd = math.nan, math.nan
+    if lens.aperture.kind == "fnumber":
+        fno: float | None = lens.aperture.value
+    elif lens.aperture.kind == "epd" and epd > 0:
+        fno = abs(efl) / epd
+    else:
+        fno = None
+    path = Path(lens.path) if lens.path else Path()
+    return LensInfo(
+        name=name if name is not None else (path.stem or lens.name),
+        title=lens.name,
+        path=path,
+        efl=efl,
+        fnumber=fno,
+        field=lens.field,
+        source=lens.source,
+        kind=provenance(lens),
+    )
+
+
+def list_lenses() -> list[LensInfo]:
+    """All bundled lenses, sorted by name."""
+    return [lens_info(load_lens(n), n) for n in bundled_names()]

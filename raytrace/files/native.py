@@ -1,0 +1,946 @@
+"""Lens prescription files: TOML, one surface per line, read into a validated :class:`Lens`.
+
+The format (documented for users in ``lenses/README.md``)::
+
+    name       = "Cooke triplet 50 mm f/4"
+    source     = "where the numbers come from"
+    provenance = "patent"            # optional: "patent" | "derived" | "rescaled"
+    notes      = "free text"         # optional
+    units      = "mm"                # only "mm"
+    wavelength = 587.5618            # nm, optional (default: the helium d line)
+    # scale_to_efl = 100.0           # optional: scale the whole lens to this paraxial EFL (mm)
+    object   = { distance = "inf" }  # mm from the object plane to the first vertex (> 0), or "inf"
+    aperture = { fnumber = 4.0 }     # exactly one of fnumber / epd (mm) / na
+    field    = { angle = 20.0 }      # exactly one of angle (max half-field, deg) / height (mm)
+    surfaces = [
+      { r = 21.25,   t = 2.0,  glass = "1.62041/60.32" },
+      { r = -158.65, t = 6.0 },
+      ...
+      { r = -17.285, t = "gaussian" },
+    ]
+
+Per surface: ``r`` (radius, mm, ``"inf"`` = plane; positive when the centre of curvature lies
+after the vertex) or ``c`` (curvature, 1/mm); ``t`` (mm to the next vertex; for the last surface
+to the image plane, or ``"gaussian"`` to solve it to the paraxial image of the file's object);
+the medium after the surface: ``glass = "nd/vd"`` (model glass), ``n = 1.5`` (fixed index) or
+nothing / ``glass = "air"``; ``sd`` (semi-diameter, mm); ``stop = true``; ``k`` (conic);
+``asph = [A4, A6, ...]``; ``label``. ``[object]`` may also carry ``glass`` / ``n`` for an
+immersed object space.
+
+The provenance is kept as the first line of ``Lens.notes`` (``"provenance: patent"``), so that it
+survives :func:`dumps` / :func:`loads`; :func:`provenance` reads it back.
+
+Every problem raises :class:`~raytrace.errors.PrescriptionError` naming the file, the line and,
+where it applies, the surface (1-based).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import tomllib
+
+from ..errors import LensError, PrescriptionError
+from ..lens import Aperture, Field, Lens, Surface
+from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
+from .output import write_atomic
+from .text import decode_text, read_bytes
+
+WHAT = "a TOML lens prescription"
+
+PROVENANCES = ("patent", "derived", "rescaled")
+
+# Canonical key -> accepted spellings (the first is the one the writer uses).
+_SURFACE_KEYS: dict[str, tuple[str, ...]] = {
+    "r": ("r", "radius"),
+    "c": ("c", "curvature"),
+    "t": ("t", "thickness"),
+    "glass": ("glass", "material"),
+    "catalog": ("catalog",),
+    "model": ("model",),
+    "n": ("n", "index"),
+    "sd": ("sd", "semi_diameter"),
+    "k": ("k", "conic"),
+    "asph": ("asph", "aspheric"),
+    "stop": ("stop",),
+    "label": ("label",),
+}
+_TOP_KEYS = (
+    "name",
+    "source",
+    "provenance",
+    "notes",
+    "units",
+    "wavelength",
+    "scale_to_efl",
+    "object",
+    "aperture",
+    "field",
+    "surfaces",
+)
+_OBJECT_KEYS = ("distance", "glass", "catalog", "model", "n")
+_APERTURE_KEYS = ("fnumber", "epd", "na")
+_FIELD_KEYS = ("angle", "height")
+
+_PROVENANCE_RE = re.compile(r"provenance: (patent|derived|rescaled)(\n|$)")
+
+
+# --------------------------------------------------------------------------------------------
+# Locating things in the raw text (tomllib gives no positions for values)
+# --------------------------------------------------------------------------------------------
+
+
+class _Source:
+    """The raw text of a file plus helpers that find the line of a key, table or surface."""
+
+    def __init__(self, text: str, path: str | None) -> None:
+        self.text = text
+        self.path = path
+        self.lines = text.splitlines()
+        self.surface_lines = _surface_lines(text)
+
+    def error(
+        self, message: str, line: int | None = None, surface: int | None = None
+    ) -> PrescriptionError:
+        return PrescriptionError(message, path=self.path, line=line, surface=surface)
+
+    @property
+    def last_line(self) -> int:
+        return max(1, len(self.lines))
+
+    def key_line(self, table: str, key: str | None = None) -> int | None:
+        """Line of ``key`` inside ``[table]`` (``table=""`` for the root); falls back to the
+        table header, then to a root ``table = {...}`` line. None when nothing matches."""
+        current = ""
+        header_line = None
+        key_re = re.compile(r"^\s*" + re.escape(key) + r"\s*=") if key else None
+        for i, raw in enumerate(self.lines, start=1):
+            m = re.match(r"^\s*\[\[?\s*([A-Za-z0-9_.\-\"' ]+?)\s*\]\]?\s*(#.*)?$", raw)
+            if m:
+                current = m.group(1).strip()
+                if current == table:
+                    header_line = i
+                continue
+            if key_re is not None and current == table and key_re.match(raw):
+                return i
+        if header_line is not None:
+            return header_line
+        if table:
+            return self.key_line("", table)
+        return None
+
+    def surface_line(self, i: int) -> int | None:
+        """Line of the 0-based surface ``i``."""
+        if len(self.surface_lines) > i:
+            return self.surface_lines[i]
+        return self.key_line("", "surfaces")
+
+
+def _surface_lines(text: str) -> list[int]:
+    """1-based line of each surface: each ``{`` opening an inline table directly inside the
+    ``surfaces = [ ... ]`` array (strings and comments skipped), or each ``[[surfaces]]`` header."""
+    m = re.search(r"(?m)^[ \t]*surfaces[ \t]*=[ \t]*\[", text)
+    if m is None:
+        return [
+            text.count("\n", 0, h.start()) + 1
+            for h in re.finditer(r"(?m)^[ \t]*\[\[[ \t]*surfaces[ \t]*\]\]", text)
+        ]
+    out: list[int] = []
+    line = text.count("\n", 0, m.end()) + 1
+    i, n = m.end(), len(text)
+    brackets, braces = 1, 0
+    while i < n and brackets > 0:
+        ch = text[i]
+        if ch == "\n":
+            line += 1
+        elif ch == "#":
+            j = text.find("\n", i)
+            i = n if j < 0 else j
+            continue
+        elif ch in "\"'":
+            delim = ch * 3 if text.startswith(ch * 3, i) else ch
+            j = i + len(delim)
+            while j < n and not text.startswith(delim, j):
+                if ch == '"' and text[j] == "\\":
+                    j += 1
+                j += 1
+            line += text.count("\n", i, min(j, n))
+            i = j + len(delim)
+            continue
+        elif ch == "[":
+            brackets += 1
+        elif ch == "]":
+            brackets -= 1
+        elif ch == "{":
+            if braces == 0 and brackets == 1:
+                out.append(line)
+            braces += 1
+        elif ch == "}":
+            braces -= 1
+        i += 1
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Value helpers
+# --------------------------------------------------------------------------------------------
+
+
+def _suggest(key: str, allowed: dict[str, tuple[str, ...]]) -> str:
+    names = {alias: canon for canon, aliases in allowed.items() for alias in aliases}
+    close = difflib.get_close_matches(key.lower(), list(names), n=1, cutoff=0.6)
+    if not close:
+        return ""
+    spellings = allowed[names[close[0]]]
+    if len(spellings) > 1:
+        return " (did you mean " + "/".join(f"'{s}'" for s in reversed(spellings)) + "?)"
+    return f" (did you mean '{spellings[0]}'?)"
+
+
+def _check_keys(
+    src: _Source,
+    table: dict[str, Any],
+    allowed: dict[str, tuple[str, ...]],
+    where: str,
+    line: int | None | Callable[[str], int | None],
+    surface: int | None = None,
+) -> None:
+    """Reject keys not in ``allowed`` with a "did you mean" (``line`` may be a function of the
+    key)."""
+    flat = {a for aliases in allowed.values() for a in aliases}
+    for key in table:
+        if key not in flat:
+            sugg = _suggest(key, allowed)
+            if not sugg and key in _TOP_KEYS and where.startswith("["):
+                sugg = (
+                    f" ('{key}' belongs at the top of the file: top-level keys and the surfaces "
+                    "array must come before the first [table] header)"
+                )
+            known = ", ".join(sorted({a for aliases in allowed.values() for a in aliases}))
+            raise src.error(
+                f"unknown key '{key}' in {where}{sugg}; known keys: {known}",
+                line=line(key) if callable(line) else line,
+                surface=surface,
+            )
+
+
+def _one_of(
+    src: _Source,
+    table: dict[str, Any],
+    canon: str,
+    allowed: dict[str, tuple[str, ...]],
+    line: int | None,
+    surface: int | None = None,
+) -> Any:
+    """The value under any spelling of ``canon`` (None if absent); error if given twice."""
+    given = [a for a in allowed[canon] if a in table]
+    if len(given) > 1:
+        raise src.error(
+            f"'{given[0]}' and '{given[1]}' are the same key: give only one", line, surface
+        )
+    return table[given[0]] if given else None
+
+
+def _number(
+    src: _Source,
+    value: Any,
+    what: str,
+    line: int | None,
+    surface: int | None = None,
+    allow_inf: bool = False,
+) -> float:
+    """A finite float (or +inf when ``allow_inf`` and the value is ``"inf"`` / ``inf``)."""
+    if isinstance(value, str) and allow_inf and value.strip().lower() in ("inf", "infinity"):
+        return math.inf
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        expect = 'a number or "inf"' if allow_inf else "a number"
+        raise src.error(f"{what} must be {expect}, got {value!r}", line, surface)
+    v = float(value)
+    if math.isnan(v) or (math.isinf(v) and not (allow_inf and v > 0)):
+        raise src.error(f"{what} must be a finite number, got {value!r}", line, surface)
+    return v
+
+
+def _material(
+    src: _Source,
+    glass: Any,
+    n: Any,
+    line: int | None,
+    surface: int | None = None,
+    catalog: Any = None,
+    model: Any = None,
+) -> Material:
+    if glass is not None and n is not None:
+        raise src.error('give either glass = "..." or n = <index>, not both', line, surface)
+    if catalog is not None and not isinstance(catalog, str):
+        raise src.error(f"catalog must be a string, got {catalog!r}", line, surface)
+    if model is not None and not isinstance(model, str):
+        raise src.error(f"model must be a string, got {model!r}", line, surface)
+    if n is not None:
+        v = _number(src, n, "n (fixed refractive index)", line, surface)
+        if v < 1.0:
+            raise src.error(f"n (fixed refractive index) must be >= 1, got {v!r}", line, surface)
+        return fixed_index(v)
+    if glass is None:
+        return AIR
+    help_ = (
+        'use a catalog name (e.g. "N-BK7", optionally with catalog = "Schott"), "nd/vd" '
+        '(e.g. "1.5168/64.17"), "air", or n = <index> for a fixed index'
+    )
+    if not isinstance(glass, str):
+        raise src.error(f"glass must be a string, got {glass!r}: {help_}", line, surface)
+    text = glass.strip()
+    if text.lower() == "air":
+        return AIR
+    parts = text.split("/")
+    if len(parts) == 2:
+        try:
+            nd, vd = float(parts[0]), float(parts[1])
+        except ValueError:
+            nd = vd = math.nan
+        if math.isfinite(nd) and math.isfinite(vd):
+            if nd < 1.0 or vd <= 0.0:
+                raise src.error(
+                    f"glass {glass!r}: nd must be >= 1 and vd > 0 (got nd={nd!r}, vd={vd!r})",
+                    line,
+                    surface,
+                )
+            if model is None:
+                return model_glass(nd, vd)
+            try:
+                return Material("model", nd, vd, model=model)
+            except ValueError as e:
+                raise src.error(f"glass {glass!r}: {e}", line, surface) from None
+    if model is not None:
+        raise src.error(f"model = {model!r} applies to an nd/vd model glass only", line, surface)
+    from ..glass import lookup_glass
+
+    try:
+        g = lookup_glass(text, [catalog] if catalog else None, first_catalog_wins=bool(catalog))
+    except PrescriptionError as e:
+        raise src.error(e.reason, line, surface) from None
+    if catalog and g.catalog.lower() != catalog.strip().lower():
+        raise src.error(
+            f"glass {text!r} is not in the {catalog} catalog (found in {g.catalog})", line, surface
+        )
+    return g.material
+
+
+def _string(src: _Source, data: dict[str, Any], key: str, default: str | None) -> str | None:
+    v = data.get(key, default)
+    if v is not None and not isinstance(v, str):
+        raise src.error(f"{key} must be a string, got {v!r}", src.key_line("", key))
+    return v
+
+
+def _table(src: _Source, data: dict[str, Any], key: str) -> dict[str, Any] | None:
+    v = data.get(key)
+    if v is not None and not isinstance(v, dict):
+        raise src.error(
+            f"{key} must be a table, e.g. [{key}] or {key} = {{ ... }}", src.key_line("", key)
+        )
+    return v
+
+
+# --------------------------------------------------------------------------------------------
+# Reading
+# --------------------------------------------------------------------------------------------
+
+
+def read_lens(path: str | Path) -> Lens:
+    """Read a prescription file (see the module docstring) into a validated :class:`Lens`."""
+    return loads(read_bytes(path), path=str(path))
+
+
+def loads(text: str | bytes, *, path: str | Path | None = None) -> Lens:
+    """Parse prescription text into a validated :class:`Lens` (``path`` is used in messages and
+    stored in ``Lens.path``; the default name is its stem)."""
+    spath = None if path is None else str(path)
+    if isinstance(text, bytes):
+        text = decode_text(text, spath, WHAT, latin1=False)
+    src = _Source(text, spath)
+    if not text.strip():
+        raise src.error("the file is empty: expected a TOML lens prescription", line=1)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        msg = str(e)
+        m = re.search(r"at line (\d+)", msg)
+        line = int(m.group(1)) if m else None
+        if "inline table" in msg or "key part" in msg:
+            msg += " (each surface is an inline table { key = value, ... } on ONE line)"
+        raise src.error(f"TOML syntax error: {msg}", line=line) from None
+    if not data:
+        raise src.error("the file holds no prescription (only comments or blank lines)", line=1)
+    return _build(src, data)
+
+
+def _build(src: _Source, data: dict[str, Any]) -> Lens:
+    top = {k: (k,) for k in _TOP_KEYS}
+    _check_keys(src, data, top, "the file", lambda k: src.key_line("", k))
+    name = _string(src, data, "name", None)
+    if name is None:
+        name = Path(src.path).stem if src.path else "lens"
+    source = _string(src, data, "source", "") or ""
+    notes = _string(src, data, "notes", None)
+    prov = _string(src, data, "provenance", None)
+    if prov is not None and prov not in PROVENANCES:
+        raise src.error(
+            f"provenance must be one of {', '.join(PROVENANCES)}, got {prov!r}",
+            src.key_line("", "provenance"),
+        )
+    units = _string(src, data, "units", "mm")
+    if units != "mm":
+        raise src.error(
+            f'units must be "mm" (the only unit supported), got {units!r}',
+            src.key_line("", "units"),
+        )
+    wavelength = LAMBDA_D
+    if "wavelength" in data:
+        wavelength = _number(
+            src, data["wavelength"], "wavelength (nm)", src.key_line("", "wavelength")
+        )
+    scale_to = None
+    if "scale_to_efl" in data:
+        line = src.key_line("", "scale_to_efl")
+        scale_to = _number(src, data["scale_to_efl"], "scale_to_efl (mm)", line)
+        if scale_to <= 0.0:
+            raise src.error(f"scale_to_efl must be positive, got {scale_to!r}", line)
+        if prov is None:
+            prov = "rescaled"
+        elif prov == "patent":
+            raise src.error(
+                "a lens scaled with scale_to_efl is no longer the patent's numbers: "
+                'use provenance = "rescaled"',
+                src.key_line("", "provenance"),
+            )
+
+    # [object]
+    object_distance, object_material = math.inf, AIR
+    obj = _table(src, data, "object")
+    if obj is not None:
+        _check_keys(
+            src,
+            obj,
+            {k: (k,) for k in _OBJECT_KEYS},
+            "[object]",
+            lambda k: src.key_line("object", k),
+        )
+        if "distance" in obj:
+            line = src.key_line("object", "distance")
+            object_distance = _number(
+                src, obj["distance"], "object distance (mm)", line, allow_inf=True
+            )
+            if object_distance <= 0.0:
+                raise src.error(
+                    "object distance must be positive (a magnitude from the object plane to the "
+                    f'first vertex) or "inf", got {object_distance!r}',
+                    line,
+                )
+        object_material = _material(
+            src,
+            obj.get("glass"),
+            obj.get("n"),
+            src.key_line("object", "glass"),
+            catalog=obj.get("catalog"),
+            model=obj.get("model"),
+        )
+
+    aperture = _choice(src, data, "aperture", _APERTURE_KEYS, Aperture)
+    fld = _choice(src, data, "field", _FIELD_KEYS, Field)
+
+    surfaces = _surfaces(src, data)
+
+    lens_notes = notes
+    if prov is not None:
+        lens_notes = f"provenance: {prov}" + ("" if notes is None else "\n" + notes)
+    lens_notes = lens_notes or ""
+
+    last_t = surfaces[-1].thickness
+    solve = "gaussian" if isinstance(last_t, str) else None
+    if solve:
+        surfaces[-1] = replace(surfaces[-1], thickness=0.0)
+    lens = _make_lens(
+        src,
+        name=name,
+        surfaces=tuple(surfaces),
+        aperture=aperture,
+        field=fld,
+        object_distance=object_distance,
+        wavelength=wavelength,
+        source=source,
+        notes=lens_notes,
+        units="mm",
+        object_material=object_material,
+        path=src.path,
+    )
+    if solve:
+        lens = _solve_gaussian(src, lens)
+    if scale_to is not None:
+        lens = _scale_to_efl(src, lens, scale_to)
+    return lens
+
+
+def _choice(src: _Source, data: dict[str, Any], table: str, keys: tuple[str, ...], cls: type):
+    """The single ``kind = value`` entry of [aperture] / [field]."""
+    t = _table(src, data, table)
+    wanted = " / ".join(keys)
+    if t is None:
+        raise src.error(
+            f"missing [{table}] table: give exactly one of {wanted}", line=src.last_line
+        )
+    _check_keys(src, t, {k: (k,) for k in keys}, f"[{table}]", lambda k: src.key_line(table, k))
+    given = [k for k in keys if k in t]
+    if len(given) != 1:
+        got = ", ".join(given) if given else "none"
+        raise src.error(
+            f"[{table}] needs exactly one of {wanted} (got: {got})", line=src.key_line(table)
+        )
+    kind = given[0]
+    line = src.key_line(table, kind)
+    value = _number(src, t[kind], f"{table} {kind}", line)
+    if value < 0.0 or (value == 0.0 and table == "aperture"):
+        raise src.error(f"{table} {kind} must be positive, got {value!r}", line)
+    if kind == "angle" and value >= 90.0:
+        raise src.error(f"field angle must be below 90 degrees, got {value!r}", line)
+    return cls(kind, value)
+
+
+def _surfaces(src: _Source, data: dict[str, Any]) -> list[Surface]:
+    raw = data.get("surfaces")
+    if raw is None:
+        raise src.error(
+            "missing surfaces = [ ... ] (one inline table per surface; it must come before "
+            "the first [table] header)",
+            line=src.last_line,
+        )
+    sline = src.key_line("", "surfaces")
+    if not isinstance(raw, list) or not raw:
+        raise src.error("surfaces must be a non-empty array of { ... } tables", sline)
+    out: list[Surface] = []
+    n = len(raw)
+    for i, entry in enumerate(raw):
+        no = i + 1
+        line = src.surface_line(i)
+        if not isinstance(entry, dict):
+            raise src.error(f"each surface must be a {{ ... }} table, got {entry!r}", line, no)
+        out.append(_surface(src, entry, line, no, last=(i == n - 1)))
+
+    stops = [i for i, s in enumerate(out) if s.stop]
+    if not stops:
+        raise src.error("no surface is the aperture stop: add stop = true to one surface", sline)
+    if len(stops) > 1:
+        listed = " and ".join(str(i + 1) for i in stops)
+        raise src.error(
+            f"two or more stops (surfaces {listed}): exactly one surface may have stop = true",
+            src.surface_line(stops[1]),
+            stops[1] + 1,
+        )
+    _check_edges(src, out)
+    return out
+
+
+def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: bool) -> Surface:
+    K = _SURFACE_KEYS
+    _check_keys(src, e, K, "surface", line, no)
+    r = _one_of(src, e, "r", K, line, no)
+    c = _one_of(src, e, "c", K, line, no)
+    if r is not None and c is not None:
+        raise src.error("give either r (radius) or c (curvature), not both", line, no)
+    if r is None and c is None:
+        raise src.error(
+            'missing radius: give r (radius in mm, "inf" for a plane) or c (curvature, 1/mm)',
+            line,
+            no,
+        )
+    if r is not None:
+        rv = _number(src, r, "r (radius, mm)", line, no, allow_inf=True)
+        if rv == 0.0:
+            raise src.error('r = 0 is not a surface (use r = "inf" for a plane)', line, no)
+        curvature = 0.0 if math.isinf(rv) else 1.0 / rv
+    else:
+        curvature = _number(src, c, "c (curvature, 1/mm)", line, no)
+
+    material = _material(
+        src,
+        _one_of(src, e, "glass", K, line, no),
+        _one_of(src, e, "n", K, line, no),
+        line,
+        no,
+        catalog=_one_of(src, e, "catalog", K, line, no),
+        model=_one_of(src, e, "model", K, line, no),
+    )
+
+    t = _one_of(src, e, "t", K, line, no)
+    if t is None:
+        what = 'distance to the image plane, or "gaussian"' if last else "to the next vertex"
+        raise src.error(f"missing thickness t (mm, {what})", line, no)
+    thickness: Any
+    if isinstance(t, str) and t.strip().lower() == "gaussian":
+        if not last:
+            raise src.error(
+                't = "gaussian" is only allowed on the last surface (it solves the image distance)',
+                line,
+                no,
+            )
+        thickness = "gaussian"
+    else:
+        thickness = _number(src, t, "t (thickness, mm)", line, no)
+        if last:
+            if thickness < 0.0:
+                raise src.error(
+                    f"the image distance (t of the last surface) must be >= 0, got {thickness!r}",
+                    line,
+                    no,
+                )
+        elif not material.is_air and thickness <= 0.0:
+            raise src.error(f"glass thickness must be positive, got t = {thickness!r}", line, no)
+        elif thickness < 0.0:
+            raise src.error(f"air thickness must not be negative, got t = {thickness!r}", line, no)
+
+    sd = math.inf
+    sdv = _one_of(src, e, "sd", K, line, no)
+    if sdv is not None:
+        sd = _number(src, sdv, "sd (semi-diameter, mm)", line, no, allow_inf=True)
+        if sd <= 0.0:
+            raise src.error(f"sd (semi-diameter) must be positive, got {sd!r}", line, no)
+
+    conic = 0.0
+    kv = _one_of(src, e, "k", K, line, no)
+    if kv is not None:
+        conic = _number(src, kv, "k (conic constant)", line, no)
+
+    asph: tuple[float, ...] = ()
+    av = _one_of(src, e, "asph", K, line, no)
+    if av is not None:
+        if not isinstance(av, list):
+            raise src.error(f"asph must be a list [A4, A6, ...], got {av!r}", line, no)
+        asph = tuple(
+            _number(src, a, f"asph[{j}] (A{4 + 2 * j})", line, no) for j, a in enumerate(av)
+        )
+
+    stop = e.get("stop", False)
+    if not isinstance(stop, bool):
+        raise src.error(f"stop must be true or false, got {stop!r}", line, no)
+    label = e.get("label", "")
+    if not isinstance(label, str):
+        raise src.error(f"label must be a string, got {label!r}", line, no)
+
+    if math.isfinite(sd) and math.isnan(float(_sag(curvature, conic, asph, sd))):
+        raise src.error(
+            f"sd = {sd!r} is larger than the surface allows (|r| = {abs(1.0 / curvature)!r})",
+            line,
+            no,
+        )
+    return Surface(
+        curvature=curvature,
+        thickness=thickness,  # type: ignore[arg-type]  ("gaussian" is resolved by the caller)
+        material=material,
+        semi_diameter=sd,
+        stop=stop,
+        conic=conic,
+        aspheric=asph,
+        label=label,
+        line=line,
+    )
+
+
+def _sag(c: float, k: float, asph: tuple[float, ...], r: np.ndarray | float) -> np.ndarray:
+    return Surface(c, 0.0, conic=k, aspheric=asph).sag(r)
+
+
+def _check_edges(src: _Source, surfaces: list[Surface]) -> None:
+    """Consecutive surfaces with given semi-diameters must not cross inside them."""
+    for i in range(len(surfaces) - 1):
+        a, b = surfaces[i], surfaces[i + 1]
+        if not (math.isfinite(a.semi_diameter) and math.isfinite(b.semi_diameter)):
+            continue
+        h = np.linspace(0.0, min(a.semi_diameter, b.semi_diameter), 33)
+        gap = a.thickness + b.sag(h) - a.sag(h)
+        j = int(np.argmin(gap))
+        if gap[j] < 0.0:
+            raise src.error(
+                f"surfaces {i + 1} and {i + 2} cross inside their semi-diameters (axial gap "
+                f"{gap[j]:.6g} mm at height {h[j]:.6g} mm): increase t or reduce sd",
+                src.surface_line(i),
+                i + 1,
+            )
+
+
+def _lens_error(src: _Source, lens_name: str, err: Exception, default_line: int | None):
+    msg = str(err)
+    if msg.startswith(lens_name + ": "):
+        msg = msg[len(lens_name) + 2 :]
+    m = re.match(r"surface (\d+): ", msg)
+    if m:
+        no = int(m.group(1))
+        return src.error(msg[m.end() :], src.surface_line(no - 1), no)
+    low = msg.lower()
+    for word, (table, key) in {
+        "wavelength": ("", "wavelength"),
+        "aperture": ("aperture", None),
+        "na ": ("aperture", None),
+        "field": ("field", None),
+        "object": ("object", None),
+    }.items():
+        if word in low:
+            line = src.key_line(table, key) if table else src.key_line("", key)
+            if line is not None:
+                return src.error(msg, line)
+    return src.error(msg, default_line)
+
+
+def _make_lens(src: _Source, **kw: Any) -> Lens:
+    try:
+        return Lens(**kw)
+    except (LensError, ValueError) as e:
+        raise _lens_error(src, kw["name"], e, src.key_line("", "surfaces")) from None
+
+
+def _solve_gaussian(src: _Source, lens: Lens) -> Lens:
+    """Put the image plane at the paraxial image of the lens's own object."""
+    from ..paraxial import paraxial
+
+    n = lens.n_surfaces
+    line = src.surface_line(n - 1)
+    provisional = lens.with_image_distance(0.0)
+    try:
+        d = float(paraxial(provisional).gaussian_image_distance)
+    except LensError as e:
+        raise _lens_error(src, lens.name, e, line) from None
+    if not math.isfinite(d):
+        raise src.error(
+            't = "gaussian": the paraxial image is at infinity; give the image distance',
+            line,
+            n,
+        )
+    if d < 0.0:
+        raise src.error(
+            f't = "gaussian": the paraxial image is virtual ({d:.6g} mm before the last '
+            "vertex); give the image distance",
+            line,
+            n,
+        )
+    s = list(lens.surfaces)
+    s[-1] = replace(s[-1], thickness=float(d))
+    return replace(lens, surfaces=tuple(s), image_solve="gaussian")
+
+
+def _scale_to_efl(src: _Source, lens: Lens, target: float) -> Lens:
+    from ..paraxial import paraxial
+
+    line = src.key_line("", "scale_to_efl")
+    try:
+        efl = float(paraxial(lens).efl)
+    except LensError as e:
+        raise _lens_error(src, lens.name, e, line) from None
+    factor = target / efl
+    if not (math.isfinite(factor) and factor > 0.0):
+        raise src.error(
+            f"scale_to_efl: the prescription's EFL is {efl:.6g} mm; it cannot be scaled to "
+            f"{target!r} mm",
+            line,
+        )
+    scaled = lens.scaled(factor)
+    record = (
+        f"scaled by {factor!r} from the prescription's EFL {efl!r} mm to EFL {target!r} mm "
+        "(scale_to_efl)"
+    )
+    scaled = replace(scaled, notes=scaled.notes + "\n" + record if scaled.notes else record)
+    if lens.image_solve == "gaussian":
+        scaled = _solve_gaussian(src, scaled)
+    return scaled
+
+
+def provenance(lens: Lens) -> str | None:
+    """The lens's provenance ("patent", "derived", "rescaled") from the first line of its notes,
+    or None when the file gave none."""
+    m = _PROVENANCE_RE.match(lens.notes)
+    return m.group(1) if m else None
+
+
+# --------------------------------------------------------------------------------------------
+# Writing
+# --------------------------------------------------------------------------------------------
+
+_HEADER = """\
+# orthoscope lens prescription (TOML). Units: mm; wavelength: nm; angles: degrees.
+# Light travels left to right (+z); the first vertex is at z = 0.
+"""
+
+_COLUMNS = """\
+# One surface per line, in the order the light meets them. Columns:
+#   r / c   radius of curvature, mm ("inf" = plane; + when the centre of curvature lies to the
+#           right of the vertex), or c = curvature 1/mm
+#   t       axial thickness to the next vertex, mm; last surface: to the image plane, or
+#           "gaussian" = solved to the paraxial image of the object above
+#   glass   medium after the surface: a catalog name (with catalog = "Schott", ...), or "nd/vd"
+#           model glass; n = fixed index; omitted = air
+#   sd      semi-diameter, mm (omitted = unlimited)
+#   k       conic constant;  asph = [A4, A6, ...] even-asphere coefficients of r^4, r^6, ...
+#   stop    true on the aperture stop (exactly one);  label = optional name
+"""
+
+
+def _toml_str(s: str) -> str:
+    """A TOML string literal for ``s`` (a literal multi-line string for readable notes)."""
+    if (
+        "\n" in s
+        and "'''" not in s
+        and not s.endswith("'")
+        and all(ch in "\n\t" or (ch >= " " and ch != "\x7f") for ch in s)
+    ):
+        return "'''\n" + s + "'''"
+    out = []
+    for ch in s:
+        if ch == "\\":
+            out.append("\\\\")
+        elif ch == '"':
+            out.append('\\"')
+        elif ch == "\n":
+            out.append("\\n")
+        elif ch == "\t":
+            out.append("\\t")
+        elif ch < " " or ch == "\x7f":
+            out.append(f"\\u{ord(ch):04x}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
+def _fnum(x: float) -> str:
+    """Full-precision TOML number (``"inf"`` for +infinity)."""
+    x = float(x)
+    if math.isinf(x) and x > 0:
+        return '"inf"'
+    if not math.isfinite(x):
+        raise ValueError(f"cannot write non-finite number {x!r}")
+    return repr(x)
+
+
+def _radius_cell(c: float) -> tuple[str, str]:
+    """("r", text) with the shortest radius whose reciprocal is exactly ``c``; ("c", text)
+    when no radius reproduces the curvature bit for bit."""
+    c = float(c)
+    if c == 0.0:
+        return "r", '"inf"'
+    r0 = 1.0 / c
+    candidates = [r0]
+    lo = hi = r0
+    for _ in range(8):
+        lo, hi = math.nextafter(lo, -math.inf), math.nextafter(hi, math.inf)
+        candidates += [lo, hi]
+    ok = [r for r in candidates if math.isfinite(r) and 1.0 / r == c]
+    if not ok:
+        return "c", repr(c)
+    best = min(ok, key=lambda r: (len(repr(r)), abs(r - r0)))
+    return "r", repr(best)
+
+
+def _material_cells(m: Material) -> list[tuple[str, str] | None]:
+    """Two cells (aligned columns): the medium, and its catalog or model-glass law if any."""
+    if m.is_air:
+        return [None, None]
+    if m.kind == "index":
+        return [("n", repr(float(m.nd))), None]
+    if m.kind == "catalog":
+        return [("glass", _toml_str(m.name)), ("catalog", _toml_str(m.catalog))]
+    glass = ("glass", '"' + f"{float(m.nd)!r}/{float(m.vd)!r}" + '"')
+    return [glass, ("model", _toml_str(m.model)) if m.model != "cauchy2" else None]
+
+
+def _surface_cells(s: Surface, last: bool, solve: str | None) -> list[tuple[str, str] | None]:
+    t = '"gaussian"' if (last and solve == "gaussian") else _fnum(s.thickness)
+    cells: list[tuple[str, str] | None] = [
+        _radius_cell(s.curvature),
+        ("t", t),
+        *_material_cells(s.material),
+        ("sd", _fnum(s.semi_diameter)) if math.isfinite(s.semi_diameter) else None,
+        ("k", repr(float(s.conic))) if s.conic != 0.0 else None,
+        ("asph", "[" + ", ".join(repr(float(a)) for a in s.aspheric) + "]") if s.aspheric else None,
+        ("stop", "true") if s.stop else None,
+        ("label", _toml_str(s.label)) if s.label else None,
+    ]
+    return cells
+
+
+def dumps(lens: Lens) -> str:
+    """The prescription text of ``lens``: ``loads(dumps(lens)) == lens`` exactly (full float
+    precision, materials, aspheric terms, image solve, provenance and notes)."""
+    if lens.image_solve not in (None, "gaussian"):
+        raise PrescriptionError(f"cannot write image_solve = {lens.image_solve!r}")
+    if lens.units != "mm":
+        raise PrescriptionError(f"cannot write units {lens.units!r} (only mm)")
+    out = [_HEADER]
+    out.append(f"name       = {_toml_str(lens.name)}\n")
+    out.append(f"source     = {_toml_str(lens.source)}\n")
+    notes: str | None = lens.notes
+    m = _PROVENANCE_RE.match(lens.notes)
+    if m:
+        out.append(f'provenance = "{m.group(1)}"\n')
+        notes = lens.notes[m.end() :] if m.group(2) == "\n" else None
+    elif not notes:
+        notes = None
+    if notes is not None:
+        out.append(f"notes      = {_toml_str(notes)}\n")
+    out.append('units      = "mm"\n')
+    out.append(f"wavelength = {_fnum(lens.wavelength)}   # nm\n\n")
+
+    obj = [f"distance = {_fnum(lens.object_distance)}"]
+    obj += [f"{c[0]} = {c[1]}" for c in _material_cells(lens.object_material) if c]
+    out.append(
+        '# object distance: mm from the object plane to the first vertex (positive), or "inf"\n'
+    )
+    out.append(f"object   = {{ {', '.join(obj)} }}\n")
+    ap_help = {"fnumber": "f-number", "epd": "entrance-pupil diameter, mm", "na": "object NA"}
+    out.append(
+        f"aperture = {{ {lens.aperture.kind} = {_fnum(lens.aperture.value)} }}"
+        f"   # {ap_help[lens.aperture.kind]}\n"
+    )
+    fld_help = {"angle": "max half-field angle, degrees", "height": "max object height, mm"}
+    out.append(
+        f"field    = {{ {lens.field.kind} = {_fnum(lens.field.value)} }}"
+        f"   # {fld_help[lens.field.kind]}\n\n"
+    )
+
+    out.append(_COLUMNS)
+    n = lens.n_surfaces
+    rows = [_surface_cells(s, i == n - 1, lens.image_solve) for i, s in enumerate(lens.surfaces)]
+    ncol = len(rows[0])
+    widths = [
+        max((len(f"{c[0]} = {c[1]}") for row in rows if (c := row[j]) is not None), default=0)
+        for j in range(ncol)
+    ]
+    texts = []
+    for row in rows:
+        present = [j for j in range(ncol) if row[j] is not None]
+        parts = []
+        for j in range(ncol):
+            if widths[j] == 0:
+                continue
+            cell = row[j]
+            if cell is None:
+                parts.append(" " * (widths[j] + 1))
+            else:
+                sep = "," if j != present[-1] else ""
+                parts.append(f"{cell[0]} = {cell[1]}{sep}".ljust(widths[j] + 1))
+        texts.append(" ".join(parts).rstrip())
+    width = max(len(t) for t in texts)
+    out.append("surfaces = [\n")
+    for i, t in enumerate(texts, start=1):
+        out.append(f"  {{ {t.ljust(width)} }},  # {i}\n")
+    out.append("]\n")
+    return "".join(out)
+
+
+def write_lens(lens: Lens, path: str | Path, **options: Any) -> None:
+    """Write ``lens`` to ``path`` in the prescription format (UTF-8), atomically; ``options``
+    (``overwrite``, ``inputs``, ``flag``) as in :func:`raytrace.files.output.write_atomic`."""
+    write_atomic(path, dumps(lens), **options)

@@ -1,0 +1,172 @@
+"""What every lens-file reader shares: bytes → text, file reading, number tokens, wavelength
+units, the guarded parse (nothing but :class:`~raytrace.errors.PrescriptionError` leaves a reader),
+and skipped-command warnings."""
+
+from __future__ import annotations
+
+import codecs
+import math
+import re
+import warnings
+from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+
+from ..errors import PrescriptionError
+from ..lens import Lens
+
+
+class InteropWarning(UserWarning):
+    """A lens file held commands orthoscope skipped (listed in the message)."""
+
+
+@dataclass(frozen=True)
+class ImportResult:
+    """A lens read from a foreign format plus the list of things that were skipped or changed
+    (each entry names the line)."""
+
+    lens: Lens
+    warnings: tuple[str, ...] = ()
+
+
+# --------------------------------------------------------------------------------------------
+# Bytes → text
+# --------------------------------------------------------------------------------------------
+
+
+def decode_text(raw: bytes, path: str | None, what: str, *, latin1: bool = True) -> str:
+    """Decode a lens file: UTF-8 (with or without BOM), UTF-16 LE/BE (BOM, or recognised by its
+    NUL bytes, as OpticStudio writes), else Latin-1 (``latin1=False``: invalid UTF-8 is an
+    error, as TOML requires). Binary data raises PrescriptionError."""
+    try:
+        if raw.startswith(codecs.BOM_UTF8):
+            text = raw[3:].decode("utf-8")
+        elif raw.startswith(codecs.BOM_UTF16_LE):
+            text = raw[2:].decode("utf-16-le")
+        elif raw.startswith(codecs.BOM_UTF16_BE):
+            text = raw[2:].decode("utf-16-be")
+        elif b"\x00" in raw:
+            sample = raw[:4096]
+            even = sample[0::2].count(0)
+            odd = sample[1::2].count(0)
+            half = max(1, len(sample) // 2)
+            if odd > 0.4 * half and even < 0.05 * half:
+                text = raw.decode("utf-16-le")
+            elif even > 0.4 * half and odd < 0.05 * half:
+                text = raw.decode("utf-16-be")
+            else:
+                line = raw.count(b"\n", 0, raw.index(b"\x00")) + 1
+                raise PrescriptionError(
+                    f"not a text file (binary data, NUL byte): expected {what}",
+                    path=path,
+                    line=line,
+                )
+        else:
+            try:
+                text = raw.decode("utf-8")
+            except UnicodeDecodeError as e:
+                if not latin1:
+                    line = raw.count(b"\n", 0, e.start) + 1
+                    raise PrescriptionError(
+                        f"not valid UTF-8 text (byte 0x{raw[e.start]:02x} at offset {e.start}): "
+                        f"expected {what}",
+                        path=path,
+                        line=line,
+                    ) from None
+                text = raw.decode("latin-1")
+    except UnicodeDecodeError as e:
+        nl = b"\n\x00" if b"\n\x00" in raw else b"\n"
+        line = raw.count(nl, 0, e.start) + 1
+        raise PrescriptionError(
+            f"cannot decode the file as text ({e.reason} at byte {e.start}): expected {what}",
+            path=path,
+            line=line,
+        ) from None
+    if "\x00" in text:
+        line = text.count("\n", 0, text.index("\x00")) + 1
+        raise PrescriptionError(
+            f"not a text file (NUL character): expected {what}", path=path, line=line
+        )
+    return text
+
+
+def read_bytes(path: str | Path) -> bytes:
+    """Read a file, turning OS errors into PrescriptionError."""
+    p = Path(path)
+    try:
+        return p.read_bytes()
+    except FileNotFoundError:
+        raise PrescriptionError("no such file", path=str(p)) from None
+    except IsADirectoryError:
+        raise PrescriptionError("is a directory, not a lens file", path=str(p)) from None
+    except OSError as e:
+        raise PrescriptionError(f"cannot read: {e.strerror}", path=str(p)) from None
+
+
+def number(tok: str, what: str, err, line: int, *, allow_inf: bool = False) -> float:
+    """Parse a finite float token (``INFINITY``/``INF`` → inf when ``allow_inf``)."""
+    t = tok.strip()
+    if allow_inf and t.upper() in ("INFINITY", "INF", "+INF", "+INFINITY"):
+        return math.inf
+    try:
+        v = float(t)
+    except (ValueError, OverflowError):
+        raise err(f"{what}: expected a number, got {tok[:40]!r}", line) from None
+    if not math.isfinite(v):
+        if allow_inf and v == math.inf:
+            return v
+        raise err(f"{what}: expected a finite number, got {tok[:40]!r}", line)
+    return v
+
+
+def micron_to_nm(tok: str, err, line: int, what: str) -> float:
+    """µm token → nm, by a decimal shift (so that nm → µm text → nm is exact)."""
+    try:
+        d = Decimal(tok.strip())
+    except (InvalidOperation, ValueError):
+        raise err(f"{what}: expected a wavelength in µm, got {tok[:40]!r}", line) from None
+    if not d.is_finite():
+        raise err(f"{what}: expected a finite wavelength in µm, got {tok[:40]!r}", line)
+    try:
+        return float(d.scaleb(3))
+    except (OverflowError, InvalidOperation):
+        raise err(f"{what}: wavelength out of range: {tok[:40]!r}", line) from None
+
+
+def nm_to_micron_text(nm: float) -> str:
+    """nm → µm text by a decimal shift of ``repr`` (inverse of :func:`micron_to_nm`)."""
+    return format(Decimal(repr(float(nm))).scaleb(-3), "f")
+
+
+def guarded_parse(parser, text: str | bytes, path: str | Path | None, what: str) -> ImportResult:
+    """Decode ``text`` if it is bytes and run ``parser(text, path).parse()``, so that nothing but
+    a PrescriptionError (with the file and a line) ever leaves a reader."""
+    spath = None if path is None else str(path)
+    if isinstance(text, bytes):
+        text = decode_text(text, spath, what)
+    try:
+        return parser(text, spath).parse()
+    except PrescriptionError:
+        raise
+    except (ValueError, ArithmeticError, RecursionError, MemoryError) as e:  # pragma: no cover
+        raise PrescriptionError(
+            f"cannot read the file ({type(e).__name__}: {e})", path=spath, line=1
+        ) from None
+
+
+def lens_error(err, e: Exception, surface_lines: list[int], default_line: int | None):
+    """Map a LensError/ValueError from the Lens constructor to ``err(message, line, surface)``,
+    using the surface number in the message to find the line."""
+    msg = str(e)
+    m = re.search(r"surface (\d+): ", msg)
+    if m and 1 <= int(m.group(1)) <= len(surface_lines):
+        no = int(m.group(1))
+        return err(f"invalid lens: {msg[m.end() :]}", surface_lines[no - 1], no)
+    return err(f"invalid lens: {msg}", default_line)
+
+
+def emit_warnings(result: ImportResult, path: str | None) -> Lens:
+    if result.warnings:
+        where = f"{path}: " if path else ""
+        warnings.warn(where + "; ".join(result.warnings), InteropWarning, stacklevel=3)
+    return result.lens

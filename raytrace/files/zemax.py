@@ -1,0 +1,785 @@
+"""Zemax OpticStudio ``.zmx`` files: read (ASCII, UTF-8 or UTF-16) and write.
+
+Reading (:func:`read_zmx`, :func:`loads_zmx`, :func:`parse_zmx`) supports a sequential lens made
+of ``STANDARD`` and ``EVENASPH`` surfaces:
+
+* ``SURF n`` blocks in order; surface 0 is the object, the last one the image, the ones between
+  are the lens. ``CURV`` (curvature, 1/lens unit), ``DISZ`` (thickness to the next vertex;
+  ``INFINITY`` or ≥ 1e10 on surface 0 = object at infinity), ``CONI``, ``STOP``, ``COMM``
+  (label), ``GLAS``, ``DIAM`` (semi-diameter, despite the name: a *fixed* one — solve flag 1 —
+  clips rays; an automatic one — flag 0 — only reports what the rays need and does not clip),
+  ``CLAP 0 r`` (circular aperture, clips at r).
+* ``EVENASPH``: Zemax's sag is ``c r²/(1+√(1−(1+k)c²r²)) + α1 r² + α2 r⁴ + … + α8 r¹⁶`` in lens
+  units (not normalized), with ``PARM i`` = αi. So ``PARM 2`` = A4, ``PARM 3`` = A6, …,
+  ``PARM 8`` = A16. ``PARM 1`` (the r² term) must be 0: orthoscope models r⁴ and higher only.
+* The image surface's ``DISZ`` is irrelevant: the last lens surface's ``DISZ`` is the image
+  distance. A curved image surface is reported and read as flat.
+* ``GLAS``: ``GLAS ___BLANK 1 0 nd vd dPgF …`` (a model glass; fields 4 and 5 after the command
+  are nd and vd; vd = 0 means a non-dispersive index, as in OpticStudio) or a catalog name
+  (``GLAS N-BK7 0 0 1.5 40 …`` — OpticStudio stores placeholder numbers for catalog glasses, so
+  they are NOT used): the name is resolved through :mod:`raytrace.glass`, the ``GCAT`` catalogs
+  first (first one that has it wins, as in OpticStudio). ``GLAS MIRROR`` is refused.
+* Aperture: ``ENPD`` (entrance-pupil diameter), ``FNUM`` (image-space F/#, EFL/EPD for an
+  infinite conjugate = orthoscope's f-number), ``OBNA`` (object-space NA). Field: ``FTYP t``
+  with t = 0 (angle, degrees) or 1 (object height); the field values are ``XFLN``/``YFLN`` (or
+  the older ``XFLD``/``YFLD``), of which the first ``FTYP``-count are used; the lens's field is
+  the largest radial value √(x² + y²). Wavelength: ``WAVM i λ w`` (or ``WAVL λ1 λ2 …``) in µm and
+  ``PWAV i`` (the primary) → nm.
+* ``UNIT MM|CM|IN|M``: lengths are converted to mm.
+
+Solves (``PZUP``, solve fields on ``CURV``/``DISZ``) are ignored: OpticStudio stores the solved
+values, which are read. Display, tolerance, coating and merit-function commands are skipped.
+Other unknown commands are reported in one :class:`InteropWarning`. Anything that would change
+the optics and cannot be modelled (coordinate breaks, tilts/decenters, non-sequential mode,
+mirrors, other surface types, gradient index, the r² term, float-by-stop aperture, image-height
+fields) raises :class:`~raytrace.errors.PrescriptionError` with the file, line and what to do.
+Every problem with the input raises PrescriptionError (never another exception type).
+
+Writing (:func:`dumps_zmx`, :func:`write_zmx`) produces a sequential file OpticStudio reads, with
+every number at full float64 precision (``repr``), model glasses, fixed semi-diameters, and the
+orthoscope fields Zemax has no place for (source, notes, the Gaussian image solve) in
+``NOTE 0 orthoscope.<key>: <json>`` lines, so that native → .zmx → native is exact.
+"""
+
+from __future__ import annotations
+
+import codecs
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import LensError, PrescriptionError
+from ..glass import lookup_glass, parse_glass_code
+from ..lens import Aperture, Field, Lens, Surface
+from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
+from .output import write_atomic
+from .text import (
+    ImportResult,
+    emit_warnings,
+    guarded_parse,
+    lens_error,
+    micron_to_nm,
+    nm_to_micron_text,
+    number,
+    read_bytes,
+)
+
+#: Zemax stores an object at infinity as ``DISZ INFINITY`` and treats ≥ 1e10 as infinite.
+ZEMAX_INFINITY = 1.0e10
+
+_UNITS = {"MM": 1.0, "CM": 10.0, "IN": 25.4, "M": 1000.0, "METER": 1000.0, "METR": 1000.0}
+
+
+# --------------------------------------------------------------------------------------------
+# Reader
+# --------------------------------------------------------------------------------------------
+
+# Commands skipped silently: display, reporting, tolerancing, coating, merit function, solves
+# (the solved value is stored), configuration bookkeeping, non-optical metadata.
+_IGNORED_GLOBAL = set(
+    """VERS PFIL LANG ENVD GFAC RAIM PUSH SDMA ROPD PICB FWGN FWGT VDXN VDYN VCXN VCYN VANN
+    POLS GLRS GSTD NSCD COFN TOL TOLE MOFF BLNK TRAC OPDX HYPR EFLY DMFS OMMA OEMA RCMF AUTH
+    DBDT WWGT WAVN XFIE PUCN TCMM TOTR FLAN WFAN SSOB SGLI ZVDX ZVDY ZVCX ZVCY ZVAN PMAG
+    MAZH TCED""".split()
+)
+_IGNORED_SURFACE = set(
+    """HIDE MIRR SLAB POPS VDSZ FLAP MEMA FIMP COAT PZUP PPAR VPAR VCON EDGE UDAD USAP BLNK
+    TCED OBDC CDCS DCPM THMP""".split()
+)
+_VIGNETTING = {"SQAP", "ELAP", "OBSC", "UDAP", "RBAP", "SPID"}
+_TILTS = {"DECX", "DECY", "TILX", "TILY", "TILZ", "TILT", "SCBD"}
+_SURF_CMDS = (
+    {"TYPE", "CURV", "DISZ", "DIAM", "CONI", "PARM", "GLAS", "STOP", "COMM", "CLAP", "XDAT"}
+    | _IGNORED_SURFACE
+    | _VIGNETTING
+    | _TILTS
+)
+_MAX_WARNINGS = 50
+
+
+@dataclass
+class _ZSurf:
+    number: int
+    line: int
+    type: str = "STANDARD"
+    type_line: int = 0
+    curv: float = 0.0
+    curv_line: int = 0
+    disz: float = 0.0
+    disz_line: int = 0
+    diam: float = 0.0
+    diam_fixed: bool = False
+    diam_line: int = 0
+    clap: float = math.inf
+    coni: float = 0.0
+    parm: dict[int, tuple[float, int]] = field(default_factory=dict)
+    glas: tuple[list[str], int] | None = None
+    stop: bool = False
+    comm: str = ""
+
+
+class _ZmxParser:
+    def __init__(self, text: str, path: str | None) -> None:
+        self.text = text
+        self.path = path
+        self.warnings: list[str] = []
+        self.unknown: dict[str, int] = {}
+
+    def err(self, message: str, line: int | None, surface: int | None = None) -> PrescriptionError:
+        return PrescriptionError(message, path=self.path, line=line or 1, surface=surface)
+
+    def fail(self, message: str, line: int | None) -> PrescriptionError:
+        return self.err(message, line)
+
+    def warn(self, message: str) -> None:
+        if len(self.warnings) < _MAX_WARNINGS:
+            self.warnings.append(message)
+
+    def num(self, args: list[str], i: int, cmd: str, line: int, *, allow_inf=False) -> float:
+        if i >= len(args):
+            raise self.err(f"{cmd} needs a number (field {i + 1} is missing)", line)
+        return number(args[i], cmd, self.fail, line, allow_inf=allow_inf)
+
+    def integer(self, args: list[str], i: int, cmd: str, line: int) -> int:
+        v = self.num(args, i, cmd, line)
+        if v != int(v) or abs(v) > 1e6:
+            raise self.err(f"{cmd}: expected a whole number, got {args[i][:40]!r}", line)
+        return int(v)
+
+    # ------------------------------------------------------------------------------------
+    def parse(self) -> ImportResult:
+        lines = self.text.split("\n")
+        if not self.text.strip():
+            raise self.err("the file is empty: expected a Zemax .zmx lens file", 1)
+        surfaces: list[_ZSurf] = []
+        cur: _ZSurf | None = None
+        h: dict[str, tuple] = {}
+        notes_meta: dict[str, str] = {}
+        plain_notes: list[str] = []
+        xfln: tuple[list[float], int] | None = None
+        yfln: tuple[list[float], int] | None = None
+        wavm: dict[int, tuple[float, int]] = {}
+        wavl: tuple[list[float], int] | None = None
+        gcat: list[str] = []
+        for lineno, raw in enumerate(lines, start=1):
+            s = raw.strip().lstrip("\ufeff")
+            if not s:
+                continue
+            parts = s.split()
+            cmd = parts[0].upper()
+            args = parts[1:]
+            rest = s[len(parts[0]) :].strip()
+            if cmd == "SURF":
+                n = self.integer(args, 0, "SURF", lineno)
+                expected = len(surfaces)
+                if n != expected:
+                    raise self.err(
+                        f"SURF {n} out of order: expected SURF {expected} (surfaces must be "
+                        "numbered 0, 1, 2, ... in order)",
+                        lineno,
+                    )
+                if n > 10000:
+                    raise self.err("more than 10000 surfaces", lineno)
+                cur = _ZSurf(number=n, line=lineno, type_line=lineno)
+                surfaces.append(cur)
+                continue
+            if cmd in _SURF_CMDS:
+                if cur is None:
+                    raise self.err(
+                        f"{cmd} before the first SURF line: surface data must follow a "
+                        "'SURF n' line",
+                        lineno,
+                    )
+                self.surface_command(cur, cmd, args, rest, lineno)
+                continue
+            # ---- global commands
+            if cmd == "MODE":
+                mode = args[0].upper() if args else ""
+                if mode != "SEQ":
+                    raise self.err(
+                        f"MODE {mode or '(none)'}: only sequential lenses (MODE SEQ) can be "
+                        "read; non-sequential files are not supported — export the sequential "
+                        "part of the system from OpticStudio",
+                        lineno,
+                    )
+            elif cmd == "NAME":
+                h["NAME"] = (rest, lineno)
+            elif cmd == "NOTE":
+                text = rest.split(None, 1)[1] if len(rest.split(None, 1)) > 1 else ""
+                if text.startswith("orthoscope.") and ":" in text:
+                    key, _, val = text.partition(":")
+                    notes_meta[key[len("orthoscope.") :].strip()] = val.strip()
+                elif text.strip():
+                    plain_notes.append(text.rstrip())
+            elif cmd == "UNIT":
+                u = args[0].upper() if args else ""
+                if u not in _UNITS:
+                    raise self.err(
+                        f"UNIT {u or '(none)'}: unknown lens unit (MM, CM, IN or M expected)",
+                        lineno,
+                    )
+                h["UNIT"] = (_UNITS[u], lineno)
+            elif cmd in ("ENPD", "FNUM", "OBNA"):
+                h["APER"] = (cmd, self.num(args, 0, cmd, lineno), lineno)
+            elif cmd in ("FLOA", "WFNO", "OBCA", "PWFN"):
+                meaning = {
+                    "FLOA": "float by stop size",
+                    "WFNO": "paraxial working F/#",
+                    "OBCA": "object cone angle",
+                    "PWFN": "paraxial working F/#",
+                }[cmd]
+                raise self.err(
+                    f"{cmd}: aperture type '{meaning}' is not supported; in OpticStudio set the "
+                    "system aperture to Entrance Pupil Diameter (ENPD), Image Space F/# (FNUM) "
+                    "or Object Space NA (OBNA) and save again",
+                    lineno,
+                )
+            elif cmd == "FTYP":
+                ft = self.integer(args, 0, "FTYP", lineno)
+                nf = self.integer(args, 2, "FTYP", lineno) if len(args) > 2 else None
+                nw = self.integer(args, 3, "FTYP", lineno) if len(args) > 3 else None
+                h["FTYP"] = (ft, nf, nw, lineno)
+            elif cmd in ("XFLN", "XFLD"):
+                xfln = ([self.num(args, i, cmd, lineno) for i in range(len(args))], lineno)
+            elif cmd in ("YFLN", "YFLD"):
+                yfln = ([self.num(args, i, cmd, lineno) for i in range(len(args))], lineno)
+            elif cmd == "WAVM":
+                i = self.integer(args, 0, "WAVM", lineno)
+                if len(args) < 2:
+                    raise self.err("WAVM needs 'WAVM index wavelength_um weight'", lineno)
+                wavm[i] = (micron_to_nm(args[1], self.fail, lineno, "WAVM"), lineno)
+            elif cmd == "WAVL":
+                wavl = (
+                    [micron_to_nm(a, self.fail, lineno, "WAVL") for a in args],
+                    lineno,
+                )
+            elif cmd == "PWAV":
+                h["PWAV"] = (self.integer(args, 0, "PWAV", lineno), lineno)
+            elif cmd == "GCAT":
+                gcat = list(args)
+            elif cmd == "MNUM":
+                n = self.integer(args, 0, "MNUM", lineno)
+                if n > 1:
+                    self.warn(
+                        f"line {lineno}: MNUM {n}: a multi-configuration file; only the "
+                        "configuration stored in the surface data is read"
+                    )
+            elif cmd == "CONF":
+                self.warn(f"line {lineno}: CONF: multi-configuration data ignored")
+            elif cmd.startswith("NSO"):
+                raise self.err(
+                    f"{cmd}: non-sequential objects are not supported; orthoscope reads "
+                    "sequential lenses only",
+                    lineno,
+                )
+            elif cmd in _IGNORED_GLOBAL:
+                pass
+            else:
+                self.unknown.setdefault(cmd[:20], lineno)
+        return self.build(surfaces, h, notes_meta, plain_notes, xfln, yfln, wavm, wavl, gcat)
+
+    # ------------------------------------------------------------------------------------
+    def surface_command(self, cur: _ZSurf, cmd: str, args: list[str], rest: str, line: int):
+        no = cur.number
+        if cmd == "TYPE":
+            t = args[0].upper() if args else ""
+            if t in ("STANDARD", "EVENASPH"):
+                cur.type, cur.type_line = t, line
+                return
+            if t == "COORDBRK":
+                raise self.err(
+                    "TYPE COORDBRK: coordinate breaks (tilts and decenters) are not supported; "
+                    "orthoscope models centred lenses only — remove the coordinate breaks (or "
+                    "set them to zero and delete them) in OpticStudio and save again",
+                    line,
+                    no,
+                )
+            hint = ""
+            if "GRIN" in t or "GRAD" in t:
+                hint = " (gradient-index media are not supported)"
+            raise self.err(
+                f"TYPE {t or '(none)'}: unsupported surface type{hint}; orthoscope reads "
+                "STANDARD and EVENASPH surfaces only — convert the surface in OpticStudio (e.g. "
+                "an even asphere without the r² term) or replace it by a standard surface",
+                line,
+                no,
+            )
+        if cmd == "CURV":
+            cur.curv, cur.curv_line = self.num(args, 0, "CURV", line), line
+        elif cmd == "DISZ":
+            cur.disz = self.num(args, 0, "DISZ", line, allow_inf=True)
+            cur.disz_line = line
+            if math.isinf(cur.disz) and cur.number > 0:
+                raise self.err("DISZ INFINITY is only allowed on the object surface", line, no)
+        elif cmd == "DIAM":
+            cur.diam = self.num(args, 0, "DIAM", line)
+            flag = self.integer(args, 1, "DIAM", line) if len(args) > 1 else 0
+            cur.diam_fixed = flag != 0
+            cur.diam_line = line
+        elif cmd == "CLAP":
+            r = self.num(args, 1, "CLAP", line)
+            rmin = self.num(args, 0, "CLAP", line)
+            if rmin != 0.0:
+                self.warn(f"line {line}: CLAP minimum radius {rmin} (annular aperture) ignored")
+            if not r > 0.0:
+                raise self.err(f"CLAP: the aperture radius must be positive, got {r}", line, no)
+            cur.clap = min(cur.clap, r)
+        elif cmd == "CONI":
+            cur.coni = self.num(args, 0, "CONI", line)
+        elif cmd == "PARM":
+            i = self.integer(args, 0, "PARM", line)
+            cur.parm[i] = (self.num(args, 1, "PARM", line), line)
+        elif cmd == "XDAT":
+            i = self.integer(args, 0, "XDAT", line)
+            v = self.num(args, 1, "XDAT", line)
+            if v != 0.0:
+                self.warn(f"line {line}: XDAT {i} {v} (extra data) ignored on a {cur.type} surface")
+        elif cmd == "GLAS":
+            if not args:
+                raise self.err("GLAS needs a glass name", line, no)
+            if args[0].upper() == "MIRROR":
+                raise self.err(
+                    "GLAS MIRROR: mirrors are not supported; orthoscope traces refracting "
+                    "lenses only",
+                    line,
+                    no,
+                )
+            cur.glas = (list(args), line)
+        elif cmd == "STOP":
+            cur.stop = True
+        elif cmd == "COMM":
+            cur.comm = rest
+        elif cmd in _VIGNETTING:
+            self.warn(
+                f"line {line}: {cmd} (a non-circular aperture or obscuration on surface {no}) "
+                "ignored: it can vignette rays but orthoscope does not clip with it"
+            )
+        elif cmd in _TILTS:
+            vals = []
+            for a in args:
+                try:
+                    vals.append(float(a))
+                except ValueError:
+                    pass
+            if any(v != 0.0 for v in vals[1:] if math.isfinite(v)) or (
+                cmd != "SCBD" and any(v != 0.0 for v in vals)
+            ):
+                raise self.err(
+                    f"{cmd}: surface tilts and decenters are not supported; orthoscope models "
+                    "centred lenses only — remove the tilt/decenter in OpticStudio and save again",
+                    line,
+                    no,
+                )
+        # _IGNORED_SURFACE: nothing
+
+    # ------------------------------------------------------------------------------------
+    def material(self, glas: tuple[list[str], int] | None, gcat: list[str], no: int) -> Material:
+        if glas is None:
+            return AIR
+        args, line = glas
+        name = args[0]
+        if name.upper() in ("___BLANK", "MODEL"):
+            if len(args) < 5:
+                raise self.err(
+                    f"GLAS {name}: a model glass needs 'GLAS {name} 1 0 nd vd ...' (nd and vd "
+                    "are the 4th and 5th fields)",
+                    line,
+                    no,
+                )
+            nd = number(args[3], "GLAS nd", self.fail, line)
+            vd = number(args[4], "GLAS vd", self.fail, line)
+            if not (nd > 0.0) or vd < 0.0:
+                raise self.err(f"GLAS {name}: nd must be > 0 and vd >= 0, got {nd}, {vd}", line)
+            return fixed_index(nd) if vd == 0.0 else model_glass(nd, vd)
+        if name.upper() == "AIR":
+            return AIR
+        code = parse_glass_code(name)
+        if code is not None:
+            return code
+        try:
+            g = lookup_glass(name, gcat, first_catalog_wins=True)
+        except PrescriptionError as e:
+            raise self.err(f"GLAS {name}: {e.reason}", line, no) from None
+        return g.material
+
+    def aspheric(self, z: _ZSurf, scale: float) -> tuple[float, ...]:
+        if z.type != "EVENASPH":
+            for i, (v, line) in sorted(z.parm.items()):
+                if v != 0.0:
+                    self.warn(f"line {line}: PARM {i} = {v} ignored on a STANDARD surface")
+            return ()
+        coef: dict[int, float] = {}
+        for i, (v, line) in z.parm.items():
+            if i == 1:
+                if v != 0.0:
+                    raise self.err(
+                        f"EVENASPH PARM 1 (the r² coefficient) = {v!r} is not supported: "
+                        "orthoscope models r⁴ and higher terms only; in OpticStudio absorb the r² "
+                        "term into the radius (re-optimize with PARM 1 = 0) and save again",
+                        line,
+                        z.number,
+                    )
+            elif 2 <= i <= 8:
+                coef[i] = v
+            else:
+                raise self.err(
+                    f"EVENASPH PARM {i}: an even asphere has parameters 1 to 8 (r² to r¹⁶)",
+                    line,
+                    z.number,
+                )
+        n = max([i for i, v in coef.items() if v != 0.0], default=1)
+        return tuple(coef.get(i, 0.0) * scale ** (1 - 2 * i) for i in range(2, n + 1))
+
+    # ------------------------------------------------------------------------------------
+    def build(self, surfaces, h, notes_meta, plain_notes, xfln, yfln, wavm, wavl, gcat):
+        last_line = len(self.text.split("\n"))
+        if len(surfaces) < 3:
+            raise self.err(
+                f"found {len(surfaces)} SURF block(s): a lens needs the object surface (SURF 0), "
+                "at least one lens surface and the image surface",
+                surfaces[-1].line if surfaces else last_line,
+            )
+        scale = h.get("UNIT", (1.0, 0))[0]
+        obj, img, body = surfaces[0], surfaces[-1], surfaces[1:-1]
+        if obj.stop or img.stop:
+            which = obj if obj.stop else img
+            raise self.err(
+                "STOP on the object or image surface: the stop must be a lens surface",
+                which.line,
+                which.number,
+            )
+        stops = [z for z in body if z.stop]
+        if len(stops) > 1:
+            raise self.err(
+                f"more than one STOP (surfaces {', '.join(str(z.number) for z in stops)})",
+                stops[1].line,
+                stops[1].number,
+            )
+        if not stops:
+            self.warn("no STOP line: surface 1 is the stop (OpticStudio's default)")
+        # object
+        od = obj.disz
+        if math.isinf(od) or od >= ZEMAX_INFINITY:
+            od = math.inf
+        else:
+            od *= scale
+            if not od > 0.0:
+                raise self.err(
+                    f"the object distance (DISZ of surface 0) must be positive or INFINITY, "
+                    f"got {obj.disz!r}",
+                    obj.disz_line or obj.line,
+                    0,
+                )
+        object_material = self.material(obj.glas, gcat, 0)
+        if img.curv != 0.0:
+            self.warn(
+                f"line {img.curv_line}: the image surface is curved (CURV {img.curv!r}); "
+                "orthoscope uses a flat image plane at the same vertex"
+            )
+        out: list[Surface] = []
+        for k, z in enumerate(body):
+            mat = self.material(z.glas, gcat, z.number)
+            sd = math.inf
+            if z.diam_fixed:
+                if not z.diam > 0.0:
+                    raise self.err(
+                        f"DIAM: a fixed semi-diameter must be positive, got {z.diam!r}",
+                        z.diam_line,
+                        z.number,
+                    )
+                sd = z.diam * scale
+            if math.isfinite(z.clap):
+                sd = min(sd, z.clap * scale)
+            th = z.disz * scale
+            if th < 0.0 and not mat.is_air:
+                raise self.err(
+                    f"DISZ {z.disz!r}: a glass thickness must not be negative",
+                    z.disz_line or z.line,
+                    z.number,
+                )
+            out.append(
+                Surface(
+                    curvature=z.curv / scale,
+                    thickness=th,
+                    material=mat,
+                    semi_diameter=sd,
+                    stop=z.stop or (not stops and k == 0),
+                    conic=z.coni,
+                    aspheric=self.aspheric(z, scale),
+                    label=z.comm,
+                    line=z.line,
+                )
+            )
+        # wavelength (nm)
+        wl = None
+        pw, pw_line = h.get("PWAV", (1, None))
+        if wavm:
+            if pw not in wavm:
+                raise self.err(
+                    f"PWAV {pw}: there is no WAVM {pw} line (wavelengths: "
+                    f"{', '.join(str(i) for i in sorted(wavm))})",
+                    pw_line or min(v[1] for v in wavm.values()),
+                )
+            wl, wl_line = wavm[pw]
+        elif wavl is not None:
+            vals, wl_line = wavl
+            if not 1 <= pw <= len(vals):
+                raise self.err(f"PWAV {pw}: WAVL lists {len(vals)} wavelength(s)", wl_line)
+            wl = vals[pw - 1]
+        if wl is None:
+            wl, wl_line = LAMBDA_D, 1
+            self.warn("no wavelength (WAVM/WAVL): the d line 587.5618 nm is used")
+        if not (200.0 <= wl <= 20000.0):
+            raise self.err(
+                f"the primary wavelength {wl / 1000:g} µm is outside 0.2-20 µm (WAVM/WAVL are "
+                "in µm)",
+                wl_line,
+            )
+        # aperture
+        if "APER" not in h:
+            raise self.err(
+                "no system aperture: the file needs ENPD (entrance-pupil diameter), FNUM "
+                "(image-space F/#) or OBNA (object-space NA)",
+                last_line,
+            )
+        acmd, aval, aline = h["APER"]
+        if not aval > 0.0:
+            raise self.err(f"{acmd} must be positive, got {aval!r}", aline)
+        if acmd == "ENPD":
+            aperture = Aperture("epd", aval * scale)
+        elif acmd == "FNUM":
+            aperture = Aperture("fnumber", aval)
+        else:
+            if aval >= 1.0 * object_material.nd or math.isinf(od):
+                raise self.err(
+                    "OBNA: an object-space NA needs a finite object distance and NA < n",
+                    aline,
+                )
+            aperture = Aperture("na", aval)
+        # field
+        ft, nf, _nw, fline = h.get("FTYP", (0, None, None, None))
+        if ft not in (0, 1):
+            raise self.err(
+                f"FTYP {ft}: field type {'paraxial image height' if ft == 2 else 'real image height' if ft == 3 else ft} "  # noqa: E501
+                "is not supported; set the field type to Angle (0) or Object Height (1) in "
+                "OpticStudio and save again",
+                fline,
+            )
+        xs = xfln[0] if xfln else []
+        ys = yfln[0] if yfln else []
+        n = max(len(xs), len(ys)) if nf is None else nf
+        if n < 0:
+            raise self.err(f"FTYP: negative number of fields {n}", fline)
+        radial = [
+            math.hypot(xs[i] if i < len(xs) else 0.0, ys[i] if i < len(ys) else 0.0)
+            for i in range(min(n, max(len(xs), len(ys))))
+        ]
+        fmax = max(radial, default=0.0)
+        if not radial:
+            self.warn("no field values (YFLN/XFLN): the field is 0")
+        fline = (yfln or xfln or (None, fline))[1] or fline or 1
+        if ft == 0:
+            if fmax >= 90.0:
+                raise self.err(f"field angle {fmax} deg: must be below 90 deg", fline)
+            fld = Field("angle", fmax)
+        else:
+            if math.isinf(od):
+                raise self.err(
+                    "FTYP 1 (object height) needs a finite object distance (DISZ of surface 0)",
+                    fline,
+                )
+            fld = Field("height", fmax * scale)
+        # names and notes
+        name_text = h.get("NAME", ("", None))[0]
+        meta = {}
+        for key, val in notes_meta.items():
+            try:
+                meta[key] = json.loads(val)
+            except ValueError:
+                plain_notes.append(f"orthoscope.{key}: {val}")
+        name = meta.get("name") if isinstance(meta.get("name"), str) else None
+        if name is None:
+            name = name_text or (Path(self.path).stem if self.path else "zemax lens")
+        source = meta.get("source")
+        if not isinstance(source, str):
+            source = f"imported from the Zemax file {Path(self.path).name}" if self.path else ""
+        notes = meta.get("notes")
+        if not isinstance(notes, str):
+            notes = "\n".join(plain_notes)
+        solve = meta.get("image_solve")
+        solve = solve if solve == "gaussian" else None
+        if self.unknown:
+            listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
+            self.warn(f"unknown commands skipped: {listing}")
+        try:
+            lens = Lens(
+                name=name,
+                surfaces=tuple(out),
+                aperture=aperture,
+                field=fld,
+                object_distance=od,
+                wavelength=wl,
+                source=source,
+                notes=notes,
+                units="mm",
+                object_material=object_material,
+                image_solve=solve,
+                path=self.path,
+            )
+        except (LensError, ValueError) as e:
+            raise lens_error(self.err, e, [z.line for z in body], surfaces[0].line) from None
+        return ImportResult(lens, tuple(self.warnings))
+
+
+def parse_zmx(text: str | bytes, *, path: str | Path | None = None) -> ImportResult:
+    """Parse ``.zmx`` content (text, or raw bytes in any of the supported encodings) into an
+    :class:`ImportResult` (lens + skipped-command list). Raises only PrescriptionError."""
+    return guarded_parse(_ZmxParser, text, path, "a Zemax .zmx lens file")
+
+
+def loads_zmx(text: str | bytes, *, path: str | Path | None = None) -> Lens:
+    """Parse ``.zmx`` content into a :class:`Lens`; skipped commands → one InteropWarning."""
+    return emit_warnings(parse_zmx(text, path=path), None if path is None else str(path))
+
+
+def read_zmx(path: str | Path) -> Lens:
+    """Read a Zemax ``.zmx`` file (ASCII/UTF-8/UTF-16) into a :class:`Lens` (mm, nm).
+
+    Raises :class:`~raytrace.errors.PrescriptionError` (file, line, what to do) for anything it
+    cannot read; skipped non-optical or unknown commands → one :class:`InteropWarning`."""
+    return emit_warnings(parse_zmx(read_bytes(path), path=path), str(path))
+
+
+# --------------------------------------------------------------------------------------------
+# Writer
+# --------------------------------------------------------------------------------------------
+
+
+def _r(x: float) -> str:
+    return repr(float(x))
+
+
+def _glas(m: Material) -> str | None:
+    if m.is_air:
+        return None
+    if m.kind == "catalog":
+        # OpticStudio stores the catalog's nd/vd after a catalog name; readers ignore them
+        return f"GLAS {m.name} 0 0 {_r(m.nd)} {_r(m.vd)} 0 0 0 0 0 0"
+    vd = 0.0 if m.kind == "index" else m.vd
+    return f"GLAS ___BLANK 1 0 {_r(m.nd)} {_r(vd)} 0 0 0 0 0 0"
+
+
+def _gcat(lens: Lens) -> list[str]:
+    """The GCAT catalogs of the lens's catalog glasses, in order of first use; raises when a
+    name would resolve to another catalog under OpticStudio's first-catalog-wins rule."""
+    mats = [lens.object_material, *(s.material for s in lens.surfaces)]
+    cats = list(dict.fromkeys(m.catalog for m in mats if m.kind == "catalog"))
+    for m in mats:
+        if m.kind == "catalog":
+            g = lookup_glass(m.name, cats, first_catalog_wins=True)
+            if g.catalog != m.catalog:
+                raise PrescriptionError(
+                    f"glass {m.name} of the {m.catalog} catalog cannot be written to .zmx next "
+                    f"to the {g.catalog} catalog, which also has a {m.name}: OpticStudio would "
+                    "take the first catalog on the GCAT line; write the lens as .toml instead"
+                )
+    return [c.upper() for c in cats]
+
+
+def _one_line(s: str) -> str:
+    return " ".join(s.split())
+
+
+def dumps_zmx(lens: Lens) -> str:
+    """The lens as ``.zmx`` text (sequential, mm, full float64 precision; catalog glasses by name
+    with a GCAT line, model glasses as ``___BLANK``).
+
+    Limits: an even asphere holds A4 … A16 (7 coefficients); more raise PrescriptionError.
+    A ``"index"`` material is written as a model glass with vd = 0 (OpticStudio's non-dispersive
+    convention). Trailing zero aspheric coefficients are not kept (same surface)."""
+    out: list[str] = ["MODE SEQ", f"NAME {_one_line(lens.name)}"]
+    meta: dict[str, str] = {}
+    if _one_line(lens.name) != lens.name or not lens.name.isascii():
+        meta["name"] = lens.name
+    meta["source"] = lens.source
+    meta["notes"] = lens.notes
+    if lens.image_solve:
+        meta["image_solve"] = lens.image_solve
+    for k, v in meta.items():
+        out.append(f"NOTE 0 orthoscope.{k}: {json.dumps(v, ensure_ascii=True)}")
+    out.append("UNIT MM X W X CM MR CPMM")
+    gcat = _gcat(lens)
+    if gcat:
+        out.append("GCAT " + " ".join(gcat))
+    ap = lens.aperture
+    out.append(
+        {"epd": f"ENPD {_r(ap.value)}", "fnumber": f"FNUM {_r(ap.value)} 0"}.get(
+            ap.kind, f"OBNA {_r(ap.value)} 0"
+        )
+    )
+    fv = float(lens.field.value)
+    fields = [0.0] if fv == 0.0 else [0.0, 0.7 * fv, fv]
+    out.append(f"FTYP {0 if lens.field.kind == 'angle' else 1} 0 {len(fields)} 1 0 0 0")
+    pad = fields + [0.0] * (12 - len(fields))
+    out.append("XFLN " + " ".join("0" for _ in pad))
+    out.append("YFLN " + " ".join(_r(v) if v else "0" for v in pad))
+    out.append("FWGN " + " ".join("1" for _ in pad))
+    out.append(f"WAVM 1 {nm_to_micron_text(lens.wavelength)} 1")
+    out.append("PWAV 1")
+    # object surface
+    out += ["SURF 0", "  TYPE STANDARD", '  CURV 0.0 0 0 0 0 ""']
+    od = lens.object_distance
+    out.append("  DISZ INFINITY" if math.isinf(od) else f"  DISZ {_r(od)}")
+    g = _glas(lens.object_material)
+    if g:
+        out.append("  " + g)
+    for i, s in enumerate(lens.surfaces, start=1):
+        asph = list(s.aspheric)
+        while asph and asph[-1] == 0.0:
+            asph.pop()
+        if len(asph) > 7:
+            raise PrescriptionError(
+                f"{len(s.aspheric)} aspheric coefficients cannot be written to .zmx: an "
+                "EVENASPH surface holds A4 to A16 (7 terms)",
+                surface=i,
+            )
+        out.append(f"SURF {i}")
+        out.append(f"  TYPE {'EVENASPH' if asph else 'STANDARD'}")
+        if s.label:
+            out.append(f"  COMM {_one_line(s.label)}")
+        out.append(f'  CURV {_r(s.curvature)} 0 0 0 0 ""')
+        if s.stop:
+            out.append("  STOP")
+        out.append(f"  DISZ {_r(s.thickness)}")
+        g = _glas(s.material)
+        if g:
+            out.append("  " + g)
+        if math.isfinite(s.semi_diameter):
+            out.append(f'  DIAM {_r(s.semi_diameter)} 1 0 0 1 ""')
+        else:
+            out.append('  DIAM 0 0 0 0 1 ""')
+        if s.conic != 0.0:
+            out.append(f"  CONI {_r(s.conic)}")
+        if asph:
+            out.append("  PARM 1 0")
+            for j in range(2, 9):
+                out.append(f"  PARM {j} {_r(asph[j - 2]) if j - 2 < len(asph) else '0'}")
+    n = len(lens.surfaces) + 1
+    out += [f"SURF {n}", "  TYPE STANDARD", '  CURV 0.0 0 0 0 0 ""', "  DISZ 0", ""]
+    return "\r\n".join(out)
+
+
+def write_zmx(lens: Lens, path: str | Path, *, encoding: str = "utf-16", **options) -> None:
+    """Write ``lens`` as a ``.zmx`` file, atomically. ``encoding`` ``"utf-16"`` (OpticStudio's
+    own: UTF-16 LE with BOM, CRLF) or ``"ascii"`` (non-ASCII characters escaped as ``?``);
+    ``options`` (``overwrite``, ``inputs``, ``flag``) as in
+    :func:`raytrace.files.output.write_atomic`."""
+    text = dumps_zmx(lens)
+    if encoding == "utf-16":
+        data = codecs.BOM_UTF16_LE + text.encode("utf-16-le")
+    elif encoding == "ascii":
+        data = text.encode("ascii", errors="replace")
+    else:
+        raise ValueError(f"encoding must be 'utf-16' or 'ascii', got {encoding!r}")
+    write_atomic(path, data, **options)

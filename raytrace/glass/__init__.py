@@ -1,0 +1,59 @@
+"""Glass catalogs shipped as data, dispersion formulas, air index and temperature effects.
+
+Lens files from Zemax and CODE V name their glasses (``N-SK16``, ``NSK16_SCHOTT``, ``S-BSL7``).
+:func:`lookup_glass` resolves such a name in the shipped catalogs (Schott, Ohara, Hoya, CDGM,
+Hikari, Sumita, and ``Misc`` for fused silica, crystals, window glasses and optical plastics;
+see :mod:`.catalog`) to a :class:`CatalogGlass`, whose ``.material`` computes the vendor's own
+dispersion formula (:mod:`.formulas`) at any wavelength — relative to air at the catalog's
+reference conditions (:mod:`.air`); other temperatures and pressures through Schott's dn/dT
+model (:mod:`.thermal`). :func:`search_glass` finds the catalog glasses nearest to an nd/vd pair.
+
+A name found in several catalogs with different nd/vd is ambiguous: the error lists the
+candidates and how to pick one (a catalog suffix ``_SCHOTT``, a Zemax ``GCAT`` line, or a model
+glass). Six-digit glass codes (``620603`` → nd 1.620, vd 60.3) and ``nd:vd`` strings are parsed
+by :func:`parse_glass_code` without any catalog.
+"""
+
+from ..materials import OutOfRangeError, OutOfRangeWarning
+from .air import absolute_to_relative, air_index, relative_to_absolute
+from .catalog import (
+    CATALOGS,
+    DATA_FILE,
+    CatalogGlass,
+    GlassMatch,
+    catalog_available,
+    catalog_glasses,
+    catalog_sources,
+    find_glass,
+    lookup_glass,
+    normalize_name,
+    parse_glass_code,
+    search_glass,
+)
+from .formulas import FORMULAS, evaluate
+from .thermal import delta_n_absolute, dn_dt_absolute, index_at
+
+__all__ = [
+    "CATALOGS",
+    "DATA_FILE",
+    "FORMULAS",
+    "CatalogGlass",
+    "GlassMatch",
+    "OutOfRangeError",
+    "OutOfRangeWarning",
+    "absolute_to_relative",
+    "air_index",
+    "catalog_available",
+    "catalog_glasses",
+    "catalog_sources",
+    "delta_n_absolute",
+    "dn_dt_absolute",
+    "evaluate",
+    "find_glass",
+    "index_at",
+    "lookup_glass",
+    "normalize_name",
+    "parse_glass_code",
+    "relative_to_absolute",
+    "search_glass",
+]

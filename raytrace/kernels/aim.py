@@ -1,0 +1,237 @@
+"""Chief-ray aiming in one kernel call: for every field, the meridional real ray through the
+centre of the stop (height zero at the stop surface), by field continuation and a safeguarded
+secant solve (Pestrecov 1958, Fig. 1: the principal ray through the centre of the real stop).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .codes import STATUS_AIM_FAILED, STATUS_OK
+from .jit import kernel
+from .surface import trace_span
+
+# Chief-ray aiming limits (per field): secant/bisection iterations per solve, step halvings of
+# the field continuation, total residual evaluations.
+AIM_MAXIT = 60
+AIM_MAX_HALVINGS = 40
+AIM_MAX_EVALS = 1500
+
+@kernel(error_model="numpy", inline="always")
+def _start_ray(finite, z_obj, f, u):
+    """Object-space meridional ray for field value f and unknown u.
+
+    finite == 0 (object at infinity): f = α (rad), start (0, u, 0), direction (0, sin α, cos α).
+    finite == 1: f = object height (mm), start (0, f, z_obj), direction ∝ (0, u, 1) (u = tan θ).
+    """
+    if finite == 0:
+        return u, 0.0, math.sin(f), math.cos(f)
+    nrm = math.sqrt(1.0 + u * u)
+    return f, z_obj, u / nrm, 1.0 / nrm
+
+
+@kernel(error_model="numpy")
+def _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u):
+    """Meridional height at the stop surface of the ray (f, u) (unclipped); (status, y)."""
+    y0, z0, M0, N0 = _start_ray(finite, z_obj, f, u)
+    st, sf, x, y, z, L, M, N = trace_span(
+        kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, False, 0.0, y0, z0, 0.0, M0, N0
+    )
+    return st, y
+
+
+@kernel(error_model="numpy")
+def _solve_field(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u0, tol, hscale):
+    """Safeguarded secant solve of y_stop(u) = 0 from the guess u0.
+
+    Returns (converged, u, residual, evaluations). A sign change between two traceable points
+    keeps a bracket; secant steps outside it are replaced by bisection; an untraceable trial
+    point is pulled halfway back toward the last good point (up to 20 times)."""
+    nev = 1
+    st, r0 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u0)
+    if st != STATUS_OK or not math.isfinite(r0):
+        return False, u0, np.nan, nev
+    if abs(r0) <= tol:
+        return True, u0, r0, nev
+    h = 1e-7 * max(abs(u0), hscale)
+    u1 = u0 + h
+    st, r1 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+    nev += 1
+    if st != STATUS_OK:
+        u1 = u0 - h
+        st, r1 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+        nev += 1
+        if st != STATUS_OK:
+            return False, u0, r0, nev
+    if abs(r1) <= tol:
+        return True, u1, r1, nev
+    # best point (ub, rb) and bracket [lo, hi] (valid when have_br)
+    g = (r1 - r0) / (u1 - u0)
+    ub, rb = u0, r0
+    if abs(r1) < abs(r0):
+        ub, rb = u1, r1
+    have_br = False
+    lo = 0.0
+    hi = 0.0
+    rlo = 0.0
+    if r0 * r1 < 0.0:
+        have_br = True
+        if u0 < u1:
+            lo, hi, rlo = u0, u1, r0
+        else:
+            lo, hi, rlo = u1, u0, r1
+    for _ in range(AIM_MAXIT):
+        if g != 0.0 and math.isfinite(g):
+            un = ub - rb / g
+        else:
+            un = 0.5 * (lo + hi) if have_br else ub + h
+        if have_br and not (lo < un < hi):
+            un = 0.5 * (lo + hi)
+        ok = False
+        rn = 0.0
+        for _k in range(20):
+            st, rn = _stop_residual(
+                kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, un
+            )
+            nev += 1
+            if st == STATUS_OK and math.isfinite(rn):
+                ok = True
+                break
+            un = ub + 0.5 * (un - ub)
+        if not ok:
+            return False, ub, rb, nev
+        if abs(rn) <= tol:
+            return True, un, rn, nev
+        if un != ub:
+            g = (rn - rb) / (un - ub)
+        # update bracket
+        if have_br:
+            if (rn < 0.0) == (rlo < 0.0):
+                lo, rlo = un, rn
+            else:
+                hi = un
+        elif rn * rb < 0.0:
+            have_br = True
+            if un < ub:
+                lo, hi, rlo = un, ub, rn
+            else:
+                lo, hi, rlo = ub, un, rb
+        if abs(rn) < abs(rb) or have_br:
+            ub, rb = un, rn
+        if have_br and hi - lo <= 4e-16 * max(abs(lo), abs(hi)):
+            return False, ub, rb, nev
+    return False, ub, rb, nev
+
+
+@kernel(error_model="numpy")
+def aim_chief(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
+              hscale, clip, start, last, status, surface, evals, residual):  # fmt: skip
+    """Aim the meridional chief ray (through the stop vertex) for every field; one call.
+
+    fields: field values (α in rad for ``finite == 0``; object height in mm for ``finite == 1``),
+    any order and sign (negative fields are mirror images of positive ones). slope0: paraxial
+    du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object). tol: absolute
+    stop-height tolerance (mm). hscale: scale of u for finite-difference steps.
+
+    Fields are solved in order of |f| by continuation: each starts from the extrapolation of the
+    last two solutions; a failed solve halves the field step (intermediate fields) until it
+    succeeds or AIM_MAX_HALVINGS / AIM_MAX_EVALS is exhausted (→ AIM_FAILED).
+
+    Outputs (filled in place, one column / entry per field): ``start`` (4, n) float64 rows y, z,
+    M, N of the object-space ray (a point and direction cosines, meridional plane x = 0);
+    ``last`` (4, n) rows y, z, M, N of the final segment (point on the last surface, direction
+    after it); ``status`` int8 and ``surface`` int32 (1-based failed surface, 0 when OK);
+    ``evals`` int32 residual evaluations used; ``residual`` float64 height at the stop (mm).
+    Fields that failed have NaN rays (z of the start point kept).
+    """
+    n = fields.shape[0]
+    ns = c.shape[0]
+    order = np.argsort(np.abs(fields))
+    # continuation state: last solved field (fb, ub) and the secant slope du/df there
+    fb = 0.0
+    ub = 0.0
+    slope = slope0
+    for ii in range(n):
+        i = order[ii]
+        ftarget = abs(fields[i])
+        sign = 1.0 if fields[i] >= 0.0 else -1.0
+        nev = 0
+        conv = False
+        u = 0.0
+        res = 0.0
+        if ftarget == 0.0:
+            conv = True
+            u = 0.0
+            res = 0.0
+        else:
+            fcur = fb
+            ucur = ub
+            step = ftarget - fcur
+            halvings = 0
+            while True:
+                ftry = fcur + step
+                if step == ftarget - fcur:
+                    ftry = ftarget
+                guess = ucur + slope * (ftry - fcur)
+                ok, usol, rsol, ne = _solve_field(
+                    kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, ftry, guess, tol,
+                    hscale,
+                )  # fmt: skip
+                nev += ne
+                if ok:
+                    if ftry != fcur:
+                        slope = (usol - ucur) / (ftry - fcur)
+                    fcur, ucur = ftry, usol
+                    fb, ub = fcur, ucur
+                    if ftry == ftarget:
+                        conv = True
+                        u = usol
+                        res = rsol
+                        break
+                    step = min(2.0 * step, ftarget - fcur)
+                else:
+                    halvings += 1
+                    if halvings > AIM_MAX_HALVINGS or nev > AIM_MAX_EVALS:
+                        u = usol
+                        res = rsol
+                        break
+                    step *= 0.5
+        y0, z0, M0, N0 = _start_ray(finite, z_obj, ftarget, u)
+        start[0, i] = sign * y0
+        start[1, i] = z0
+        start[2, i] = sign * M0
+        start[3, i] = N0
+        evals[i] = nev
+        if not conv:
+            start[0, i] = np.nan
+            start[2, i] = np.nan
+            start[3, i] = np.nan
+            for r in range(4):
+                last[r, i] = np.nan
+            status[i] = STATUS_AIM_FAILED
+            surface[i] = 0
+            residual[i] = np.nan
+            continue
+        st, sf, x, y, z, L, M, N = trace_span(
+            kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, clip, 0.0, y0, z0, 0.0, M0, N0
+        )
+        ystop = y
+        if st == STATUS_OK:
+            st, sf, x, y, z, L, M, N = trace_span(
+                kind, c, k, asph, zv, n_in, n_out, sd, stop + 1, ns, clip, x, y, z, L, M, N
+            )
+        status[i] = st
+        surface[i] = sf
+        if st == STATUS_OK:
+            last[0, i] = sign * y
+            last[1, i] = z
+            last[2, i] = sign * M
+            last[3, i] = N
+            residual[i] = sign * ystop
+        else:
+            for r in range(4):
+                last[r, i] = np.nan
+            residual[i] = sign * res
+

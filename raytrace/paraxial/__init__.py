@@ -1,0 +1,36 @@
+"""Paraxial optics: first-order data of a centred lens (:mod:`.firstorder`), Pestrecov's constants
+of orthoscopy (:mod:`.orthoscopy`) and the object / image-plane vocabulary (:mod:`.conjugates`).
+No numba here: paraxial-only commands stay fast to start."""
+
+from .conjugates import (
+    ImagePlane,
+    image_planes,
+    object_distance_for_s,
+    object_distance_for_scale,
+    plane_z,
+    resolve_object_distance,
+)
+from .firstorder import ParaxialResult, paraxial
+from .orthoscopy import (
+    PestrecovConstants,
+    ideal_heights,
+    orthoscopy_abscissa,
+    paraxial_chief_heights,
+    pestrecov_constants,
+)
+
+__all__ = [
+    "ImagePlane",
+    "ParaxialResult",
+    "PestrecovConstants",
+    "ideal_heights",
+    "image_planes",
+    "object_distance_for_s",
+    "object_distance_for_scale",
+    "orthoscopy_abscissa",
+    "paraxial",
+    "paraxial_chief_heights",
+    "pestrecov_constants",
+    "plane_z",
+    "resolve_object_distance",
+]

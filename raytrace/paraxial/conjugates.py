@@ -1,0 +1,238 @@
+"""Where the object and the image plane are: the one vocabulary of the project.
+
+The same names are used as API keywords, CLI flags (with dashes) and JSON keys (with ``_mm``);
+docs/design.md ("Vocabulary") has the table.
+
+Object plane (give at most one; default: the lens file's object):
+
+``object_distance``
+    mm from the object plane to the FIRST VERTEX, a positive magnitude as in lens files, or
+    ``inf``. (A string ``"12x"`` is accepted as the image scale below.)
+``object_s``
+    Pestrecov's signed ``s``: mm from the first principal point H, negative for a real object.
+``object_scale``
+    an image scale N ("N×"): the object distance at which the Gaussian magnification is −1/N,
+    ``s = f/m0 − f = −f (1 + N)`` (Pestrecov Eq. 5 inverted).
+
+Image plane (:class:`ImagePlane`; default: the Gaussian image plane of the object):
+
+``s_prime``
+    mm from the second principal point H' (Pestrecov's s', positive to the right);
+``from_last_vertex``
+    mm from the last vertex, positive to the right;
+``defocus``
+    mm from the Gaussian image plane of the object (+ = away from the lens);
+``gaussian`` / ``file``
+    the Gaussian image plane / the plane the lens file defines (its last thickness).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import TraceError
+from .orthoscopy import object_distance_for_magnification
+
+if TYPE_CHECKING:
+    from ..lens import Lens
+    from .firstorder import ParaxialResult
+
+PLANE_KINDS = ("s_prime", "from_last_vertex", "defocus", "gaussian", "file")
+
+
+@dataclass(frozen=True)
+class ImagePlane:
+    """An image plane in the project's vocabulary (module docstring).
+
+    kind:  ``"s_prime"`` | ``"from_last_vertex"`` | ``"defocus"`` | ``"gaussian"`` | ``"file"``.
+    value: the distance in mm for the first three kinds (ignored for the others).
+    """
+
+    kind: str
+    value: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in PLANE_KINDS:
+            raise TraceError(
+                f"unknown image-plane kind {self.kind!r}; expected one of {', '.join(PLANE_KINDS)}"
+            )
+        if not math.isfinite(self.value):
+            raise TraceError(f"image plane {self.kind}: expected a finite distance in mm")
+
+    def z(self, par: ParaxialResult) -> float:
+        """Absolute z (mm from the first vertex) of this plane for the paraxial data ``par``."""
+        if self.kind == "s_prime":
+            return float(par.z_from_s_prime(self.value))
+        if self.kind == "from_last_vertex":
+            return float(par.z_from_last_vertex(self.value))
+        if self.kind == "defocus":
+            return float(par.z_from_defocus(self.value))
+        if self.kind == "file":
+            return float(par.z_image_file)
+        return float(par.z_gauss)
+
+    def describe(self) -> str:
+        if self.kind in ("gaussian", "file"):
+            return {"gaussian": "the Gaussian image plane", "file": "the lens file's plane"}[
+                self.kind
+            ]
+        return f"{self.kind} = {self.value:g} mm"
+
+
+def image_planes(
+    plane: ImagePlane | Iterable[ImagePlane] | str | None = None,
+    *,
+    s_prime=None,
+    from_last_vertex=None,
+    defocus=None,
+) -> list[ImagePlane]:
+    """The image planes a call asks for: ``plane`` (an :class:`ImagePlane`, a list of them, or
+    ``"gaussian"`` / ``"file"``) or ONE of the keywords ``s_prime`` / ``from_last_vertex`` /
+    ``defocus`` (a number or a sequence of numbers, mm). Nothing → the Gaussian plane."""
+    kw = {
+        k: v
+        for k, v in (
+            ("s_prime", s_prime),
+            ("from_last_vertex", from_last_vertex),
+            ("defocus", defocus),
+        )
+        if v is not None
+    }
+    if len(kw) + (plane is not None) > 1:
+        raise TraceError(
+            "give the image plane(s) one way: plane=, s_prime=, from_last_vertex= or defocus="
+        )
+    if kw:
+        ((kind, v),) = kw.items()
+        arr = np.atleast_1d(np.asarray(v, dtype=float)).ravel()
+        if arr.size == 0:
+            raise TraceError(f"{kind}: no image plane given")
+        return [ImagePlane(kind, float(x)) for x in arr]
+    if plane is None:
+        return [ImagePlane("gaussian")]
+    if isinstance(plane, str):
+        if plane not in ("gaussian", "file"):
+            raise TraceError(
+                f"plane={plane!r}: a string plane is 'gaussian' or 'file'; for a distance use "
+                "s_prime=, from_last_vertex= or defocus= (mm)"
+            )
+        return [ImagePlane(plane)]
+    if isinstance(plane, ImagePlane):
+        return [plane]
+    out = list(plane)
+    if not out or not all(isinstance(p, ImagePlane) for p in out):
+        raise TraceError("plane= takes an ImagePlane, a list of them, 'gaussian' or 'file'")
+    return out
+
+
+def plane_z(par: ParaxialResult, planes: list[ImagePlane]) -> np.ndarray:
+    """Absolute z of ``planes``; refuses a plane on or before the last vertex."""
+    z = np.array([p.z(par) for p in planes], dtype=float)
+    if not np.all(np.isfinite(z)):
+        raise TraceError("the Gaussian image is at infinity; give the image plane explicitly")
+    bad = np.nonzero(z <= par.z_last)[0]
+    if bad.size:
+        i = int(bad[0])
+        raise TraceError(
+            f"image plane {planes[i].describe()} lies {z[i] - par.z_last:+.4f} mm from the last "
+            "vertex, on or before the last surface; an image plane must be behind the lens"
+        )
+    return z
+
+
+def parse_scale(text: str) -> float | None:
+    """``"12x"`` / ``"12X"`` / ``"12×"`` → 12.0; anything else → None."""
+    t = str(text).strip()
+    if t[-1:] in ("x", "X", "×"):
+        try:
+            n = float(t[:-1])
+        except ValueError:
+            return None
+        return n
+    return None
+
+
+def object_distance_for_scale(lens: Lens, n: float, wavelength: float | None = None) -> float:
+    """Object distance (mm from the first vertex) for the image scale "N×": Gaussian
+    magnification −1/N, ``s = −f (1 + N)`` from H (Pestrecov Eq. 5 inverted)."""
+    from .firstorder import paraxial
+
+    if not (math.isfinite(n) and n > 0):
+        raise TraceError(f"image scale {n!r}x: N must be a positive number (12x: m0 = -1/12)")
+    par = paraxial(lens, math.inf, wavelength)
+    s = object_distance_for_magnification(par.efl, -1.0 / n)
+    return object_distance_for_s(lens, s, wavelength, _par=par)
+
+
+def object_distance_for_s(
+    lens: Lens, s: float, wavelength: float | None = None, *, _par: ParaxialResult | None = None
+) -> float:
+    """Object distance (mm from the first vertex) of Pestrecov's signed ``s`` (mm from H)."""
+    from .firstorder import paraxial
+
+    if not (math.isfinite(s) and s < 0):
+        raise TraceError(f"object_s must be negative (a real object left of H), got {s!r}")
+    par = _par if _par is not None else paraxial(lens, math.inf, wavelength)
+    od = -(par.z_H + s)
+    if not od > 0:
+        raise TraceError(
+            f"object_s {s!r} puts the object plane behind the first vertex (H lies "
+            f"{par.z_H:.4f} mm from the first vertex)"
+        )
+    return float(od)
+
+
+def resolve_object_distance(
+    lens: Lens,
+    *,
+    object_distance: float | str | None = None,
+    object_s: float | None = None,
+    object_scale: float | None = None,
+    wavelength: float | None = None,
+) -> float:
+    """The object distance (positive mm from the first vertex, or ``inf``) from at most one of
+    ``object_distance`` (mm, ``inf`` or ``"12x"``), ``object_s`` (signed mm from H) and
+    ``object_scale`` (N of "N×"); none → the lens file's object."""
+    given = [
+        k
+        for k, v in (
+            ("object_distance", object_distance),
+            ("object_s", object_s),
+            ("object_scale", object_scale),
+        )
+        if v is not None
+    ]
+    if len(given) > 1:
+        raise TraceError(f"give the object one way, not {' and '.join(given)}")
+    if object_s is not None:
+        return object_distance_for_s(lens, float(object_s), wavelength)
+    if object_scale is not None:
+        return object_distance_for_scale(lens, float(object_scale), wavelength)
+    if object_distance is None:
+        return float(lens.object_distance)
+    if isinstance(object_distance, str):
+        t = object_distance.strip().lower()
+        if t in ("inf", "infinity"):
+            return math.inf
+        n = parse_scale(t)
+        if n is not None:
+            return object_distance_for_scale(lens, n, wavelength)
+        try:
+            object_distance = float(t)
+        except ValueError:
+            raise TraceError(
+                f"object_distance {object_distance!r}: expected mm, 'inf' or an image scale "
+                "such as '12x'"
+            ) from None
+    od = float(object_distance)
+    if not od > 0:
+        raise TraceError(
+            f"object_distance must be a positive magnitude (mm from the object plane to the "
+            f"first vertex) or inf, got {od!r}; for Pestrecov's signed s use object_s="
+        )
+    return od

@@ -1,0 +1,340 @@
+"""First-order (paraxial, y-nu) optics of a centred lens: cardinal points, pupils, m_e.
+
+All distances are in mm and signed per docs/design.md ("Conventions") / Pestrecov Fig. 1:
+
+* absolute positions ``z_*`` are measured along the axis from the first vertex (light toward +z);
+* ``s`` is the object-plane distance from the first principal (nodal) point H, negative for a real
+  object; ``s'`` the image-plane distance from H', positive for a real image;
+* ``HE0 = z_E0 - z_H`` and ``H'E0' = z_E0' - z_H'`` locate the paraxial pupils; ``p0 = s - HE0``
+  (object plane from E0, negative) and ``p0' = s' - H'E0'`` (image plane from E0').
+
+The paraxial ray is traced in the reduced form ``n'u' = n u - y φ`` (refraction, ``φ = (n'-n) c``)
+and ``y₂ = y₁ + t u'`` (transfer), with ``u`` the slope dy/dz. Everything follows from the 2×2
+system matrix and two rays; the chief ray is the paraxial ray through the centre of the stop.
+
+Pestrecov's Eq. (6), ``m_e = lim tan α / tan α'`` (object- over image-space slope of the
+paraxial chief ray), and Eq. (5), the Gaussian magnification, are computed here; the constants of
+orthoscopy in any image plane (Eqs. 7–8) are in :mod:`.orthoscopy`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import LensError
+from ..lens import Lens
+
+
+@dataclass(frozen=True)
+class ParaxialResult:
+    """First-order data of a lens for one object distance and wavelength (mm, signed; see module).
+
+    efl:       equivalent focal length 1/Φ (in air equal to the focal lengths f = f').
+    f_object, f_image:  object-side focal length ``-n/Φ`` (negative for a positive lens) and
+               image-side focal length ``n'/Φ``.
+    bfl:       last vertex → F' ;  ffl: first vertex → F (signed; negative when F lies to the left).
+    z_F, z_Fp, z_H, z_Hp, z_N, z_Np:  focal, principal and nodal points (absolute z).
+    z_E0, z_E0p, epd, xpd:  paraxial entrance / exit pupil positions and diameters.
+    pupil_magnification: xpd / epd.
+    m_e:       Pestrecov Eq. (6): object- over image-space slope of the paraxial chief ray.
+    lagrange:  Lagrange invariant n (u_c y_m − u_m y_c) for the lens's full field and aperture.
+    stop_radius: paraxial radius of the stop that the aperture specification implies.
+    HE0, HpE0p: pupil positions from the principal points (Pestrecov Table III).
+    object_distance: positive magnitude, first vertex to object plane (inf for infinity).
+    z_object:  object plane (−inf for infinity); s: object plane from H (−inf for infinity).
+    z_gauss:   Gaussian image plane; s_prime_gauss: it from H'; gaussian_image_distance: from the
+               last vertex; m0: Gaussian lateral magnification (Eq. 5; 0 for an object at infinity).
+    p0:        s − HE0 (−inf for infinity); working_fnumber: 1/(2 n' |u'_marginal|).
+    z_last:    z of the last vertex; z_image_file: the image plane the lens file defines.
+    n_object, n_image: indices of object and image space.
+    """
+
+    efl: float
+    f_object: float
+    f_image: float
+    bfl: float
+    ffl: float
+    z_F: float
+    z_Fp: float
+    z_H: float
+    z_Hp: float
+    z_N: float
+    z_Np: float
+    z_E0: float
+    z_E0p: float
+    epd: float
+    xpd: float
+    pupil_magnification: float
+    m_e: float
+    lagrange: float
+    stop_radius: float
+    HE0: float
+    HpE0p: float
+    object_distance: float
+    z_object: float
+    s: float
+    z_gauss: float
+    s_prime_gauss: float
+    gaussian_image_distance: float
+    m0: float
+    p0: float
+    working_fnumber: float
+    z_last: float
+    z_image_file: float
+    n_object: float
+    n_image: float
+    wavelength: float
+
+    @property
+    def infinite(self) -> bool:
+        """True for an object at infinity."""
+        return math.isinf(self.object_distance)
+
+    # --- image-plane conversions (all return an absolute z) -----------------------------------
+    def z_from_s_prime(self, s_prime: float | np.ndarray) -> float | np.ndarray:
+        """Image plane given as s' from H' (Pestrecov) → absolute z."""
+        return _shift(self.z_Hp, s_prime)
+
+    def z_from_last_vertex(self, d: float | np.ndarray) -> float | np.ndarray:
+        """Image plane given as a distance from the last vertex → absolute z."""
+        return _shift(self.z_last, d)
+
+    def z_from_defocus(self, dz: float | np.ndarray) -> float | np.ndarray:
+        """Image plane given as a defocus from the Gaussian image plane (+ = away from lens)."""
+        return _shift(self.z_gauss, dz)
+
+    def s_prime_of(self, z_image: float | np.ndarray) -> float | np.ndarray:
+        """s' (from H') of an absolute image-plane position."""
+        return z_image - self.z_Hp
+
+
+def _shift(origin: float, d: float | np.ndarray) -> float | np.ndarray:
+    """origin + d, keeping a Python float for a scalar."""
+    return origin + np.asarray(d, dtype=float) if np.ndim(d) else origin + float(d)
+
+
+def _system(lens: Lens, wavelength: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Curvatures, thicknesses (between vertices), indices before and after each surface."""
+    ss = lens.surfaces
+    c = np.array([s.curvature for s in ss], dtype=float)
+    t = np.array([s.thickness for s in ss[:-1]], dtype=float)
+    n_out = np.array([s.material.index(wavelength) for s in ss], dtype=float)
+    n_in = np.concatenate(([lens.object_material.index(wavelength)], n_out[:-1]))
+    return c, t, n_in, n_out
+
+
+def _trace(
+    c: np.ndarray,
+    t: np.ndarray,
+    n_in: np.ndarray,
+    n_out: np.ndarray,
+    y: float,
+    nu: float,
+    upto: int,
+) -> tuple[float, float]:
+    """Paraxial trace of (y, n·u) at the first vertex through surfaces [0, upto).
+
+    Returns (y, n'u') just after surface ``upto-1`` (or at the first vertex for upto=0).
+    """
+    for i in range(upto):
+        nu = nu - y * (n_out[i] - n_in[i]) * c[i]
+        if i + 1 < upto:
+            y = y + t[i] * nu / n_out[i]
+    return y, nu
+
+
+def _matrix(c, t, n_in, n_out, upto: int) -> np.ndarray:
+    """2×2 matrix mapping (y, nu) at the first vertex to (y, n'u') after surface upto-1."""
+    a = _trace(c, t, n_in, n_out, 1.0, 0.0, upto)
+    b = _trace(c, t, n_in, n_out, 0.0, 1.0, upto)
+    return np.array([[a[0], b[0]], [a[1], b[1]]])
+
+
+def _entrance_pupil(c, t, n_in, n_out, stop: int) -> tuple[float, float, float]:
+    """(a, b, z_E0): the stop height ``a y1 + b n u1`` of a paraxial ray per unit height / unit
+    reduced slope at the first vertex, and the paraxial entrance pupil (absolute z; inf for an
+    object-space telecentric stop)."""
+    (a, b), _ = _matrix(c, t, n_in, n_out, stop + 1)
+    z_E0 = math.inf if a == 0.0 else float(b * n_in[0] / a)
+    return float(a), float(b), z_E0
+
+
+def entrance_pupil_diameter(lens: Lens, efl: float, n0: float, z_E0: float, z_obj: float) -> float:
+    """The paraxial entrance-pupil diameter the lens's aperture specification implies (mm) — the
+    one conversion in the project.
+
+    ``fnumber`` N: ``EPD = |EFL| / N`` (infinite-conjugate f-number); ``epd``: as given;
+    ``na`` (object-space n sin U of the axial marginal ray): the marginal ray leaves the axial
+    object point at the real angle ``U = asin(NA/n)`` toward the paraxial pupil edge,
+    ``EPD = 2 |z_E0 − z_obj| tan(asin(NA/n))`` — optiland's convention
+    (``ObjectNAAperture.compute_epd``), checked against optiland in tests/test_paraxial.py.
+    """
+    ap = lens.aperture
+    if ap.kind == "fnumber":
+        if not math.isfinite(efl):
+            raise LensError(f"{lens.name}: an f-number aperture needs a finite focal length")
+        return abs(efl) / ap.value
+    if ap.kind == "epd":
+        return ap.value
+    if ap.value >= n0:
+        raise LensError(f"{lens.name}: NA {ap.value} must be below the object index {n0}")
+    if math.isinf(z_obj):
+        raise LensError(f"{lens.name}: an object-space NA needs a finite object distance")
+    if math.isinf(z_E0):
+        raise LensError(f"{lens.name}: entrance pupil at infinity with an object-space NA")
+    return 2.0 * abs(z_E0 - z_obj) * math.tan(math.asin(ap.value / n0))
+
+
+def _marginal_start(
+    lens: Lens, epd: float, n0: float, z_E0: float, z_obj: float
+) -> tuple[float, float]:
+    """(y1, n u1) at the first vertex of the paraxial marginal ray to the pupil edge."""
+    if math.isinf(z_obj):
+        return epd / 2.0, 0.0
+    if math.isinf(z_E0):
+        raise LensError(f"{lens.name}: entrance pupil at infinity with a finite object")
+    um = (epd / 2.0) / (z_E0 - z_obj)
+    return um * (0.0 - z_obj), n0 * um
+
+
+def aim_geometry(
+    lens: Lens, object_distance: float, wavelength: float | None = None
+) -> tuple[float, float]:
+    """(z_E0, stop radius) in mm for chief-ray aiming: the paraxial entrance pupil and the
+    paraxial marginal-ray height at the stop. Unlike :func:`paraxial` it works for an afocal lens
+    whose aperture is not an f-number."""
+    wl = lens.wavelength if wavelength is None else float(wavelength)
+    c, t, n_in, n_out = _system(lens, wl)
+    a, b, z_E0 = _entrance_pupil(c, t, n_in, n_out, lens.stop_index)
+    if a == 0.0:
+        raise LensError(f"{lens.name}: the stop is at a paraxial image of the object-space axis")
+    z_obj = -math.inf if math.isinf(object_distance) else -float(object_distance)
+    efl = math.nan
+    if lens.aperture.kind == "fnumber":
+        (_, _), (C, _) = _matrix(c, t, n_in, n_out, len(c))
+        efl = -1.0 / C if C != 0.0 else math.inf
+    epd = entrance_pupil_diameter(lens, efl, float(n_in[0]), z_E0, z_obj)
+    ym1, num1 = _marginal_start(lens, epd, float(n_in[0]), z_E0, z_obj)
+    return z_E0, abs(a * ym1 + b * num1)
+
+
+def paraxial(
+    lens: Lens, object_distance: float | None = None, wavelength: float | None = None
+) -> ParaxialResult:
+    """First-order analysis of ``lens`` (see :class:`ParaxialResult` for every quantity).
+
+    object_distance: positive magnitude from the object plane to the first vertex, or ``inf``;
+        defaults to the lens's. wavelength: nm, defaults to the lens's.
+    Raises :class:`LensError` for an afocal lens, a stop the paraxial chief ray cannot locate
+    (pupil at infinity is allowed and reported as ±inf), or an object at a focal point.
+    """
+    od = lens.object_distance if object_distance is None else float(object_distance)
+    if not (od > 0.0):
+        raise LensError(f"object distance must be a positive magnitude or inf, got {od}")
+    wl = lens.wavelength if wavelength is None else float(wavelength)
+    c, t, n_in, n_out = _system(lens, wl)
+    ns = len(c)
+    n0, nk = float(n_in[0]), float(n_out[-1])
+    z_last = float(np.sum(t))
+    (A, B), (C, D) = _matrix(c, t, n_in, n_out, ns)
+    power_scale = float(np.sum(np.abs((n_out - n_in) * c))) + 1e-300
+    if abs(C) < 1e-9 * power_scale:
+        raise LensError(f"{lens.name}: the lens is afocal (zero power); focal data undefined")
+    phi = -C
+    efl = 1.0 / phi
+    f_obj, f_img = -n0 / phi, nk / phi
+    bfl = -A * nk / C
+    ffl = n0 * D / C
+    z_Fp = z_last + bfl
+    z_F = ffl
+    z_H = z_F - f_obj
+    z_Hp = z_Fp - f_img
+    z_N = z_F + f_img
+    z_Np = z_Fp + f_obj
+
+    # Chief ray: the paraxial ray through the centre of the stop (y_stop = a y1 + b nu1 = 0).
+    a, b, z_E0 = _entrance_pupil(c, t, n_in, n_out, lens.stop_index)
+    if a == 0.0:
+        yc1, nuc1 = 1.0, 0.0  # object-space telecentric: chief ray parallel to the axis
+    else:
+        yc1, nuc1 = -b * n0 / a, n0  # u1 = 1
+    yck, nuck = _trace(c, t, n_in, n_out, yc1, nuc1, ns)
+    uck = nuck / nk
+    z_E0p = math.inf if uck == 0.0 else z_last - yck / uck
+    m_e = (nuc1 / n0) / uck if uck != 0.0 else math.inf
+
+    # Object plane and marginal ray.
+    infinite = math.isinf(od)
+    z_obj = -math.inf if infinite else -od
+    epd = entrance_pupil_diameter(lens, efl, n0, z_E0, z_obj)
+    ym1, num1 = _marginal_start(lens, epd, n0, z_E0, z_obj)
+    stop_radius = abs(a * ym1 + b * num1)
+    ymk, numk = _trace(c, t, n_in, n_out, ym1, num1, ns)
+    umk = numk / nk
+    if math.isinf(z_E0p):
+        xpd = math.inf
+    else:
+        xpd = 2.0 * abs(ymk + umk * (z_E0p - z_last))
+    working_f = math.inf if umk == 0.0 else 1.0 / (2.0 * nk * abs(umk))
+
+    if infinite:
+        s = -math.inf
+        z_gauss = z_Fp
+        m0 = 0.0
+        p0 = -math.inf
+    else:
+        s = z_obj - z_H
+        if abs(umk) < 1e-300:
+            raise LensError(
+                f"{lens.name}: the object is at the front focal point: image at infinity"
+            )
+        z_gauss = z_last - ymk / umk
+        m0 = (num1) / (numk) if numk != 0.0 else math.inf  # n u / n' u' of the marginal ray
+        p0 = z_obj - z_E0
+    # Lagrange invariant for the lens's full field: scale the chief ray to the field.
+    fld = lens.field
+    if fld.kind == "angle":
+        k = math.tan(math.radians(fld.value))  # chief-ray slope in object space
+    else:
+        k = fld.value / (z_obj - z_E0) if not (infinite or math.isinf(z_E0)) else 0.0
+    lagrange = n0 * (k * (nuc1 / n0) * ym1 - (num1 / n0) * k * yc1)
+    return ParaxialResult(
+        efl=efl,
+        f_object=f_obj,
+        f_image=f_img,
+        bfl=bfl,
+        ffl=ffl,
+        z_F=z_F,
+        z_Fp=z_Fp,
+        z_H=z_H,
+        z_Hp=z_Hp,
+        z_N=z_N,
+        z_Np=z_Np,
+        z_E0=z_E0,
+        z_E0p=z_E0p,
+        epd=epd,
+        xpd=xpd,
+        pupil_magnification=xpd / epd,
+        m_e=m_e,
+        lagrange=lagrange,
+        stop_radius=stop_radius,
+        HE0=z_E0 - z_H,
+        HpE0p=z_E0p - z_Hp,
+        object_distance=od,
+        z_object=z_obj,
+        s=s,
+        z_gauss=z_gauss,
+        s_prime_gauss=z_gauss - z_Hp,
+        gaussian_image_distance=z_gauss - z_last,
+        m0=m0,
+        p0=p0,
+        working_fnumber=working_f,
+        z_last=z_last,
+        z_image_file=z_last + lens.surfaces[-1].thickness,
+        n_object=n0,
+        n_image=nk,
+        wavelength=wl,
+    )

@@ -1,0 +1,232 @@
+"""Bulk real-ray traces: any rays through a lens, one kernel call (docs/design.md, "Performance").
+
+Units: millimetres; light travels toward +z with the first vertex at z = 0. A ray is a point and
+a direction (normalised here); it may start anywhere before the first surface (it is a line: it
+is carried to each vertex plane). Every ray gets a status code (:mod:`raytrace.kernels.codes`);
+a failed ray has NaN coordinates and the 1-based number of the surface where it failed.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ..errors import TraceError
+from ..kernels.codes import STATUS_NAMES, STATUS_OK
+from ..lens import Lens
+from ..packing import PackedLens, pack
+
+#: Batches of at least this many rays use the prange kernel (when more than one thread is
+#: allowed). Measured on the 2-core development machine (benchmarks/bench_core.py crossover,
+#: vectorised kernel: serial 1 µs per 20 rays): 2 threads win from ~4k rays when a second core is
+#: free, but when it is busy (other processes) a parallel call waits one scheduler slice (~4 ms).
+#: At 32768 rays the serial kernel takes ~1.6 ms, which bounds that penalty to ~2.5x and costs at
+#: most ~0.8 ms on a quiet machine.
+PARALLEL_THRESHOLD = 32768
+
+#: numba's parallel layer is not re-entrant from several Python threads (workqueue layer): every
+#: parallel kernel launch and thread-count change holds this lock.
+PARALLEL_LOCK = threading.RLock()
+
+
+@dataclass(frozen=True, eq=False)
+class RayBatch:
+    """Result of :func:`trace_rays`: the final segment of each ray.
+
+    x, y, z: point on the last surface (mm); L, M, N: direction cosines after it.
+    status:  int8 status code per ray (:mod:`raytrace.kernels.codes`); surface: int32 1-based
+    surface where the ray failed (0 when OK). Failed rays have NaN coordinates.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    L: np.ndarray
+    M: np.ndarray
+    N: np.ndarray
+    status: np.ndarray
+    surface: np.ndarray
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask of rays with status OK."""
+        return self.status == STATUS_OK
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(n, 3) points on the last surface (mm)."""
+        return np.column_stack((self.x, self.y, self.z))
+
+    @property
+    def directions(self) -> np.ndarray:
+        """(n, 3) unit directions after the last surface."""
+        return np.column_stack((self.L, self.M, self.N))
+
+    def at_plane(self, z_plane: float) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) in mm where each final segment meets the plane z = ``z_plane`` (mm from the first
+        vertex), by analytic transfer; NaN for failed rays."""
+        from ..kernels.bulk import transfer_to_plane
+
+        arrs = (self.x, self.y, self.z, self.L, self.M, self.N)
+        if all(a.ndim == 1 and a.dtype == np.float64 and a.flags.c_contiguous for a in arrs) and (
+            len({a.shape for a in arrs}) == 1
+        ):
+            return transfer_to_plane(*arrs, float(z_plane))  # one pass, no temporaries
+        t = (float(z_plane) - self.z) / self.N
+        return self.x + t * self.L, self.y + t * self.M
+
+    def __len__(self) -> int:
+        return int(self.x.shape[0])
+
+    def __repr__(self) -> str:
+        counts = np.bincount(self.status.astype(np.int64), minlength=len(STATUS_NAMES))
+        parts = [f"{STATUS_NAMES[i]} {int(c)}" for i, c in enumerate(counts) if c]
+        return f"RayBatch({len(self)} rays: {', '.join(parts) or 'none'})"
+
+
+def _columns(a, what: str) -> list[np.ndarray]:
+    """An (n, 3) array or a sequence of three array-likes → three float64 arrays."""
+    if isinstance(a, np.ndarray) and a.ndim == 2:
+        if a.shape[1] != 3:
+            raise TraceError(f"{what} must have shape (n, 3), got {a.shape}")
+        a = a.astype(np.float64, copy=False)
+        return [a[:, 0], a[:, 1], a[:, 2]]
+    if isinstance(a, np.ndarray) and a.ndim == 1 and a.shape[0] == 3 and a.dtype != object:
+        return [np.asarray(v, dtype=np.float64) for v in a]
+    if isinstance(a, Sequence) and len(a) == 3:
+        return [np.asarray(v, dtype=np.float64) for v in a]
+    raise TraceError(f"{what}: expected an (n, 3) array or three arrays/values (x, y, z)")
+
+
+def _f64(a: np.ndarray, n: int) -> np.ndarray:
+    """A contiguous float64 1-D array of length n (one kernel specialisation only); a contiguous
+    float64 input is used without a copy (the structure-of-arrays form of :func:`trace_rays`)."""
+    if a.shape == (n,) and a.dtype == np.float64 and a.flags.c_contiguous:
+        return a
+    return np.array(np.broadcast_to(a, (n,)), dtype=np.float64, order="C")
+
+
+def packed_lens(lens: Lens | PackedLens, wavelength: float | None = None) -> PackedLens:
+    """``lens`` packed at ``wavelength`` (nm); a :class:`PackedLens` is used as it is."""
+    if isinstance(lens, PackedLens):
+        if wavelength is not None and float(wavelength) != lens.wavelength:
+            raise TraceError(
+                f"the packed lens is at {lens.wavelength:g} nm; pack it again for {wavelength} nm"
+            )
+        return lens
+    if not isinstance(lens, Lens):
+        raise TraceError(f"expected a Lens (osc.load_lens) or a PackedLens, got {type(lens)!r}")
+    return pack(lens, wavelength)
+
+
+def trace_rays(
+    lens: Lens | PackedLens,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
+    *,
+    wavelength: float | None = None,
+    clip: bool = True,
+    threads: int | None = None,
+) -> RayBatch:
+    """Trace any rays through ``lens`` and keep their final segments.
+
+    Parameters
+    ----------
+    lens : Lens or PackedLens
+        The lens (packed at ``wavelength``), or an already packed lens.
+    origins, directions : array_like
+        Either (n, 3) arrays or sequences of three array-likes ``(x, y, z)`` / ``(L, M, N)``
+        (structure of arrays, broadcast to one length; the fastest form for millions of rays).
+        Points in mm (first vertex at z = 0), anywhere before the first surface; directions
+        are normalised and must point toward +z.
+    wavelength : float, optional
+        nm; default the lens's wavelength.
+    clip : bool
+        Apply semi-diameters (status CLIPPED outside them).
+    threads : int, optional
+        numba threads for this call; 1 forces the serial kernel. Batches of
+        ``PARALLEL_THRESHOLD`` rays or more use the parallel kernel.
+
+    Returns
+    -------
+    RayBatch
+        Final segments (point on the last surface, direction after it), status per ray.
+    """
+    from ..kernels import bulk
+
+    packed = packed_lens(lens, wavelength)
+    arrs = _columns(origins, "origins") + _columns(directions, "directions")
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in arrs))
+    except ValueError as e:
+        raise TraceError(f"ray arrays do not broadcast to a common shape: {e}") from None
+    if len(shape) > 1:
+        raise TraceError(f"ray arrays must be 1-D (got shape {shape})")
+    n = int(shape[0]) if shape else 1
+    xs = [_f64(a, n) for a in arrs]
+    out = [np.empty(n) for _ in range(6)]
+    st = np.empty(n, dtype=np.int8)
+    sf = np.empty(n, dtype=np.int32)
+    args = (*packed.arrays, bool(clip), *xs, *out, st, sf)
+    if threads is not None and not (1 <= int(threads)):
+        raise TraceError(f"threads must be >= 1, got {threads}")
+    if n < PARALLEL_THRESHOLD or threads == 1:
+        bulk.trace_batch_serial(*args)
+    else:
+        import numba
+
+        with PARALLEL_LOCK:
+            top = numba.config.NUMBA_NUM_THREADS
+            want = top if threads is None else min(int(threads), top)
+            if want == 1:
+                bulk.trace_batch_serial(*args)
+            else:
+                old = numba.get_num_threads()
+                try:
+                    if threads is not None:
+                        numba.set_num_threads(want)
+                    bulk.trace_batch_parallel(*args)
+                finally:
+                    if threads is not None:
+                        numba.set_num_threads(old)
+    return RayBatch(*out, st, sf)
+
+
+@dataclass(frozen=True, eq=False)
+class RayPaths:
+    """Intersection points of each ray with every surface: x, y, z of shape (n_rays, n_surfaces)
+    in mm (NaN after a failure), with status and failed surface per ray as in :class:`RayBatch`."""
+
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    status: np.ndarray
+    surface: np.ndarray
+
+
+def ray_paths(
+    lens: Lens | PackedLens,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
+    *,
+    wavelength: float | None = None,
+    clip: bool = False,
+) -> RayPaths:
+    """Trace a few rays (same inputs as :func:`trace_rays`) and keep every surface intersection —
+    for layout drawings and checks. Serial: tens of rays, not millions."""
+    from ..kernels.paths import trace_paths
+
+    packed = packed_lens(lens, wavelength)
+    arrs = [np.atleast_1d(a) for a in _columns(origins, "origins") + _columns(directions, "dirs")]
+    n = int(np.broadcast_shapes(*(a.shape for a in arrs))[0])
+    xs = [np.ascontiguousarray(np.broadcast_to(a, (n,)), dtype=np.float64) for a in arrs]
+    ns = packed.n_surfaces
+    px, py, pz = (np.empty((n, ns)) for _ in range(3))
+    st = np.empty(n, dtype=np.int8)
+    sf = np.empty(n, dtype=np.int32)
+    trace_paths(*packed.arrays, bool(clip), *xs, px, py, pz, st, sf)
+    return RayPaths(px, py, pz, st, sf)
