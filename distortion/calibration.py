@@ -193,6 +193,16 @@ class CalibrationResult:
     def symbol(self) -> str:
         return self.curve.symbol
 
+    def __repr__(self) -> str:
+        at = f" at {', '.join(f'{a:g}' for a in self.at)}" if self.at else ""
+        unit = "" if self.curve.finite else " mm"
+        s = self.symbol
+        return (
+            f"CalibrationResult({self.method}{at}: {s}_c = {self.Kc:.6f}{unit}, "
+            f"{s}0 = {self.K0:.6f}{unit}, max |D_c| = {self.Dc_max_abs:.6g} mm, "
+            f"D_rc on the axis = {100 * self.Drc_axis:+.4f} %)"
+        )
+
     @property
     def K0(self) -> float:
         return self.curve.constant

@@ -60,6 +60,9 @@ from .curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 
 REFERENCES = ("characteristic", "distortion-focal-length", "real-chief-transport")
 DFL_EPSILON = 1e-3  # near-axis reference field as a fraction of the largest |field|
+#: what a chromatic distortion is measured against: the reference wavelength's constants, or
+#: each wavelength's own (``characteristic_distortion(..., wavelengths=..., scale=...)``)
+SCALES = ("reference", "own")
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,6 +79,12 @@ class CharacteristicDistortion:
     gaussian_constant: f or m0.  y0p, yp, D0 (p, n) in mm; Dr (p, n) a fraction (0 on the axis).
     status (n,): trace status per field (``raytrace.trace.STATUS_*``); NaN values where not OK.
     paraxial: the ``ParaxialResult`` used.
+    lens, clip: the lens traced and whether its semi-diameters clipped the chief rays, kept so
+    that :meth:`retrace` can trace the same setting at other fields (e.g. densely for a plot).
+    wavelength: the traced wavelength (nm). scale_basis: ``""`` for a single-wavelength call
+    (everything at ``wavelength``); in a :class:`ChromaticDistortion`, ``"reference"`` when
+    ``paraxial`` (so F0/M0, s', the Gaussian plane) is the lens's reference wavelength's, or
+    ``"own"`` when it is the traced wavelength's.
     """
 
     name: str
@@ -98,6 +107,10 @@ class CharacteristicDistortion:
     Dr: np.ndarray
     status: np.ndarray
     paraxial: ParaxialResult
+    lens: Lens | None = None
+    clip: bool = True
+    wavelength: float = math.nan
+    scale_basis: str = ""
 
     @property
     def finite(self) -> bool:
@@ -152,7 +165,27 @@ class CharacteristicDistortion:
             plane=self.plane_label(i),
             source=f"traced; reference {self.reference}",
             decimals=4,
+            extra={"traced": self, "plane": i},
         )
+
+    def retrace(self, fields: npt.ArrayLike) -> CharacteristicDistortion:
+        """The same lens, object, image planes, reference, wavelength and clipping at other
+        ``fields`` (same kind and unit as :attr:`fields`: degrees, or mm for object heights) —
+        one more trace, e.g. at many fields for a smooth plot."""
+        if self.lens is None:
+            raise TraceError("this distortion result carries no lens to trace again")
+        f = {"object_heights_mm" if self.field_kind == HEIGHT else "fields_deg": fields}
+        kw = dict(
+            from_last_vertex=self.from_last_vertex,
+            object_distance=self.object_distance,
+            reference=self.reference,
+            clip=self.clip,
+        )
+        if self.scale_basis:  # a member of a ChromaticDistortion: the same scale again
+            return characteristic_distortion(
+                self.lens, **f, **kw, wavelengths=[self.wavelength], scale=self.scale_basis
+            )[0]
+        return characteristic_distortion(self.lens, **f, **kw, wavelength=self.paraxial.wavelength)
 
 
 def characteristic_distortion(
@@ -168,9 +201,11 @@ def characteristic_distortion(
     object_s: float | None = None,
     object_scale: float | None = None,
     reference: str = "characteristic",
-    wavelength: float | None = None,
+    wavelength: float | str | None = None,
+    wavelengths: npt.ArrayLike | str | None = None,
+    scale: str = "reference",
     clip: bool = True,
-) -> CharacteristicDistortion:
+) -> CharacteristicDistortion | ChromaticDistortion:
     """Distortion of ``lens`` at the given fields in one or more image planes (Pestrecov 1958,
     Eqs. 8–9; the module docstring defines the three references).
 
@@ -195,15 +230,27 @@ def characteristic_distortion(
     reference : {"characteristic", "distortion-focal-length", "real-chief-transport"}
         The reference the ideal image is measured from (module docstring).
     wavelength : float, optional
-        nm; default the lens's.
+        nm; default the lens's reference wavelength. The lens is analysed as a monochromatic
+        lens at this wavelength: paraxial data, the Gaussian plane and F0/M0 at this wavelength.
+    wavelengths : sequence of float or "lens", optional
+        Several wavelengths (nm) from one kernel call (``"lens"``: the lens's own); returns a
+        :class:`ChromaticDistortion`. The object and the image planes are resolved at the lens's
+        reference wavelength, so every wavelength is measured in the same physical planes for
+        the same object points. Give ``wavelength`` or ``wavelengths``, not both.
+    scale : {"reference", "own"}
+        With ``wavelengths``: ``"reference"`` (default) measures every wavelength's distortion
+        against the reference wavelength's F0/M0 (one camera constant for all colour channels,
+        as a calibration sees it); ``"own"`` against each wavelength's own F0/M0 (its own
+        paraxial data, principal points and Gaussian plane; the planes stay where they are).
     clip : bool
         Apply the lens's semi-diameters to the chief rays.
 
     Returns
     -------
-    CharacteristicDistortion
-        Arrays (planes × fields) of y0', y', D0 (mm) and Dr (fraction); a field the lens cannot
-        pass has a status code and NaN values.
+    CharacteristicDistortion or ChromaticDistortion
+        Arrays (planes × fields) of y0', y', D0 (mm) and Dr (fraction); with ``wavelengths``
+        one such result per wavelength and stacked arrays (wavelengths × planes × fields). A
+        field the lens cannot pass has a status code and NaN values.
 
     Raises
     ------
@@ -211,22 +258,28 @@ def characteristic_distortion(
         For impossible requests (a plane before the last vertex, heights with an object at
         infinity, an unknown reference, ...).
     """
-    from raytrace.paraxial import ideal_heights, image_planes, paraxial, plane_z
+    from raytrace.paraxial import image_planes, paraxial, plane_z
     from raytrace.paraxial import resolve_object_distance
-    from raytrace.trace import STATUS_OK, aim
+    from raytrace.trace import aim
 
     if reference not in REFERENCES:
         raise TraceError(
             f"unknown distortion reference {reference!r}; expected one of {', '.join(REFERENCES)}"
         )
+    if scale not in SCALES:
+        raise TraceError(f"unknown scale {scale!r}; expected one of {', '.join(SCALES)}")
+    chromatic = wavelengths is not None
+    if chromatic and wavelength is not None:
+        raise TraceError("give wavelength= or wavelengths=, not both")
+    wl = None if chromatic else _wavelength(wavelength)
     od = resolve_object_distance(
         lens,
         object_distance=object_distance,
         object_s=object_s,
         object_scale=object_scale,
-        wavelength=wavelength,
+        wavelength=wl,
     )
-    par = paraxial(lens, object_distance=od, wavelength=wavelength)
+    par = paraxial(lens, object_distance=od, wavelength=wl)
     if fields_deg is not None and object_heights_mm is not None:
         raise TraceError("give fields_deg or object_heights_mm, not both")
     if object_heights_mm is not None:
@@ -245,19 +298,74 @@ def characteristic_distortion(
         raise TraceError("object heights need a finite object distance")
     kind = ANGLE if infinite else (HEIGHT if fk == "height" else NOMINAL_ANGLE)
     x = orthoscopy_abscissa(par, f, fk)
-    yobj = np.full(f.shape, np.nan) if kind == ANGLE else x
-    planes = image_planes(plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus)
+    planes = image_planes(
+        plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus
+    )
     z = plane_z(par, planes)
-    sp = np.asarray(par.s_prime_of(z), dtype=float)
-    K0 = np.array([pestrecov_constants(par, float(v)).scale for v in sp])
-    KG = par.efl if infinite else par.m0
 
     extra = np.empty(0)
     if reference == "distortion-focal-length":
         fmax = float(np.max(np.abs(f)))
         eps = DFL_EPSILON * (fmax if fmax > 0 else 1.0)
         extra = np.array([eps, 2.0 * eps])
-    cr = aim(lens, np.concatenate([f, extra]), fk, par.object_distance, wavelength, clip)
+    ff = np.concatenate([f, extra])
+    common = dict(
+        lens=lens, reference=reference, fk=fk, kind=kind, f=f, x=x, z=z, extra=extra, clip=clip
+    )
+    if not chromatic:
+        cr = aim(lens, ff, fk, par.object_distance, wl, clip)
+        return _build(par=par, cr=cr, cr_scale=cr, basis="", **common)
+
+    from raytrace.trace.chief import resolve_wavelengths
+
+    wls = resolve_wavelengths(lens, wavelengths)
+    ref = float(lens.wavelength)
+    traced = wls if (ref in wls or scale == "own") else (*wls, ref)
+    crs = aim(lens, ff, fk, par.object_distance, clip=clip, wavelengths=traced)
+    cr_ref = crs.at(ref) if ref in traced else None
+    results = []
+    for i, w in enumerate(wls):
+        if scale == "reference":
+            p_i, cs = par, cr_ref
+        else:
+            p_i = paraxial(lens, object_distance=par.object_distance, wavelength=w)
+            cs = crs[i]
+        results.append(_build(par=p_i, cr=crs[i], cr_scale=cs, basis=scale, **common))
+    return ChromaticDistortion(
+        wavelengths=np.array(wls, dtype=float),
+        reference_wavelength=ref,
+        scale=scale,
+        results=tuple(results),
+        reference_paraxial=par,
+    )
+
+
+def _wavelength(value) -> float | None:
+    """A wavelength keyword (nm) through the one check, :func:`raytrace.units.wavelength_nm`."""
+    if value is None:
+        return None
+    from raytrace.units import UnitError, wavelength_nm
+
+    try:
+        return wavelength_nm(value)
+    except UnitError as e:
+        raise TraceError(str(e)) from None
+
+
+def _build(
+    *, lens, par, cr, cr_scale, basis, reference, fk, kind, f, x, z, extra, clip
+) -> CharacteristicDistortion:
+    """One wavelength's distortion from its traced chief rays ``cr`` (fields then the ``extra``
+    near-axis fields), measured against the constants of ``par`` (and, for the
+    distortion-focal-length reference, the near-axis rays of ``cr_scale``)."""
+    from raytrace.paraxial import ideal_heights
+    from raytrace.trace import STATUS_OK
+
+    infinite = par.infinite
+    yobj = np.full(f.shape, np.nan) if kind == ANGLE else x
+    sp = np.asarray(par.s_prime_of(z), dtype=float)
+    K0 = np.array([pestrecov_constants(par, float(v)).scale for v in sp])
+    KG = par.efl if infinite else par.m0
     n = f.size
     status = cr.status[:n].copy()
     ok = status == STATUS_OK
@@ -268,13 +376,14 @@ def characteristic_distortion(
         scale = K0.copy()
         y0p = ideal_heights(par, x, sp)
     elif reference == "distortion-focal-length":
-        if not np.all(cr.status[n:] == STATUS_OK):
+        if not np.all(cr_scale.status[n:] == STATUS_OK):
             raise TraceError(
                 "the near-axis reference chief ray for the distortion focal length failed"
             )
+        Hs = np.atleast_2d(cr_scale.heights_at(z))
         xe = orthoscopy_abscissa(par, extra, fk)
-        k1 = H[:, n] / xe[0]
-        k2 = H[:, n + 1] / xe[1]
+        k1 = Hs[:, n] / xe[0]
+        k2 = Hs[:, n + 1] / xe[1]
         scale = (4.0 * k1 - k2) / 3.0
         y0p = scale[:, None] * x[None, :]
     else:  # real-chief-transport
@@ -307,4 +416,91 @@ def characteristic_distortion(
         Dr=Dr,
         status=status,
         paraxial=par,
+        lens=lens,
+        clip=bool(clip),
+        wavelength=float(cr.wavelength),
+        scale_basis=basis,
     )
+
+
+@dataclass(frozen=True, eq=False)
+class ChromaticDistortion:
+    """Characteristic distortion at several wavelengths, from one kernel call (wavelength ×
+    field), in the same physical image planes and for the same object points.
+
+    wavelengths (w,): nm, as asked for; reference_wavelength: the lens's reference (nm);
+    scale: ``"reference"`` — every wavelength measured against the reference wavelength's F0/M0
+    (and, for the other definitions, its paraxial data / near-axis scale), as one camera constant
+    for all colour channels — or ``"own"`` — each wavelength against its own (SCALES).
+    results: one :class:`CharacteristicDistortion` per wavelength (its ``wavelength`` and
+    ``scale_basis`` say which). reference_paraxial: the reference wavelength's paraxial data (the
+    object and the planes were resolved with it).
+
+    Stacked arrays: ``yp``, ``y0p``, ``D0``, ``Dr`` (w, planes, fields); ``constant``, ``scale``
+    (w, planes); ``status`` (w, fields).
+    """
+
+    wavelengths: np.ndarray
+    reference_wavelength: float
+    scale: str
+    results: tuple[CharacteristicDistortion, ...]
+    reference_paraxial: ParaxialResult
+
+    def __getitem__(self, i: int) -> CharacteristicDistortion:
+        return self.results[i]
+
+    def __iter__(self):
+        return iter(self.results)
+
+    @property
+    def n_wavelengths(self) -> int:
+        return len(self.results)
+
+    def at(self, wavelength: float) -> CharacteristicDistortion:
+        """The result at ``wavelength`` (nm; one of :attr:`wavelengths`)."""
+        hit = np.nonzero(self.wavelengths == float(wavelength))[0]
+        if hit.size == 0:
+            raise TraceError(
+                f"{wavelength:g} nm is not one of the wavelengths "
+                f"({', '.join(f'{w:g}' for w in self.wavelengths)} nm)"
+            )
+        return self.results[int(hit[0])]
+
+    def _stack(self, name: str) -> np.ndarray:
+        return np.stack([getattr(r, name) for r in self.results])
+
+    name = property(lambda self: self.results[0].name)
+    reference = property(lambda self: self.results[0].reference)
+    field_kind = property(lambda self: self.results[0].field_kind)
+    fields = property(lambda self: self.results[0].fields)
+    x = property(lambda self: self.results[0].x)
+    object_distance = property(lambda self: self.results[0].object_distance)
+    z_planes = property(lambda self: self.results[0].z_planes)
+    yp = property(lambda self: self._stack("yp"))
+    y0p = property(lambda self: self._stack("y0p"))
+    D0 = property(lambda self: self._stack("D0"))
+    Dr = property(lambda self: self._stack("Dr"))
+    constant = property(lambda self: self._stack("constant"))
+    status = property(lambda self: self._stack("status"))
+
+    @property
+    def scale_description(self) -> str:
+        """One line saying which constants the distortion is measured against."""
+        sym = self.results[0].symbol + "0"
+        if self.scale == "reference":
+            return (
+                f"every wavelength against the reference wavelength's {sym} "
+                f"({self.reference_wavelength:g} nm)"
+            )
+        return f"each wavelength against its own {sym}"
+
+    def __repr__(self) -> str:
+        wl = ", ".join(f"{w:g}" for w in self.wavelengths)
+        with np.errstate(invalid="ignore"):
+            D0 = self.D0
+            worst = float(np.nanmax(np.abs(D0))) if np.isfinite(D0).any() else math.nan
+        return (
+            f"ChromaticDistortion({self.name!r}, {self.fields.size} fields x "
+            f"{self.n_wavelengths} wavelengths [{wl}] nm, scale {self.scale} "
+            f"(reference {self.reference_wavelength:g} nm), max |D0| = {worst:.6g} mm)"
+        )

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .camera.models import radial_polynomial, scale_radial_coefficients
 from .errors import DataError
 
 _RADIUS = ("measured", "ideal")
@@ -75,12 +76,10 @@ class RadialFit:
 
 
 def evaluate_radial(k0: float, k: Sequence[float], r_mm: np.ndarray) -> np.ndarray:
-    """δr (mm) = K0 r + Σ K_i r^(2i+1) at r (mm)."""
+    """δr (mm) = K0 r + Σ K_i r^(2i+1) at r (mm) (the even series of
+    :func:`distortion.camera.models.radial_polynomial` times r)."""
     r = np.asarray(r_mm, dtype=float)
-    out = k0 * r
-    for i, ki in enumerate(k, start=1):
-        out = out + ki * r ** (2 * i + 1)
-    return out
+    return r * (k0 + radial_polynomial(tuple(k), r * r))
 
 
 def fit_radial(
@@ -186,14 +185,14 @@ def brown_to_opencv(k: Sequence[float], c_mm: float) -> tuple[float, ...]:
     """Gaussian K_i (mm^-2i, ideal radius) → OpenCV k_i = K_i c^(2i) (c = principal distance mm)."""
     if not c_mm > 0:
         raise DataError(f"principal distance must be positive, got {c_mm!r}")
-    return tuple(ki * c_mm ** (2 * i) for i, ki in enumerate(k, start=1))
+    return scale_radial_coefficients(k, c_mm)
 
 
 def opencv_to_brown(kcv: Sequence[float], c_mm: float) -> tuple[float, ...]:
     """OpenCV k_i → Gaussian K_i = k_i / c^(2i) (inverse of :func:`brown_to_opencv`)."""
     if not c_mm > 0:
         raise DataError(f"principal distance must be positive, got {c_mm!r}")
-    return tuple(ki / c_mm ** (2 * i) for i, ki in enumerate(kcv, start=1))
+    return scale_radial_coefficients(kcv, 1.0 / c_mm)
 
 
 @dataclass(frozen=True, eq=False)

@@ -93,7 +93,7 @@ def read_distortion_table(
     where = str(path)
     if text is None:
         try:
-            text = Path(path).read_text(encoding="utf-8")
+            text = Path(path).read_text(encoding="utf-8-sig")
         except OSError as exc:
             raise DataError(f"{where}: cannot read distortion table ({exc.strerror})") from None
         except UnicodeDecodeError:

@@ -50,6 +50,10 @@ _API: dict[str, str] = {
     "ChiefRays": "raytrace.trace",
     "trace_rays": "raytrace.trace",
     "RayBatch": "raytrace.trace",
+    "ray_fan": "raytrace.trace",
+    "RayFan": "raytrace.trace",
+    "spot_diagram": "raytrace.trace",
+    "SpotDiagram": "raytrace.trace",
     # distortion (Pestrecov 1958)
     "characteristic_distortion": "distortion.characteristic",
     "CharacteristicDistortion": "distortion.characteristic",
@@ -92,6 +96,7 @@ __all__ = sorted([*_API, "__version__"])
 
 
 def _version() -> str:
+    """The installed distribution's version (read on first use: importlib.metadata is slow)."""
     try:
         from importlib.metadata import PackageNotFoundError, version
     except ImportError:  # pragma: no cover
@@ -102,10 +107,11 @@ def _version() -> str:
         return "0+unknown"
 
 
-__version__ = _version()
-
-
 def __getattr__(name: str) -> Any:
+    if name == "__version__":
+        v = _version()
+        globals()["__version__"] = v
+        return v
     mod = _API.get(name)
     if mod is None:
         raise AttributeError(f"module 'orthoscope' has no attribute {name!r}")
@@ -140,7 +146,16 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from raytrace.materials import Material, fixed_index, model_glass
     from raytrace.optimize import optimize, read_spec
     from raytrace.paraxial import ImagePlane, ParaxialResult, paraxial, pestrecov_constants
-    from raytrace.trace import ChiefRays, RayBatch, chief_rays, trace_rays
+    from raytrace.trace import (
+        ChiefRays,
+        RayBatch,
+        RayFan,
+        SpotDiagram,
+        chief_rays,
+        ray_fan,
+        spot_diagram,
+        trace_rays,
+    )
 
     from .plots.distortion import (
         plot_calibrated,

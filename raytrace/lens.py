@@ -62,6 +62,19 @@ class Surface:
             return KIND_PLANE
         return KIND_QUADRIC
 
+    def __repr__(self) -> str:
+        r = "inf" if self.curvature == 0.0 else f"{1.0 / self.curvature:.6g}"
+        parts = [f"r={r}", f"t={self.thickness:.6g}", self.material.describe()]
+        if math.isfinite(self.semi_diameter):
+            parts.append(f"sd={self.semi_diameter:.6g}")
+        if self.conic:
+            parts.append(f"k={self.conic:.6g}")
+        if any(self.aspheric):
+            parts.append(f"asph={len(self.aspheric)} terms")
+        if self.stop:
+            parts.append("stop")
+        return f"Surface({', '.join(parts)})"
+
     def sag(self, r: float | np.ndarray) -> float | np.ndarray:
         """Surface sag z(r) in mm (see module docstring); NaN where the quadric is undefined."""
         r2 = np.asarray(r, dtype=float) ** 2
@@ -109,9 +122,18 @@ class Lens:
     object_distance: axial distance (mm) from the object plane to the first vertex, a *positive
         magnitude* for a real object on the left; ``math.inf`` for an object at infinity.
         (Pestrecov's signed ``s`` is measured from H and is negative: see ``raytrace.paraxial``.)
-    wavelength:      design wavelength, nm.
+    wavelength:      the reference (primary) wavelength, nm: paraxial data, solves and every
+        single-wavelength call use it unless told otherwise (``Lens.reference_wavelength``).
     image_solve:     ``"gaussian"`` when the last thickness was solved to put the image plane at the
-        paraxial (Gaussian) image of the file's object; ``None`` when it was given as a number.
+        paraxial (Gaussian) image of the file's object (at the reference wavelength); ``None``
+        when it was given as a number.
+    wavelengths:     the lens's wavelengths (nm; .zmx ``WAVM``, .seq ``WL``), the reference among
+        them; ``()`` means ``(wavelength,)``. weights: one per wavelength (``()`` → all 1).
+    temperature_c, pressure_atm: the system environment (.zmx ``ENVD``): catalog glasses are
+        evaluated relative to the air at these conditions through Schott's dn/dT model
+        (:func:`raytrace.glass.thermal.index_at`); ``None`` = each catalog material at its own
+        reference conditions (the vendor catalogs: 20 °C, 1 atm). Model glasses and fixed indices
+        are not changed.
     """
 
     name: str
@@ -126,9 +148,37 @@ class Lens:
     object_material: Material = AIR
     image_solve: str | None = None
     path: str | None = field(default=None, compare=False)
+    wavelengths: tuple[float, ...] = ()
+    weights: tuple[float, ...] = ()
+    temperature_c: float | None = None
+    pressure_atm: float | None = None
 
     def __post_init__(self) -> None:
+        _normalize_wavelengths(self)
         validate(self)
+
+    def __repr__(self) -> str:
+        ap = {"fnumber": "f/{:g}", "epd": "EPD {:g} mm", "na": "NA {:g}"}[self.aperture.kind]
+        fld = "{:g} deg" if self.field.kind == "angle" else "{:g} mm"
+        obj = (
+            "object at infinity"
+            if math.isinf(self.object_distance)
+            else f"object {self.object_distance:g} mm"
+        )
+        return (
+            f"Lens({self.name!r}: {self.n_surfaces} surfaces, stop {self.stop_index + 1}, "
+            f"{ap.format(self.aperture.value)}, field {fld.format(self.field.value)}, {obj})"
+        )
+
+    def __str__(self) -> str:
+        from .listing import format_prescription
+
+        return format_prescription(self)
+
+    def _repr_html_(self) -> str:
+        from .listing import html_prescription
+
+        return html_prescription(self)
 
     @property
     def stop_index(self) -> int:
@@ -158,6 +208,66 @@ class Lens:
     @property
     def image_material(self) -> Material:
         return self.surfaces[-1].material
+
+    @property
+    def reference_wavelength(self) -> float:
+        """The reference (primary) wavelength, nm (= ``wavelength``)."""
+        return self.wavelength
+
+    @property
+    def environment(self) -> tuple[float, float] | None:
+        """(temperature °C, pressure atm) the lens states, or None (catalog conditions)."""
+        if self.temperature_c is None and self.pressure_atm is None:
+            return None
+        t = 20.0 if self.temperature_c is None else float(self.temperature_c)
+        p = 1.0 if self.pressure_atm is None else float(self.pressure_atm)
+        return t, p
+
+    def with_wavelengths(
+        self,
+        wavelengths,
+        weights=None,
+        reference: float | None = None,
+    ) -> Lens:
+        """A copy with other wavelengths (nm), weights (default all 1) and reference wavelength
+        (default: the current reference if it is among them, else the first)."""
+        wl = tuple(float(w) for w in np.atleast_1d(np.asarray(wavelengths, dtype=float)))
+        if not wl:
+            raise LensError(f"{self.name}: give at least one wavelength")
+        ref = reference
+        if ref is None:
+            ref = self.wavelength if self.wavelength in wl else wl[0]
+        w = () if weights is None else tuple(float(x) for x in weights)
+        return replace(self, wavelengths=wl, weights=w, wavelength=float(ref))
+
+    def indices(self, wavelengths=None) -> np.ndarray:
+        """Refractive indices at ``wavelengths`` (nm; a number or a sequence; default the
+        reference wavelength): array (n_wavelengths, n_surfaces + 1) — column 0 the object space,
+        column j + 1 the medium after surface j. The one place indices of a lens are computed
+        (packing and paraxial optics use it). Catalog glasses are relative to the air of the
+        lens's environment (``temperature_c``, ``pressure_atm``; see the class docstring)."""
+        from .units import wavelength_nm
+
+        raw = self.wavelength if wavelengths is None else wavelengths
+        wl = np.array(
+            [wavelength_nm(float(w)) for w in np.atleast_1d(np.asarray(raw, dtype=float))]
+        )
+        env = self.environment
+        mats = [self.object_material, *(s.material for s in self.surfaces)]
+        out = np.empty((wl.size, len(mats)))
+        done: dict[Material, np.ndarray] = {}
+        for j, m in enumerate(mats):
+            n = done.get(m)
+            if n is None:
+                if env is not None and m.kind == "catalog":
+                    from .glass.thermal import index_at
+
+                    n = np.asarray(index_at(m, wl, env[0], env[1]), dtype=float)
+                else:
+                    n = np.asarray(m.index(wl), dtype=float)
+                done[m] = n
+            out[:, j] = n
+        return out
 
     def with_image_distance(self, thickness: float) -> Lens:
         """A copy whose last thickness (last vertex to image plane) is ``thickness``."""
@@ -199,6 +309,14 @@ class Lens:
         )
 
 
+def _normalize_wavelengths(lens: Lens) -> None:
+    """``wavelengths=()`` → ``(wavelength,)``; ``weights=()`` → all 1; numbers as floats."""
+    wl = tuple(float(w) for w in lens.wavelengths) or (float(lens.wavelength),)
+    w = tuple(float(x) for x in lens.weights) or (1.0,) * len(wl)
+    object.__setattr__(lens, "wavelengths", wl)
+    object.__setattr__(lens, "weights", w)
+
+
 def validate(lens: Lens) -> None:
     """Check what a lens needs to be traceable; raise :class:`LensError` naming the surface."""
     if not lens.surfaces:
@@ -227,8 +345,32 @@ def validate(lens: Lens) -> None:
             f"{lens.name}: object distance must be positive (a magnitude from the object plane to "
             f"the first vertex) or inf, got {lens.object_distance}"
         )
-    if not (math.isfinite(lens.wavelength) and 200.0 <= lens.wavelength <= 20000.0):
-        raise LensError(f"{lens.name}: wavelength must be in nm (200-20000), got {lens.wavelength}")
+    from .units import UnitError, wavelength_nm
+
+    try:
+        for w in (lens.wavelength, *lens.wavelengths):
+            wavelength_nm(w)
+    except UnitError as e:
+        raise LensError(f"{lens.name}: {e}") from None
+    if lens.wavelength not in lens.wavelengths:
+        raise LensError(
+            f"{lens.name}: the reference wavelength {lens.wavelength:g} nm is not among the "
+            f"wavelengths {', '.join(f'{w:g}' for w in lens.wavelengths)} nm; use "
+            "lens.with_wavelengths(...) to change them together"
+        )
+    if len(lens.weights) != len(lens.wavelengths) or not all(
+        math.isfinite(w) and w >= 0.0 for w in lens.weights
+    ):
+        raise LensError(
+            f"{lens.name}: give one non-negative weight per wavelength "
+            f"({len(lens.wavelengths)} wavelengths, {len(lens.weights)} weights)"
+        )
+    for what in ("temperature_c", "pressure_atm"):
+        v = getattr(lens, what)
+        if v is not None and not math.isfinite(v):
+            raise LensError(f"{lens.name}: {what} must be a finite number or None, got {v}")
+    if lens.pressure_atm is not None and lens.pressure_atm < 0.0:
+        raise LensError(f"{lens.name}: pressure_atm must not be negative, got {lens.pressure_atm}")
     if not (math.isfinite(lens.aperture.value) and lens.aperture.value > 0.0):
         raise LensError(f"{lens.name}: aperture {lens.aperture.kind} must be positive")
     if lens.aperture.kind == "na" and not math.isfinite(lens.object_distance):
@@ -239,3 +381,43 @@ def validate(lens: Lens) -> None:
         raise LensError(f"{lens.name}: field angle must be below 90 degrees")
     if lens.field.kind == "height" and not math.isfinite(lens.object_distance):
         raise LensError(f"{lens.name}: an object-height field needs a finite object distance")
+    check_physical(lens)
+
+
+def check_physical(lens: Lens) -> None:
+    """What every reader must refuse, whatever the file format (one validation for all): glass
+    of zero thickness, a refractive index below 1, a semi-diameter beyond the surface's sag
+    (|sd| ≥ |R| for a sphere), and consecutive surfaces that cross inside their semi-diameters.
+    Raises :class:`LensError` naming the surface (1-based) and the fix."""
+    n = len(lens.surfaces)
+    for i, s in enumerate(lens.surfaces, start=1):
+        m = s.material
+        if m.kind in ("index", "model") and m.nd < 1.0:
+            raise LensError(
+                f"{lens.name}: surface {i}: refractive index {m.nd:g} is below 1; give the index "
+                "of the medium after the surface (air is 1)"
+            )
+        if i < n and s.thickness == 0.0 and not m.is_air:
+            raise LensError(
+                f"{lens.name}: surface {i}: the glass after it has zero thickness; give its "
+                "centre thickness (mm)"
+            )
+        if math.isfinite(s.semi_diameter) and s.curvature != 0.0:
+            if 1.0 - (1.0 + s.conic) * (s.curvature * s.semi_diameter) ** 2 <= 0.0:
+                raise LensError(
+                    f"{lens.name}: surface {i}: semi-diameter {s.semi_diameter:g} mm reaches "
+                    f"beyond the surface (radius {s.radius:g} mm, conic {s.conic:g}); reduce sd"
+                )
+    for i in range(n - 1):
+        a, b = lens.surfaces[i], lens.surfaces[i + 1]
+        if not (math.isfinite(a.semi_diameter) and math.isfinite(b.semi_diameter)):
+            continue
+        h = np.linspace(0.0, min(a.semi_diameter, b.semi_diameter), 33)
+        gap = a.thickness + b.sag(h) - a.sag(h)
+        j = int(np.argmin(gap))
+        if gap[j] < 0.0:
+            raise LensError(
+                f"{lens.name}: surface {i + 1}: surfaces {i + 1} and {i + 2} cross inside their "
+                f"semi-diameters (axial gap {gap[j]:.6g} mm at height {h[j]:.6g} mm); increase "
+                "the thickness or reduce the semi-diameters"
+            )

@@ -249,3 +249,11 @@ def test_binary_garbage_lens_file(tmp_path, capsys):
     f.write_bytes(bytes(range(256)) * 4)
     rc, out, err = run(capsys, "paraxial", str(f))
     assert rc == 2 and "garbage.toml" in err and "Traceback" not in err
+
+
+def test_cli_choices_equal_the_science_constants():
+    from distortion.calibration import METHODS
+    from distortion.characteristic import REFERENCES
+    from orthoscope.cli import common
+
+    assert common.METHODS == METHODS and common.REFERENCES == REFERENCES

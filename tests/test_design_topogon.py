@@ -20,7 +20,7 @@ from distortion.calibration import calibrate
 from distortion.characteristic import characteristic_distortion
 from distortion.tablefile import read_distortion_table
 from raytrace.files.library import load_lens
-from raytrace.optimize import evaluate, merit, optimize, read_spec, start_lens
+from raytrace.optimize import apply, evaluate, merit, optimize, read_spec
 from raytrace.paraxial import paraxial
 
 DATA = Path(__file__).parent / "data"
@@ -78,9 +78,20 @@ def test_lens_is_four_menisci_about_a_central_stop(lens):
         assert s[i].thickness >= 0.1
 
 
-@pytest.mark.slow
-def test_spec_reproduces_shipped_merit(lens):
+def test_optimizer_converges_back_from_a_perturbed_start(lens):
+    """The spec's optimizer problem has the shipped lens at its minimum: from a start perturbed by
+    2e-4 (relative) in every variable, damped least squares returns to the shipped merit
+    (regression pin: the shipped merit; the full design run from the patent start lens takes
+    about 2 minutes and is described in lenses/specs/topogon-like-pestrecov.toml)."""
+    from dataclasses import replace
+
+    from raytrace.optimize.solver import get_value
+
     spec = read_spec(SPEC)
     shipped = merit(evaluate(lens, spec.operands))
-    res = optimize(start_lens(spec), spec)
-    assert res.merit == pytest.approx(shipped, rel=0.01)
+    x = np.array([get_value(lens, v.kind, v.surface) for v in spec.variables])
+    signs = np.where(np.arange(x.size) % 2 == 0, 1.0, -1.0)
+    start = apply(lens, spec, x * (1.0 + 2e-4 * signs))
+    assert merit(evaluate(start, spec.operands)) > 10 * shipped
+    res = optimize(start, replace(spec, max_evaluations=400, merit_goal=None))
+    assert res.merit <= 1.05 * shipped

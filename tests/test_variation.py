@@ -336,7 +336,7 @@ def test_plots_written(tmp_path):
     assert "µm" in fig1.axes[0].get_ylabel()
     labels = [t.get_text() for t in fig1.axes[0].get_legend().get_texts()]
     assert "8×(12×)" in labels and "12×" in labels
-    assert "g_ss'" in fig2.axes[0].get_ylabel()
+    assert "g_{ss'}" in fig2.axes[0].get_ylabel()
 
 
 # --------------------------------------------------------------------------------------------

@@ -15,17 +15,23 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 from collections.abc import Sequence
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
 
+#: subcommands that never run a numba kernel (no "compiling" notice for them)
+NO_KERNELS = {"lenses", "prescription", "paraxial", "calibrate", "convert", "glass"}
+
 #: The subcommands, in the order ``orthoscope --help`` lists them (module names in this package).
 COMMANDS: tuple[str, ...] = (
     "lenses",
+    "prescription",
     "paraxial",
     "trace",
+    "fan",
     "distortion",
     "calibrate",
     "compensate",
@@ -42,8 +48,62 @@ def _version() -> str:
     return __version__
 
 
+class HelpFormatter(argparse.HelpFormatter):
+    """Help with the defaults shown (where there is one) and text with line breaks (the examples
+    of an epilog) kept as written; other paragraphs are wrapped."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        h = action.help or ""
+        d = action.default
+        if d in (None, False, argparse.SUPPRESS, []) or "default" in h.lower():
+            return h
+        return h + " (default: %(default)s)"
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        if "\n" in text:
+            return "".join(indent + line for line in text.splitlines(keepends=True))
+        return super()._fill_text(text, width, indent)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors: ``PROG: error: WHAT (see PROG --help)``, exit status 2, and
+    defaults shown in the help."""
+
+    def __init__(self, *args, **kw) -> None:
+        kw["formatter_class"] = HelpFormatter
+        super().__init__(*args, **kw)
+
+    def error(self, message: str):  # type: ignore[override]
+        import difflib
+        import re
+
+        m = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if m:
+            choices = re.findall(r"'([^']*)'", m.group(2))
+            close = difflib.get_close_matches(m.group(1), choices, n=1)
+            if close:
+                message += f"; did you mean '{close[0]}'?"
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+_SIGNED = re.compile(r"^-(\d|\.\d)")
+
+
+def signed_values(argv: Sequence[str]) -> list[str]:
+    """``--fields -10,0,10`` → ``--fields=-10,0,10``: a value that starts with a minus sign and a
+    digit is joined to the long option before it (argparse would take it for an option; no
+    option of orthoscope starts with a digit)."""
+    out: list[str] = []
+    for tok in argv:
+        if out and _SIGNED.match(tok) and out[-1].startswith("--") and "=" not in out[-1]:
+            out[-1] = f"{out[-1]}={tok}"
+        else:
+            out.append(tok)
+    return out
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = Parser(
         prog="orthoscope",
         description=(
             "Lens distortion toolkit: paraxial data, real chief rays and Pestrecov's "
@@ -56,12 +116,18 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"orthoscope {_version()}")
     p.add_argument(
+        "--allow-large",
+        action="store_true",
+        help="Lift the work limits (fields, radii, rays per command) that protect against a "
+        "mistyped count.",
+    )
+    p.add_argument(
         "--threads",
         type=int,
         metavar="N",
         help="Numba threads for bulk traces (default: numba's setting, NUMBA_NUM_THREADS).",
     )
-    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"{__name__}.{name}").register(sub)
@@ -71,16 +137,32 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 a run that did not succeed, 2 a
     usage or input error, 130 interrupted)."""
+    import warnings
+
     from raytrace.errors import OrthoscopeError
 
     debug = os.environ.get("ORTHOSCOPE_DEBUG", "") not in ("", "0")
     command = "orthoscope"
+    warnings.showwarning = _one_line_warning
+    _ascii_safe_streams()
+    # the command line only writes figures to files (no window): a broken MPLBACKEND must not
+    # stop it
+    os.environ.pop("MPLBACKEND", None)
+    bad = _bad_environment()
+    if bad:
+        print(f"orthoscope: error: {bad}", file=sys.stderr)
+        return EXIT_USAGE
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
+        try:
+            args = parser.parse_args(signed_values(sys.argv[1:] if argv is None else list(argv)))
+        except SystemExit as e:  # --help, --version, or a usage error already printed
+            return e.code if isinstance(e.code, int) else EXIT_USAGE
         command = f"orthoscope {args.command}"
         if args.threads is not None:
             _set_threads(args.threads)
+        if args.command not in NO_KERNELS:
+            _compile_notice()
         return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print(f"{command}: interrupted", file=sys.stderr)
@@ -104,6 +186,53 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
 
 
+_ASCII = {
+    "α": "alpha", "β": "beta", "γ": "gamma", "ρ": "rho", "ε": "eps", "δ": "d", "Δ": "D",
+    "µ": "u", "μ": "u", "—": "-", "–": "-", "−": "-", "′": "'", "±": "+/-", "×": "x", "≤": "<=",
+    "≥": ">=", "∞": "inf", "°": " deg", "²": "^2", "³": "^3", "⁴": "^4", "√": "sqrt", "→": "->",
+    "Σ": "sum", "≈": "~", "…": "...", "’": "'", "“": '"', "”": '"', "ü": "u", "é": "e",
+}  # fmt: skip
+
+
+def _ascii_fallback(err: UnicodeError):
+    """Codec error handler: Greek letters, dashes and units in ASCII words (non-UTF-8 locales)."""
+    bad = err.object[err.start : err.end]
+    return "".join(_ASCII.get(ch, "?") for ch in bad), err.end
+
+
+def _ascii_safe_streams() -> None:
+    """Under a locale that cannot encode the tables' symbols (``LANG=C``), write them in ASCII
+    instead of failing."""
+    import codecs
+
+    codecs.register_error("orthoscope-ascii", _ascii_fallback)
+    for stream in (sys.stdout, sys.stderr):
+        enc = getattr(stream, "encoding", None) or "ascii"
+        try:
+            "α—µ".encode(enc)
+        except (UnicodeEncodeError, LookupError):
+            try:
+                stream.reconfigure(errors="orthoscope-ascii")
+            except (AttributeError, ValueError):  # not a TextIOWrapper (a test's capture)
+                pass
+
+
+def _bad_environment() -> str | None:
+    """A one-line reason when an environment variable the engine reads is unusable."""
+    v = os.environ.get("NUMBA_NUM_THREADS")
+    if v is not None and not (v.strip().isdigit() and int(v) > 0):
+        return (
+            f"NUMBA_NUM_THREADS={v!r} must be a positive whole number (the threads numba may "
+            "use); unset it or set e.g. NUMBA_NUM_THREADS=2"
+        )
+    return None
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings on the command line: one line, no source path."""
+    print(f"orthoscope: warning: {message}", file=sys.stderr)
+
+
 def _silence_stdout() -> None:
     """After a closed pipe, point stdout at devnull so the interpreter's final flush is quiet."""
     try:
@@ -111,6 +240,42 @@ def _silence_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
     except (OSError, ValueError):
         pass
+
+
+def _numba_without_blas_probe() -> None:
+    """Import numba's numpy support without its BLAS probe.
+
+    numba checks at import whether SciPy's BLAS is available (for ``np.dot`` in jitted code) by
+    importing ``scipy.linalg.cython_blas`` — a quarter of a second on every run. The kernels of
+    this project use no BLAS, and the command line compiles no other code, so the probe is
+    answered "absent" for numba alone; SciPy itself imports normally afterwards.
+    """
+    if "numba.np.arraymath" in sys.modules:
+        return
+    key = "scipy.linalg.cython_blas"
+    had = key in sys.modules
+    if not had:
+        sys.modules[key] = None  # type: ignore[assignment]
+    try:
+        import numba.np.arraymath  # noqa: F401
+    except Exception:  # noqa: BLE001 - a speed-up only: never fail because of it
+        pass
+    finally:
+        if not had:
+            sys.modules.pop(key, None)
+
+
+def _compile_notice() -> None:
+    """One line on stderr when the ray-tracing kernels are not in the numba cache yet."""
+    _numba_without_blas_probe()
+    from raytrace.kernels import aim, bulk
+    from raytrace.kernels.jit import cache_is_warm
+
+    if not cache_is_warm(aim.aim_chief, bulk.trace_batch_serial):
+        print(
+            "orthoscope: compiling the ray-tracing kernels (first run only, about a minute)",
+            file=sys.stderr,
+        )
 
 
 def _set_threads(n: int) -> None:

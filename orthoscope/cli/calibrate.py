@@ -13,6 +13,13 @@ TABLE_HELP = (
 )
 
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["calibrate", "{data}/pestrecov_table1.csv", "--method", "two-point", "--at", "37.5,45"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png")]
+
+
 def cmd_calibrate(args) -> int:
     from distortion.calibration import calibrate
     from distortion.tablefile import read_distortion_table
@@ -35,15 +42,15 @@ def cmd_calibrate(args) -> int:
     else:
         print(format_calibration(res, layout=args.table_layout))
     if args.plot or args.plot_rotation:
+        from ..plots.common import offscreen_figures
         from ..plots.distortion import plot_calibrated, plot_rotation
         from ..plots.save import save_figure
 
-        if args.plot:
-            save_figure(plot_calibrated(res), args.plot, overwrite=args.force, inputs=[args.table])
-        if args.plot_rotation:
-            save_figure(
-                plot_rotation(res), args.plot_rotation, overwrite=args.force, inputs=[args.table]
-            )
+        for path, fn in ((args.plot, plot_calibrated), (args.plot_rotation, plot_rotation)):
+            if path:
+                with offscreen_figures():
+                    fig = fn(res)
+                save_figure(fig, path, overwrite=args.force, inputs=[args.table])
     return 0
 
 

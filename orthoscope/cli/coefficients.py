@@ -9,6 +9,13 @@ import math
 from .common import CliError, load_scaled, print_json
 from .variation import CONJ_HELP, UNITS_EPILOG
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["coefficients", "--lens", "cooke-triplet-f4", "--focus", "12x"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = []
+
+
 def cmd_coefficients(args) -> int:
     from distortion.coefficients import fit_radial, opencv_model
 
@@ -228,8 +235,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Print JSON: fits and an 'opencv' block with dist_coeffs [k1,k2,p1,p2,k3].",
     )
     c.set_defaults(func=cmd_coefficients)
-
-
 
 
 def _lens_only(args) -> list[str]:

@@ -26,7 +26,7 @@ PLANE_HELP = (
     "Image plane, one of: --s-prime S' (mm from the second principal point H', Pestrecov's s'), "
     "--from-last-vertex D (mm from the last vertex), --defocus DZ (mm from the Gaussian image "
     "plane, + away from the lens), --gaussian (the Gaussian plane of the object). Default: the "
-    "lens file's image plane (a file whose last thickness is \"gaussian\" means the Gaussian "
+    'lens file\'s image plane (a file whose last thickness is "gaussian" means the Gaussian '
     "plane of whatever object is traced)."
 )
 FIELDS_HELP = (
@@ -34,6 +34,13 @@ FIELDS_HELP = (
     "with a finite object, Pestrecov's nominal angles, y = p0 tan(alpha)) or object heights in mm, "
     "as --field-kind says. Signed values are fine: --fields -10,0,10."
 )
+
+
+#: Choices of the science packages, spelled here so that building the parser imports none of
+#: them (tests/test_cli.py checks they equal distortion.calibration.METHODS and
+#: distortion.characteristic.REFERENCES).
+METHODS = ("two-point", "minimax", "least-squares", "zero-at", "given")
+REFERENCES = ("characteristic", "distortion-focal-length", "real-chief-transport")
 
 
 class CliError(OrthoscopeError):
@@ -75,12 +82,36 @@ def number(text: str, what: str) -> float:
     return v
 
 
-def parse_list(text: str, what: str) -> np.ndarray:
-    """``'0,10,20'`` → array; a clear error on garbage."""
+def length(text: str, what: str, **kw) -> float:
+    """A length in mm from ``text``: a number (mm) or a number with a unit (``1.5m``, ``25cm``)
+    (:func:`raytrace.units.length_mm`)."""
+    from raytrace.units import UnitError, length_mm
+
+    try:
+        return length_mm(str(text).strip(), what, **kw)
+    except UnitError as e:
+        raise CliError(str(e)) from None
+
+
+def wavelength_arg(text: str) -> float:
+    """argparse type of --wavelength: nm, or with a unit (``587.6nm``, ``0.5876um``); a bare
+    value below 100 looks like micrometres and is refused with the fix."""
+    from raytrace.units import UnitError, wavelength_nm
+
+    try:
+        return wavelength_nm(text, "--wavelength")
+    except UnitError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def parse_list(text: str, what: str, *, lengths: bool = False) -> np.ndarray:
+    """``'0,10,20'`` → array; a clear error on garbage. ``lengths``: items may carry a length
+    unit (``425mm``, ``0.5m``), the result is in mm."""
     parts = [p.strip() for p in str(text).split(",") if p.strip()]
     if not parts:
         raise CliError(f"{what}: empty list")
-    return np.array([number(p, what) for p in parts])
+    conv = (lambda p: length(p, what)) if lengths else (lambda p: number(p, what))
+    return np.array([conv(p) for p in parts])
 
 
 def signed_list(text: str) -> str:
@@ -134,15 +165,21 @@ def add_object_args(p: argparse.ArgumentParser) -> None:
 def resolve_object(lens, args) -> float:
     """The object distance (mm from the first vertex, or inf) from the object flags."""
     from raytrace.paraxial import resolve_object_distance
+    from raytrace.units import UnitError, image_scale
 
-    s = None if args.object_s is None else number(args.object_s, "--object-s")
+    s = None if args.object_s is None else length(args.object_s, "--object-s")
     scale = None
     if args.object_scale is not None:
-        t = str(args.object_scale).strip().rstrip("xX×")
-        scale = number(t, "--object-scale")
-    return resolve_object_distance(
-        lens, object_distance=args.object_distance, object_s=s, object_scale=scale
-    )
+        try:
+            scale = image_scale(args.object_scale, "--object-scale")
+        except UnitError as e:
+            raise CliError(str(e)) from None
+    od = args.object_distance
+    if od is not None:
+        t = str(od).strip().lower()
+        if t not in ("inf", "infinity") and not t.endswith(("x", "×")):
+            od = length(t, "--object-distance", allow_inf=True)
+    return resolve_object_distance(lens, object_distance=od, object_s=s, object_scale=scale)
 
 
 # ----------------------------------------------------------------------------- image planes
@@ -153,9 +190,15 @@ def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> N
     )
     act = "append" if repeatable else "store"
     g.add_argument("--s-prime", type=str, action=act, metavar="S'", help="mm from H'.")
-    g.add_argument("--from-last-vertex", type=str, action=act, metavar="D", help="mm from the last vertex.")
-    g.add_argument("--defocus", type=str, action=act, metavar="DZ", help="mm from the Gaussian plane.")
-    g.add_argument("--gaussian", action="store_true", help="the Gaussian image plane of the object.")
+    g.add_argument(
+        "--from-last-vertex", type=str, action=act, metavar="D", help="mm from the last vertex."
+    )
+    g.add_argument(
+        "--defocus", type=str, action=act, metavar="DZ", help="mm from the Gaussian plane."
+    )
+    g.add_argument(
+        "--gaussian", action="store_true", help="the Gaussian image plane of the object."
+    )
     for old, new, dest in (
         ("--image-distance", "--s-prime", "s_prime"),
         ("--image-from-vertex", "--from-last-vertex", "from_last_vertex"),
@@ -188,7 +231,7 @@ def resolve_planes(lens, args) -> list:
         vals = v if isinstance(v, list) else [v]
         nums = []
         for item in vals:
-            nums.extend(parse_list(item, flag).tolist())
+            nums.extend(parse_list(item, flag, lengths=True).tolist())
         given[key] = nums
     if len(given) > 1:
         flags = ", ".join("--" + k.replace("_", "-") for k in given)
@@ -236,7 +279,24 @@ def add_field_args(p: argparse.ArgumentParser) -> None:
     )
 
 
+#: Work limits of one command (fields, radii, rays). Beyond them a command refuses before
+#: allocating anything and names the flag that lifts the limit (--allow-large).
 MAX_FIELDS = 100_000
+MAX_SAMPLES = 1_000_000
+
+
+def check_size(value: int, limit: int, what: str, args, per_item_bytes: int = 200) -> int:
+    """``value`` if it is at most ``limit`` (or the run has --allow-large); else CliError with
+    the memory the request would take and the flag that lifts the limit."""
+    if value < 1:
+        raise CliError(f"{what} must be at least 1, got {value}")
+    if value > limit and not getattr(args, "allow_large", False):
+        gb = value * per_item_bytes / 1e9
+        raise CliError(
+            f"{what} {value}: more than {limit} (about {gb:.3g} GB and a long run); give "
+            "--allow-large (before the command) to run it anyway"
+        )
+    return value
 
 
 def resolve_fields(lens, args) -> tuple[np.ndarray, str]:
@@ -245,7 +305,9 @@ def resolve_fields(lens, args) -> tuple[np.ndarray, str]:
     if args.fields is not None:
         if args.max_field is not None or args.steps is not None:
             raise CliError("give either --fields or --max-field/--steps, not both")
-        return parse_list(args.fields, "--fields"), kind
+        f = parse_list(args.fields, "--fields")
+        check_size(f.size, MAX_FIELDS, "--fields (count)", args, per_item_bytes=150)
+        return f, kind
     fmax = args.max_field
     if fmax is None:
         if kind != lens.field.kind:
@@ -254,8 +316,7 @@ def resolve_fields(lens, args) -> tuple[np.ndarray, str]:
     steps = 10 if args.steps is None else args.steps
     if steps < 1:
         raise CliError("--steps must be at least 1")
-    if steps > MAX_FIELDS:
-        raise CliError(f"--steps {steps}: at most {MAX_FIELDS} fields per call")
+    check_size(steps, MAX_FIELDS, "--steps", args, per_item_bytes=150)
     if not math.isfinite(fmax):
         raise CliError("--max-field must be finite")
     return np.linspace(0.0, fmax, steps + 1), kind
@@ -277,9 +338,9 @@ def add_output_args(p: argparse.ArgumentParser, *, csv: bool = True) -> None:
 def add_wavelength_arg(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--wavelength",
-        type=float,
+        type=wavelength_arg,
         metavar="NM",
-        help="Wavelength in nm (default: the lens file's).",
+        help="Wavelength in nm, or with a unit: 587.6nm, 0.5876um (default: the lens file's).",
     )
 
 

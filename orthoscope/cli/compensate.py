@@ -5,6 +5,14 @@ from __future__ import annotations
 import argparse
 import math
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [
+    ["compensate", "topogon-us2031792-fig1", "twinplex-like-55-525", "--fields", "0,10,20,30"]
+]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = []
+
 
 def _curve_from(arg: str, role: str, args, camera_curve=None):
     """A DistortionCurve from a CSV table or from a lens (traced)."""
@@ -57,7 +65,7 @@ def cmd_compensate(args) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from distortion.calibration import METHODS
+    from .common import METHODS
 
     from .common import DeprecatedAlias
 
@@ -71,7 +79,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "chosen by --method. CAMERA and PRINTER are distortion tables (.csv) or lenses "
             "(files or bundled names; the printer file must define its finite object distance)."
         ),
-        epilog="Example: orthoscope compensate tests/data/pestrecov_table1.csv printer.csv",
+        epilog="Example: orthoscope compensate topogon-us2031792-fig1 twinplex-like-55-525 "
+        "--fields 0,10,20,30,35",
     )
     q.add_argument("camera", metavar="CAMERA", help="Camera distortion table (.csv) or lens.")
     q.add_argument("printer", metavar="PRINTER", help="Printer distortion table (.csv) or lens.")
@@ -83,14 +92,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         "characteristic curves) or a calibration method over the camera fields.",
     )
     q.add_argument(
-        "--criterion", dest="method", choices=METHODS, action=DeprecatedAlias, new="--method",
+        "--criterion",
+        dest="method",
+        choices=METHODS,
+        action=DeprecatedAlias,
+        new="--method",
         help=argparse.SUPPRESS,
     )
     q.add_argument(
         "--magnification", type=float, metavar="M", help="Print magnification factor M for 'given'."
     )
     q.add_argument(
-        "--M", dest="magnification", type=float, action=DeprecatedAlias, new="--magnification",
+        "--M",
+        dest="magnification",
+        type=float,
+        action=DeprecatedAlias,
+        new="--magnification",
         help=argparse.SUPPRESS,
     )
     q.add_argument("--at", metavar="A[,B]", help="Field(s) for two-point or zero-at (degrees).")

@@ -4,6 +4,12 @@ from __future__ import annotations
 
 import argparse
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["convert", "cooke-triplet-f4", "{tmp}/cooke.zmx"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("OUT", ".zmx")]
+
 
 def cmd_convert(args) -> int:
     import sys

@@ -19,8 +19,7 @@ METHOD_HELP = (
 )
 AT_HELP = "Field(s) for two-point (two) or zero-at (one): degrees or object heights, A,B."
 EXAGGERATION_HELP = (
-    "Plot exaggeration k of the distortion scale (Eq. 14: tan rho_k = k (Fc/F0 - 1)). "
-    "Default: 200."
+    "Plot exaggeration k of the distortion scale (Eq. 14: tan rho_k = k (Fc/F0 - 1)). Default: 200."
 )
 REFERENCE_HELP = (
     "Reference definition: 'characteristic' (Pestrecov Eq. 8, paraxial M0/F0 in the actual "
@@ -34,8 +33,15 @@ TABLE_LAYOUT_HELP = (
 )
 
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--calibrate", "minimax"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png"), ("--layout", ".png")]
+
+
 def add_calibration_args(q: argparse.ArgumentParser, *, required: bool) -> None:
-    from distortion.calibration import METHODS
+    from .common import METHODS
 
     g = q.add_argument_group("calibration")
     if required:
@@ -51,11 +57,13 @@ def add_calibration_args(q: argparse.ArgumentParser, *, required: bool) -> None:
         g.add_argument("--calibrate", metavar="METHOD", choices=METHODS, help=METHOD_HELP)
     g.add_argument("--at", metavar="A[,B]", help=AT_HELP)
     g.add_argument("--value", type=float, metavar="K", help="Fc (mm) or Mc for 'given'.")
+    g.add_argument("--exaggeration", type=float, default=200.0, metavar="K", help=EXAGGERATION_HELP)
     g.add_argument(
-        "--exaggeration", type=float, default=200.0, metavar="K", help=EXAGGERATION_HELP
-    )
-    g.add_argument(
-        "--k", dest="exaggeration", type=float, action=_alias("--exaggeration"), help=argparse.SUPPRESS
+        "--k",
+        dest="exaggeration",
+        type=float,
+        action=_alias("--exaggeration"),
+        help=argparse.SUPPRESS,
     )
 
 
@@ -89,9 +97,9 @@ def check_plot_path(path: str | None, flag: str, args) -> None:
 
     from .common import CliError
 
+    check_output(path, inputs=getattr(args, "_inputs", ()), overwrite=args.force, flag="--force")
     if Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
         raise CliError(f"{flag} {path}: the file must end in .png, .svg or .pdf")
-    check_output(path, inputs=getattr(args, "_inputs", ()), overwrite=args.force, flag="--force")
 
 
 def cmd_distortion(args) -> int:
@@ -173,36 +181,38 @@ def cmd_distortion(args) -> int:
 def _plots(res, cals, args, lens) -> None:
     from .common import CliError
 
-    if args.plot:
-        from ..plots.distortion import plot_calibrated, plot_characteristic, plot_planes
-        from ..plots.save import save_figure
+    if args.plot_rotation and not cals:
+        raise CliError("--plot-rotation (Fig. 4) needs --calibrate")
+    if not (args.plot or args.plot_rotation or args.layout):
+        return
+    from ..plots.common import offscreen_figures
+    from ..plots.distortion import plot_calibrated, plot_characteristic, plot_planes, plot_rotation
+    from ..plots.layout import plot_layout
+    from ..plots.save import save_figure
 
-        if res.n_planes > 1:
-            fig = plot_planes([res.curve(i) for i in range(res.n_planes)])
-        elif cals:
-            fig = plot_calibrated(cals[0])
-        else:
-            fig = plot_characteristic(res.curve(0))
+    if args.plot:
+        with offscreen_figures():
+            if res.n_planes > 1:
+                fig = plot_planes(res)
+            elif cals:
+                fig = plot_calibrated(cals[0])
+            else:
+                fig = plot_characteristic(res)
         save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
     if args.plot_rotation:
-        if not cals:
-            raise CliError("--plot-rotation (Fig. 4) needs --calibrate")
-        from ..plots.distortion import plot_rotation
-        from ..plots.save import save_figure
-
-        save_figure(plot_rotation(cals[0]), args.plot_rotation, overwrite=args.force)
+        with offscreen_figures():
+            fig = plot_rotation(cals[0])
+        save_figure(fig, args.plot_rotation, overwrite=args.force)
     if args.layout:
-        from ..plots.layout import plot_layout
-        from ..plots.save import save_figure
-
-        fig = plot_layout(
-            lens,
-            res.fields,
-            field_kind="height" if res.field_kind == "height" else "angle",
-            object_distance=res.object_distance,
-            z_planes=res.z_planes,
-            wavelength=args.wavelength,
-        )
+        key = "object_heights_mm" if res.field_kind == "height" else "fields_deg"
+        with offscreen_figures():
+            fig = plot_layout(
+                lens,
+                **{key: res.fields},
+                object_distance=res.object_distance,
+                z_planes=res.z_planes,
+                wavelength=args.wavelength,
+            )
         save_figure(fig, args.layout, overwrite=args.force)
 
 
@@ -213,7 +223,7 @@ def add_force_arg(q: argparse.ArgumentParser) -> None:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from distortion.characteristic import REFERENCES
+    from .common import REFERENCES
 
     q = sub.add_parser(
         "distortion",
@@ -238,9 +248,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_object_args(q)
     add_field_args(q)
     add_plane_args(q, repeatable=True)
-    q.add_argument(
-        "--reference", default="characteristic", choices=REFERENCES, help=REFERENCE_HELP
-    )
+    q.add_argument("--reference", default="characteristic", choices=REFERENCES, help=REFERENCE_HELP)
     add_calibration_args(q, required=False)
     add_wavelength_arg(q)
     add_table_layout_arg(q)

@@ -4,6 +4,12 @@ from __future__ import annotations
 
 import argparse
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["lenses"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = []
+
 
 def cmd_lenses(args) -> int:
     from raytrace.files.library import list_lenses

@@ -1,4 +1,6 @@
-"""CLI: ``orthoscope optimize SPEC.toml -o LENS.toml`` — a reproducible design run."""
+"""CLI: ``orthoscope optimize SPEC.toml -o LENS.toml [--global ...]`` — a reproducible design run:
+damped least squares from the spec's start lens, or (``--global``) the global search with glass
+substitution (:func:`raytrace.optimize.global_optimize`)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from pathlib import Path
 from .common import CliError, print_json
 
 EXIT_NOT_CONVERGED = 1
+EXIT_INTERRUPTED = 130
 
 
 class _Progress:
@@ -47,6 +50,67 @@ class _Progress:
             sys.stderr.write("\n")
 
 
+class GlobalProgress:
+    """Progress of the global search on stderr: a tqdm bar over the starts on a terminal when
+    tqdm is installed, plain lines otherwise (one per finished start, and the best merit every
+    ``every`` seconds while a start runs)."""
+
+    def __init__(self, starts: int, quiet: bool, *, stream=None, every: float = 10.0) -> None:
+        self.stream = stream or sys.stderr
+        self.quiet = quiet
+        self.every = every
+        self.last = time.monotonic()
+        self.bar = None
+        if quiet:
+            return
+        if getattr(self.stream, "isatty", lambda: False)():
+            try:
+                from tqdm import tqdm
+            except ImportError:
+                tqdm = None
+            if tqdm is not None:
+                self.bar = tqdm(total=starts, desc="starts", unit="start", file=self.stream)
+
+    def __call__(self, ev) -> None:
+        if self.quiet:
+            return
+        if self.bar is not None:
+            if ev.event == "start":
+                self.bar.update(1)
+            self.bar.set_postfix_str(f"best merit {ev.best:.6g}", refresh=True)
+            return
+        now = time.monotonic()
+        if ev.event == "start":
+            line = (
+                f"start {ev.start} done ({ev.starts_done}/{ev.starts}): merit {ev.merit:.6g}, "
+                f"best {ev.best:.6g}, {ev.elapsed_s:.1f} s"
+            )
+        elif ev.event == "polish":
+            line = f"polished: merit {ev.merit:.6g}, {ev.elapsed_s:.1f} s"
+        elif now - self.last >= self.every:
+            hop = "" if ev.hop < 0 else f" hop {ev.hop}"
+            line = (
+                f"start {ev.start}{hop}: merit {ev.merit:.6g}, best {ev.best:.6g}, "
+                f"{ev.elapsed_s:.1f} s"
+            )
+        else:
+            return
+        self.last = now
+        self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["optimize", "{specs}/twinplex-like-55-525.toml", "-o", "{tmp}/designed.toml"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("-o", ".toml")]
+
+
 def provenance_notes(lens, spec, res, start_name: str) -> str:
     """Notes of a designed lens: provenance line first (see raytrace.files.native)."""
     date = _dt.date.today().isoformat()
@@ -58,11 +122,83 @@ def provenance_notes(lens, spec, res, start_name: str) -> str:
     )
 
 
-def cmd_optimize(args) -> int:
-    from raytrace.files.native import write_lens
-    from raytrace.files.output import check_output
-    from raytrace.optimize import optimize, read_spec, start_lens
+def global_provenance_notes(spec, res, start_name: str) -> str:
+    """Notes of a lens designed by the global search: provenance line first, then how to
+    reproduce it (seed, starts) and what it found."""
+    date = _dt.date.today().isoformat()
+    glasses = "; ".join(f"S{g.surface} {g.name} ({g.catalog})" for g in res.glasses)
+    text = (
+        "provenance: derived\n"
+        f"Designed with 'orthoscope optimize {Path(spec.path).name} --global --seed {res.seed} "
+        f"--starts {res.starts}' ({spec.search.hops} hops per start) from the start lens "
+        f"{start_name}; merit {res.merit:.9g} (start {res.merit_start:.9g}), best of "
+        f"{res.starts_done}/{res.starts} starts (start {res.best_start}), {res.evaluations} "
+        f"evaluations, {res.seconds:.0f} s with {res.workers} worker(s); {date}."
+    )
+    if glasses:
+        text += f" Glasses: {glasses}."
+    if res.stopped:
+        text += f" Search stopped early ({res.stopped}): the best design found by then."
+    return text
 
+
+def _operand_table(operands) -> list[dict]:
+    return [
+        {
+            "operand": o.operand.label(),
+            "value": o.value,
+            "target": o.operand.target,
+            "weight": o.operand.weight,
+            "residual": o.residual,
+        }
+        for o in operands
+    ]
+
+
+def _print_table(table: list[dict]) -> None:
+    print(f"{'operand':40} {'value':>14} {'target':>14} {'weighted resid.':>16}")
+    for r in table:
+        print(
+            f"{r['operand'][:40]:40} {r['value']:14.6f} {r['target']:14.6f} {r['residual']:16.6g}"
+        )
+
+
+def _search_overrides(args) -> dict:
+    from raytrace.optimize import parse_duration
+
+    over = {}
+    if args.time is not None:
+        try:
+            over["time_budget_s"] = parse_duration(args.time)
+        except Exception as e:  # SpecError: say it with the flag's name
+            raise CliError(f"--time {args.time}: {str(e).split(': ', 1)[-1]}") from None
+    for name, lo in (("seed", 0), ("starts", 1), ("workers", 1), ("hops", 0)):
+        v = getattr(args, name)
+        if v is not None:
+            if v < lo:
+                raise CliError(f"--{name} must be at least {lo}, got {v}")
+            over[name] = v
+    return over
+
+
+def cmd_optimize(args) -> int:
+    from raytrace.files.output import check_output
+    from raytrace.optimize import read_spec, start_lens
+
+    glob_only = [
+        f
+        for f, v in (
+            ("--time", args.time),
+            ("--seed", args.seed),
+            ("--starts", args.starts),
+            ("--workers", args.workers),
+            ("--hops", args.hops),
+            ("--glass-map", args.glass_map),
+        )
+        if v is not None
+    ]
+    if glob_only and not args.global_search:
+        raise CliError(f"{', '.join(glob_only)} belong(s) to the global search: add --global")
     spec = read_spec(args.spec)
     if args.max_evaluations is not None:
         if args.max_evaluations < 1:
@@ -71,22 +207,33 @@ def cmd_optimize(args) -> int:
     out = Path(args.output)
     if out.suffix.lower() != ".toml":
         raise CliError(f"-o {out}: the output lens file must end in .toml")
+    over = _search_overrides(args) if args.global_search else {}
     lens = start_lens(spec)
     inputs = [spec.path] + ([lens.path] if lens.path else [])
-    check_output(out, inputs=inputs, overwrite=args.force, flag="--force")  # before the run
+    # every output is checked before the run
+    check_output(out, inputs=inputs, overwrite=args.force, flag="--force")
+    if args.glass_map is not None:
+        gm = Path(args.glass_map)
+        if not any(v.kind == "glass" for v in spec.variables):
+            raise CliError(f"--glass-map: the spec {spec.path} has no glass variables to map")
+        if gm.suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise CliError(f"--glass-map {gm}: use a .png, .svg or .pdf file")
+        if gm.resolve() == out.resolve():
+            raise CliError("--glass-map and -o name the same file")
+        check_output(gm, inputs=inputs, overwrite=args.force, flag="--force")
+    if args.global_search:
+        return _run_global(args, spec, lens, out, inputs, over)
+    return _run_local(args, spec, lens, out, inputs)
+
+
+def _run_local(args, spec, lens, out, inputs) -> int:
+    from raytrace.files.native import write_lens
+    from raytrace.optimize import optimize
+
     prog = _Progress(args.quiet or args.json)
     res = optimize(lens, spec, progress=prog)
     prog.done()
-    table = [
-        {
-            "operand": o.operand.label(),
-            "value": o.value,
-            "target": o.operand.target,
-            "weight": o.operand.weight,
-            "residual": o.residual,
-        }
-        for o in res.operands
-    ]
+    table = _operand_table(res.operands)
     written = res.converged or args.write_anyway
     if written:
         designed = replace(
@@ -119,12 +266,7 @@ def cmd_optimize(args) -> int:
             f"merit {res.merit_start:.6g} -> {res.merit:.6g} in {res.evaluations} evaluations "
             f"({res.seconds:.1f} s)"
         )
-        print(f"{'operand':40} {'value':>14} {'target':>14} {'weighted resid.':>16}")
-        for r in table:
-            print(
-                f"{r['operand'][:40]:40} {r['value']:14.6f} {r['target']:14.6f} "
-                f"{r['residual']:16.6g}"
-            )
+        _print_table(table)
         print(
             f"wrote {out}"
             if written
@@ -134,24 +276,136 @@ def cmd_optimize(args) -> int:
     return 0 if res.converged else EXIT_NOT_CONVERGED
 
 
+def _run_global(args, spec, lens, out, inputs, over) -> int:
+    from raytrace.files.native import write_lens
+    from raytrace.optimize import global_optimize
+
+    starts = over.get("starts", spec.search.starts)
+    prog = GlobalProgress(starts, args.quiet or args.json)
+    try:
+        res = global_optimize(lens, spec, progress=prog, **over)
+    finally:
+        prog.close()
+    table = _operand_table(res.operands)
+    written = res.converged or args.write_anyway
+    if written:
+        designed = replace(
+            res.lens,
+            name=spec.name or res.lens.name,
+            notes=global_provenance_notes(spec, res, spec.start),
+            source=(
+                f"derived by orthoscope optimize --global from {spec.start} with "
+                f"{Path(spec.path).name}"
+            ),
+        )
+        if not res.converged:
+            designed = replace(designed, notes=designed.notes + " NOT CONVERGED: " + res.message)
+        write_lens(designed, out, inputs=inputs, overwrite=args.force, flag="--force")
+    if args.glass_map is not None:
+        from raytrace.optimize import glass_pool
+
+        from ..plots.glassmap import plot_glass_map
+        from ..plots.save import save_figure
+
+        pools = {}
+        for v in spec.variables:
+            if v.kind == "glass":
+                p = glass_pool(spec.glass_settings(v))
+                pools.update({(g.name, g.catalog): g for g in p.glasses})
+        fig = plot_glass_map(
+            pools.values(), res.glasses, title=f"{spec.name}: glass pool and chosen glasses"
+        )
+        save_figure(fig, args.glass_map, overwrite=args.force, inputs=inputs)
+    if args.json:
+        print_json(
+            {
+                "spec": spec.path,
+                "start": spec.start,
+                "global": True,
+                "seed": res.seed,
+                "starts": res.starts,
+                "starts_done": res.starts_done,
+                "best_start": res.best_start,
+                "start_merits": [None if m != m else float(m) for m in res.start_merits],
+                "workers": res.workers,
+                "stopped": res.stopped or None,
+                "converged": res.converged,
+                "message": res.message,
+                "merit_start": res.merit_start,
+                "merit": res.merit,
+                "evaluations": res.evaluations,
+                "seconds": res.seconds,
+                "glasses": [
+                    {
+                        "surface": g.surface,
+                        "name": g.name,
+                        "catalog": g.catalog,
+                        "nd": g.nd,
+                        "vd": g.vd,
+                        "availability": g.availability,
+                    }
+                    for g in res.glasses
+                ],
+                "written": str(out) if written else None,
+                "operands": table,
+            }
+        )
+    else:
+        print(f"{spec.name}: {res.message}")
+        print(
+            f"merit {res.merit_start:.6g} -> {res.merit:.6g}; {res.evaluations} evaluations "
+            f"({res.seconds:.1f} s, {res.workers} worker(s))"
+        )
+        fin = [m for m in res.start_merits if m == m]
+        if fin:
+            print(
+                f"merit per start: min {min(fin):.6g}, median {sorted(fin)[len(fin) // 2]:.6g}, "
+                f"max {max(fin):.6g}"
+            )
+        for g in res.glasses:
+            print(
+                f"glass after surface {g.surface}: {g.name} ({g.catalog}, nd {g.nd:.5f}, "
+                f"vd {g.vd:.2f}, {g.availability})"
+            )
+        _print_table(table)
+        if written:
+            print(f"wrote {out}")
+        else:
+            print("NOT CONVERGED: no lens written (--write-anyway writes it, marked as such)")
+        if args.glass_map is not None:
+            print(f"wrote {args.glass_map}")
+    if res.stopped == "interrupted":
+        print("orthoscope optimize: interrupted; the best design found was kept", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return 0 if res.converged else EXIT_NOT_CONVERGED
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser(
         "optimize",
-        help="Run a design spec (damped least squares) and write the resulting lens.",
+        help="Run a design spec (damped least squares, or --global search) and write the lens.",
         description=(
-            "Optimize a lens from a TOML design spec: start lens, variables (curvature, thickness, "
-            "index, conic, A4, A6, A8, A10 of 1-based surfaces, with bounds; a start value outside "
-            "its bounds starts on the nearest bound), pick-ups, and operands with targets and "
-            "weights (efl, m_e, HE0, HpE0p, distortion, distortion_rel, image_height, best_focus, "
-            "rms_spot, center_thickness, edge_thickness). Progress (evaluation, merit, worst "
-            "operand) goes to stderr. The lens is written with its provenance (start lens, spec, "
-            "merit, date) only when the run converged (exit status 0); a run that did not "
-            "converge or missed the spec's merit_goal exits with status 1 and writes nothing."
+            "Optimize a lens from a TOML design spec (the language: docs/spec.md): start lens, "
+            "variables (curvature, thickness, index, abbe, conic, A4, A6, A8, A10 of 1-based "
+            "surfaces, with bounds; glass = substitution among real catalog glasses, --global "
+            "only), pick-ups, and operands with targets and weights (efl, m_e, HE0, HpE0p, "
+            "distortion, distortion_rel, distortion_slope, image_height, landing_angle, "
+            "best_focus, rms_spot, axial_color, center_thickness, edge_thickness). Without "
+            "--global: damped least squares from the start lens; progress (evaluation, merit, "
+            "worst operand) goes to stderr. With --global: many starts and basin hops around "
+            "damped least squares, glass substitution, in parallel worker processes; seeded "
+            "and deterministic (the same seed gives the same lens whatever --workers); a "
+            "progress bar on a terminal (tqdm) or plain lines; --time or Ctrl-C stops it and "
+            "keeps the best design found (Ctrl-C: exit status 130). The lens is written with its "
+            "provenance (start lens, spec, seed, merit, date) when the run converged / met the "
+            "spec's merit_goal (exit status 0); otherwise the exit status is 1 and nothing is "
+            "written (--write-anyway writes it, marked)."
         ),
-        epilog="Example: orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
-        "-o my-twinplex.toml",
+        epilog="Examples: orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
+        "-o my-twinplex.toml;  orthoscope optimize SPEC.toml --global --time 10m --seed 1 "
+        "-o my.toml",
     )
-    q.add_argument("spec", metavar="SPEC.toml", help="Design spec file (see README).")
+    q.add_argument("spec", metavar="SPEC.toml", help="Design spec file (docs/spec.md).")
     q.add_argument(
         "-o",
         "--output",
@@ -160,7 +414,36 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Where to write the designed lens.",
     )
     q.add_argument(
-        "--max-evaluations", type=int, metavar="N", help="Override the spec's evaluation limit."
+        "--max-evaluations",
+        type=int,
+        metavar="N",
+        help="Override the spec's evaluation limit (with --global: of the final polish, and of "
+        "each local run unless the spec's [global] local_evaluations says otherwise).",
+    )
+    g = q.add_argument_group("global search (the spec's [global] table gives the defaults)")
+    g.add_argument(
+        "--global",
+        dest="global_search",
+        action="store_true",
+        help="Global search: many starts and basin hopping around damped least squares, with "
+        "glass substitution for the spec's glass variables.",
+    )
+    g.add_argument(
+        "--time", metavar="T", help="Time budget, e.g. 90s, 10m, 1h30m; the best design is kept."
+    )
+    g.add_argument("--seed", type=int, metavar="S", help="Root seed (integer >= 0).")
+    g.add_argument("--starts", type=int, metavar="N", help="Number of starts.")
+    g.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="Worker processes (default: the spec's, else 1); the result does not depend on it.",
+    )
+    g.add_argument("--hops", type=int, metavar="N", help="Basin hops per start.")
+    g.add_argument(
+        "--glass-map",
+        metavar="FILE",
+        help="Also draw the glass pool and the chosen glasses (.png, .svg, .pdf).",
     )
     q.add_argument(
         "--write-anyway",
@@ -169,7 +452,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     q.add_argument("--quiet", action="store_true", help="No progress display.")
     q.add_argument(
-        "--force", action="store_true", help="Replace an existing output file (never an input)."
+        "--force", action="store_true", help="Replace existing output files (never an input)."
     )
     q.add_argument("--json", action="store_true", help="Print the result as JSON.")
     q.set_defaults(func=cmd_optimize)

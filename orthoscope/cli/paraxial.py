@@ -6,6 +6,12 @@ import argparse
 
 from .common import add_object_args, add_wavelength_arg
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["paraxial", "cooke-triplet-f4", "--object-distance", "500"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = []
+
 
 def cmd_paraxial(args) -> int:
     from raytrace.paraxial import paraxial

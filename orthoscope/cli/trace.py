@@ -12,6 +12,12 @@ from .common import (
     add_wavelength_arg,
 )
 
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [["trace", "cooke-triplet-f4", "--fields", "0,10,20"]]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = []
+
 
 def cmd_trace(args) -> int:
     from raytrace.paraxial import paraxial, plane_z

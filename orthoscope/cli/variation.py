@@ -1,7 +1,7 @@
 """``orthoscope variation`` (Fraser & Shortis 1992), two modes:
 
-  data:         ``orthoscope variation PROFILES.csv [--focal-length MM] ...``
-  prescription: ``orthoscope variation --lens LENS --focus 12x --objects 8x,16x,20x ...``
+data:         ``orthoscope variation PROFILES.csv [--focal-length MM] ...``
+prescription: ``orthoscope variation --lens LENS --focus 12x --objects 8x,16x,20x ...``
 """
 
 from __future__ import annotations
@@ -24,6 +24,25 @@ UNITS_EPILOG = (
     "'j x' alone is a Gaussian profile (object in the plane of focus). g_ss' is Fraser & Shortis "
     "Eq. (6): dr_ss' = dr_s + g (dr_s' - dr_s); gamma_ss' is Brown's Eq. (2). " + CONJ_HELP
 )
+
+
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [
+    [
+        "variation",
+        "--lens",
+        "cooke-triplet-f4",
+        "--focus",
+        "12x",
+        "--objects",
+        "8x,16x",
+        "--n-r",
+        "8",
+    ],
+]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("--profiles-csv", ".csv"), ("--plot", ".png"), ("--plot-g", ".png")]
 
 
 def _focus_list(values: list[str] | None):
@@ -54,8 +73,8 @@ def cmd_variation(args) -> int:
             "give a CSV of measured profiles (PROFILES.csv) or a lens with --lens, --focus and "
             "--objects"
         )
-    _check_outputs(args)
     if args.profiles:
+        _check_outputs(args)
         bad = [
             f
             for f, v in (
@@ -99,6 +118,9 @@ def cmd_variation(args) -> int:
         raise CliError("prescription mode needs --focus (e.g. --focus 12x)")
     if not args.objects:
         raise CliError("prescription mode needs --objects (e.g. --objects 8x,16x,20x)")
+    from .common import MAX_FIELDS, check_size
+
+    check_size(args.n_r, MAX_FIELDS, "--n-r", args, per_item_bytes=2000)
     lens = load_scaled(args)
     args._inputs = [lens.path] if lens.path else []
     _check_outputs(args)
@@ -135,23 +157,26 @@ def _check_outputs(args) -> None:
 
     if not hasattr(args, "_inputs"):
         args._inputs = [args.profiles] if args.profiles else []
-    for flag, path in (("--plot", args.plot), ("--plot-g", args.plot_g)):
-        if path and Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise CliError(f"{flag} {path}: the file must end in .png, .svg or .pdf")
     for path in (args.plot, args.plot_g, getattr(args, "profiles_csv", None)):
         if path:
             check_output(path, inputs=args._inputs, overwrite=args.force, flag="--force")
+    for flag, path in (("--plot", args.plot), ("--plot-g", args.plot_g)):
+        if path and Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise CliError(f"{flag} {path}: the file must end in .png, .svg or .pdf")
 
 
 def _plots(a, args) -> None:
     if not (args.plot or args.plot_g):
         return
+    from ..plots.common import offscreen_figures
     from ..plots.save import save_figure
     from ..plots.variation import plot_g, plot_profiles
 
     for path, fn in ((args.plot, plot_profiles), (args.plot_g, plot_g)):
         if path:
-            save_figure(fn(a), path, overwrite=args.force, inputs=args._inputs)
+            with offscreen_figures():
+                fig = fn(a)
+            save_figure(fig, path, overwrite=args.force, inputs=args._inputs)
 
 
 def _print_g_csv(a) -> None:
@@ -311,4 +336,3 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--force", action="store_true", help="Replace existing output files (never an input)."
     )
     q.set_defaults(func=cmd_variation)
-

@@ -1,8 +1,23 @@
-"""Distortion charts in the style of Pestrecov 1958, Figs. 2, 3, 4 and 6 (matplotlib Figure API).
+"""Distortion charts in the style of Pestrecov 1958, Figs. 2, 3, 4 and 6.
 
-Every function draws one figure and returns it (so tests and notebooks can inspect the lines);
-:func:`orthoscope.plots.save.save_figure` writes it.
-Linear distortion in mm, relative distortion in per cent, image sizes in mm.
+Every function draws into ``ax`` (a new pyplot figure when ``ax`` is None) and returns the Figure
+(:mod:`orthoscope.plots.common` states the convention); :func:`orthoscope.plots.save.save_figure`
+writes it. Linear distortion in mm, relative distortion in per cent, image sizes in mm.
+
+How the curves are drawn
+------------------------
+Markers sit at the field points of the result. The line through them depends on where the data
+come from:
+
+* a **traced** result (:class:`~distortion.characteristic.CharacteristicDistortion`, a curve taken
+  from one with ``.curve(i)``, or a calibration of either) is traced again at
+  :data:`~orthoscope.plots.common.DENSE_POINTS` fields over the same range (same lens, object,
+  image planes, reference; about 2 ms), the field points included, and the line is that dense
+  trace;
+* a **table** (a :class:`~distortion.curve.DistortionCurve` read from a file, e.g. Pestrecov's
+  Table I) is never extended with invented data: its points are joined by the monotone cubic
+  spline of Fritsch & Carlson (``scipy.interpolate.PchipInterpolator``), which passes through every
+  point and does not overshoot between them.
 """
 
 from __future__ import annotations
@@ -10,71 +25,216 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from matplotlib.figure import Figure
 
-from distortion.calibration import CalibrationResult
-from distortion.curve import DistortionCurve
+from distortion.calibration import CalibrationResult, calibrate
+from distortion.characteristic import CharacteristicDistortion
+from distortion.curve import ANGLE, HEIGHT, DistortionCurve
 from distortion.errors import DataError
+from raytrace.errors import OrthoscopeError
 
-def _title(name: str, plane: str, what: str) -> str:
-    head = " ".join(s for s in (name, plane) if s)
-    return f"{what}\n{head}" if head else what
+from .common import (
+    DENSE_POINTS,
+    FIGSIZE,
+    GRID,
+    ZERO,
+    dense_and_markers,
+    figure_and_axes,
+    fmt,
+    legend,
+    monotone_spline,
+    set_title,
+    shared_zero,
+)
+
+LINEAR = "k"
+RELATIVE = "tab:blue"
 
 
-def _two_axes(x, lin, rel, xlabel, lin_label, rel_label, title):
-    fig = Figure(figsize=(7.0, 4.6))
-    ax = fig.subplots()
-    ax.axhline(0.0, color="0.4", lw=0.8)
-    (l1,) = ax.plot(x, lin, "-o", color="k", ms=4, label=lin_label)
+# ------------------------------------------------------------------ data helpers
+
+
+def _as_curve(d, plane: int = 0) -> DistortionCurve:
+    if isinstance(d, DistortionCurve):
+        return d
+    if isinstance(d, CharacteristicDistortion):
+        if not 0 <= int(plane) < d.n_planes:
+            raise DataError(f"plane={plane}: the result has {d.n_planes} image plane(s) (0-based)")
+        return d.curve(int(plane))
+    raise DataError(
+        f"expected a DistortionCurve or a CharacteristicDistortion, got {type(d).__name__}"
+    )
+
+
+def _traced_source(curve: DistortionCurve):
+    """``(CharacteristicDistortion, plane)`` a curve was taken from, when it can be traced again."""
+    src = curve.extra.get("traced") if curve.extra else None
+    if isinstance(src, CharacteristicDistortion) and src.lens is not None:
+        return src, int(curve.extra.get("plane", 0))
+    return None, 0
+
+
+def dense_curve(
+    curve: DistortionCurve, n: int = DENSE_POINTS, *, cache: dict | None = None
+) -> DistortionCurve | None:
+    """The curve traced again at ``n`` fields over its range (its own fields included), or None
+    for a curve that does not come from a trace (a table) or whose re-trace fails (the plot then
+    joins the points by a monotone spline). ``cache``: re-traces by source, for several planes of
+    one result."""
+    src, plane = _traced_source(curve)
+    if src is None or curve.fields.size < 2:
+        return None
+    f = np.union1d(np.linspace(curve.fields.min(), curve.fields.max(), n), curve.fields)
+    key = (id(src), f.size, float(f[0]), float(f[-1]))
+    try:
+        if cache is not None and key in cache:
+            again = cache[key]
+        else:
+            again = src.retrace(f)
+            if cache is not None:
+                cache[key] = again
+    except OrthoscopeError:
+        return None
+    return again.curve(plane)
+
+
+def _dense_calibration(res: CalibrationResult) -> CalibrationResult | None:
+    """The calibration with the same K_c applied to the densely traced curve (None for a table)."""
+    d = dense_curve(res.curve)
+    return None if d is None else calibrate(d, "given", value=res.Kc, k=res.k)
+
+
+def _constant_text(symbol: str, sub: str, value: float, finite: bool) -> str:
+    """``$F_{0}$ = 153.706 mm`` with no-break spaces (a wrapped title keeps it on one line)."""
+    return f"${symbol}_{{{sub}}}$\u00a0=\u00a0{fmt(value, 7)}" + ("" if finite else "\u00a0mm")
+
+
+def _plane_text(curve: DistortionCurve) -> str:
+    """Image-plane label with sensible digits (traced curves), else the curve's own text."""
+    src, i = _traced_source(curve)
+    if src is None or curve.plane != src.plane_label(i):  # a table, or text set by the caller
+        return curve.plane
+    sp, dz = src.s_prime[i], src.defocus[i]
+    head = f"$s'$\u00a0=\u00a0{fmt(sp, 6)}\u00a0mm"
+    if abs(dz) <= 1e-9 * max(1.0, abs(sp)):
+        return f"{head} (Gaussian plane)"
+    dz_text = f"{dz:+.4g}".replace("-", "\u2212")
+    return f"{head} (defocus {dz_text}\u00a0mm)"
+
+
+def _field_axis_label(field_kind: str) -> str:
+    return {
+        ANGLE: r"field angle $\alpha$ (deg)",
+        HEIGHT: "object height $y$ (mm)",
+    }.get(field_kind, r"nominal field angle $\alpha$ (deg)")
+
+
+def _heading(what: str, curve: DistortionCurve, extra: str = "") -> str:
+    parts = [p for p in (curve.name, _plane_text(curve), extra) if p]
+    return what + (" — " + ", ".join(parts) if parts else "")
+
+
+def _interp(x, y, dense_x=None, dense_y=None):
+    """Dense line: the given dense arrays, else a monotone spline through the points."""
+    if dense_x is not None:
+        return np.asarray(dense_x, float), np.asarray(dense_y, float)
+    return monotone_spline(x, y)
+
+
+# ------------------------------------------------------------------ Figs. 2 and 3
+
+
+def _linear_and_relative(ax, x, lin, rel, dense, xlabel, lin_label, rel_label, title):
+    """Linear distortion (mm, left axis, black solid) and relative (%, right axis, blue dashed),
+    zero lines shared. ``dense`` is ``(x, lin, rel)`` dense arrays or None (spline the points)."""
+    ax.axhline(0.0, **ZERO)
+    dl = (dense[0], dense[1]) if dense is not None else monotone_spline(x, lin)
+    dr = (dense[0], dense[2]) if dense is not None else monotone_spline(x, rel)
+    h1 = dense_and_markers(ax, dl, (x, lin), color=LINEAR, marker="o")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(lin_label)
     ax2 = ax.twinx()
-    (l2,) = ax2.plot(x, rel, "--s", color="tab:blue", ms=4, label=rel_label)
-    ax2.set_ylabel(rel_label, color="tab:blue")
-    ax2.tick_params(axis="y", colors="tab:blue")
-    # share the zero line between the two scales
-    for a, v in ((ax, lin), (ax2, rel)):
-        m = float(np.nanmax(np.abs(v))) if np.size(v) else 1.0
-        m = m if m > 0 else 1.0
-        a.set_ylim(-1.15 * m, 1.15 * m)
-    ax.set_xlim(left=0.0 if np.nanmin(x) >= 0 else None)
-    ax.grid(True, color="0.85", lw=0.6)
-    ax.legend(handles=[l1, l2], loc="upper left", frameon=False)
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    return fig, ax, ax2
+    h2 = dense_and_markers(ax2, dr, (x, rel), color=RELATIVE, ls="--", marker="s", ms=3.5)
+    ax2.set_ylabel(rel_label, color=RELATIVE)
+    ax2.tick_params(axis="y", colors=RELATIVE)
+    shared_zero(ax, ax2, np.concatenate([lin, dl[1]]), np.concatenate([rel, dr[1]]))
+    if np.nanmin(x) >= 0:
+        ax.set_xlim(left=0.0)
+    ax.grid(True, **GRID)
+    legend(ax, [h1, h2], [lin_label, rel_label], loc="upper left")
+    set_title(ax, title)
+    return ax2
 
 
-def plot_characteristic(curve: DistortionCurve):
-    """Fig. 2: characteristic linear (mm, left axis) and per-cent distortion (right axis) against
-    the ideal image size y0' (mm)."""
-    k = f"{curve.symbol}0 = {curve.constant:.4f}{'' if curve.finite else ' mm'}"
-    fig, *_ = _two_axes(
+def plot_characteristic(
+    distortion: DistortionCurve | CharacteristicDistortion,
+    *,
+    ax=None,
+    title: str | None = None,
+    plane: int = 0,
+):
+    """Pestrecov's Fig. 2: characteristic linear distortion D_0 (mm, left axis) and relative
+    distortion D_r (%, right axis) against the ideal image size y_0' (mm).
+
+    Parameters
+    ----------
+    distortion : DistortionCurve or CharacteristicDistortion
+        A table or a traced result (its image plane ``plane``, 0-based). A traced curve is traced
+        again densely for the line; a table's points are joined by a monotone spline (module
+        docstring). Markers at the given field points.
+    ax : matplotlib.axes.Axes, optional
+        Draw here (the per-cent scale goes on ``ax.twinx()``); default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    curve = _as_curve(distortion, plane)
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
+    d = dense_curve(curve)
+    const = _constant_text(curve.symbol, "0", curve.constant, curve.finite)
+    _linear_and_relative(
+        ax,
         curve.y0p,
         curve.D0,
         100.0 * curve.Dr,
-        "ideal image size y0' (mm)",
-        "linear distortion D0 (mm)",
-        "relative distortion Dr (%)",
-        _title(curve.name, curve.plane, f"Characteristic linear and % distortion ({k})"),
+        None if d is None else (d.y0p, d.D0, 100.0 * d.Dr),
+        "ideal image size $y_0'$ (mm)",
+        "linear distortion $D_0$ (mm)",
+        "relative distortion $D_r$ (%)",
+        title or _heading("Characteristic linear and % distortion", curve, const),
     )
     return fig
 
 
-def plot_calibrated(res: CalibrationResult):
-    """Fig. 3: calibrated linear (mm) and per-cent distortion against calibrated image size y_c'."""
+def plot_calibrated(res: CalibrationResult, *, ax=None, title: str | None = None):
+    """Pestrecov's Fig. 3: calibrated linear distortion D_c (mm, left axis) and relative
+    distortion D_rc (%, right axis) against the calibrated image size y_c' (mm).
+
+    A calibration of a traced curve is drawn through the dense trace with the same K_c; a
+    calibration of a table through a monotone spline of its points (module docstring). Markers at
+    the field points. ``ax``, ``title``: as :func:`plot_characteristic`. Returns the Figure.
+    """
     c = res.curve
-    k = f"{res.symbol}c = {res.Kc:.4f}{'' if c.finite else ' mm'}, {res.method}"
-    fig, *_ = _two_axes(
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
+    d = _dense_calibration(res)
+    const = _constant_text(res.symbol, "c", res.Kc, c.finite) + f" ({res.method})"
+    _linear_and_relative(
+        ax,
         res.ycp,
         res.Dc,
         100.0 * res.Drc,
-        "calibrated image size yc' (mm)",
-        "calibrated linear distortion Dc (mm)",
-        "calibrated relative distortion Drc (%)",
-        _title(c.name, c.plane, f"Calibrated linear and % distortion ({k})"),
+        None if d is None else (d.ycp, d.Dc, 100.0 * d.Drc),
+        "calibrated image size $y_c'$ (mm)",
+        "calibrated linear distortion $D_c$ (mm)",
+        "calibrated relative distortion $D_{rc}$ (%)",
+        title or _heading("Calibrated linear and % distortion", c, const),
     )
     return fig
+
+
+# ------------------------------------------------------------------ Fig. 4
 
 
 def rotated_characteristic(res: CalibrationResult) -> tuple[np.ndarray, np.ndarray]:
@@ -93,74 +253,135 @@ def rotated_characteristic(res: CalibrationResult) -> tuple[np.ndarray, np.ndarr
     return Xp, Yp / res.k
 
 
-def plot_rotation(res: CalibrationResult):
-    """Fig. 4: the characteristic curve rotated by −ρ_k vs the calibrated curve (D_c vs y_c')."""
+def plot_rotation(res: CalibrationResult, *, ax=None, title: str | None = None):
+    """Pestrecov's Fig. 4: the characteristic curve rotated through −ρ_k
+    (:func:`rotated_characteristic`) against the calibrated curve D_c(y_c'); both in mm.
+
+    Lines: the dense trace (traced results) or a monotone spline through the points (tables);
+    markers at the field points. ``ax``, ``title``: as :func:`plot_characteristic`. Returns the
+    Figure.
+    """
     c = res.curve
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
     Xp, Dp = rotated_characteristic(res)
-    fig = Figure(figsize=(7.0, 4.6))
-    ax = fig.subplots()
-    ax.axhline(0.0, color="0.4", lw=0.8)
-    ax.plot(
-        Xp,
-        Dp,
-        "--o",
-        color="tab:red",
-        ms=4,
-        label=f"characteristic, rotated by −ρk (ρk = {res.rho_k_deg:.2f}°, k = {res.k:g})",
+    d = _dense_calibration(res)
+    ax.axhline(0.0, **ZERO)
+    if d is not None:
+        rot_dense = rotated_characteristic(d)
+        cal_dense = (d.ycp, d.Dc)
+    else:
+        rot_dense = monotone_spline(Xp, Dp)
+        cal_dense = monotone_spline(res.ycp, res.Dc)
+    h1 = dense_and_markers(ax, rot_dense, (Xp, Dp), color="tab:red", ls="--", marker="o")
+    h2 = dense_and_markers(ax, cal_dense, (res.ycp, res.Dc), color=LINEAR, marker="s", ms=3.5)
+    rho = (
+        rf"characteristic, rotated by $-\rho_k$ ($\rho_k$ = {res.rho_k_deg:.2f}°, "
+        f"$k$ = {fmt(res.k, 4)})"
     )
-    ax.plot(
-        res.ycp, res.Dc, "-s", color="k", ms=4, label=f"calibrated, {res.symbol}c = {res.Kc:.3f}"
-    )
-    ax.set_xlabel("image size: X' (rotated) / yc' (calibrated) (mm)")
+    cal = "calibrated, " + _constant_text(res.symbol, "c", res.Kc, c.finite)
+    ax.set_xlabel("image size $X'$ (rotated) / $y_c'$ (calibrated) (mm)")
     ax.set_ylabel("linear distortion (mm)")
-    ax.set_xlim(left=0.0 if np.nanmin(Xp) >= 0 else None)
-    ax.grid(True, color="0.85", lw=0.6)
-    ax.legend(loc="lower left", frameon=False, fontsize=9)
-    ax.set_title(
-        _title(c.name, c.plane, "Shapes of characteristic and calibrated distortion curves"),
-        fontsize=10,
-    )
-    fig.tight_layout()
+    if np.nanmin(Xp) >= 0:
+        ax.set_xlim(left=0.0)
+    ax.grid(True, **GRID)
+    legend(ax, [h1, h2], [rho, cal], loc="lower left")
+    set_title(ax, title or _heading("Shapes of characteristic and calibrated distortion curves", c))
     return fig
 
 
-def plot_planes(
-    curves: list[DistortionCurve], *, against: str = "field", title: str | None = None
-):
-    """Fig. 6: linear distortion curves in several image planes on one chart.
+# ------------------------------------------------------------------ Fig. 6
 
-    against: ``"field"`` (field angle / object height, common to all planes — as Fig. 6 and
-    Table V) or ``"image"`` (the ideal image size y0' of each plane). Labels come from each
-    curve's ``plane``.
+_STYLES = [("-", "o"), ("--", "s"), ("-.", "^"), (":", "D"), ("-", "v"), ("--", "P")]
+
+
+def plot_planes(
+    curves: list[DistortionCurve] | CharacteristicDistortion,
+    *,
+    against: str = "field",
+    ax=None,
+    title: str | None = None,
+):
+    """Pestrecov's Fig. 6: characteristic linear distortion D_0 (mm) in several image planes on one
+    chart.
+
+    Parameters
+    ----------
+    curves : list of DistortionCurve, or a CharacteristicDistortion with several planes
+        One curve per plane. Traced curves are traced again densely; tabulated ones are joined
+        by a monotone spline (module docstring). Legend: the plane of each traced curve (s' in
+        mm), else each curve's ``plane`` text.
+    against : {"field", "image"}
+        Abscissa: the field (angle α in degrees or object height in mm, common to all planes, as
+        Fig. 6 and Table V) or the ideal image size y_0' (mm) of each plane.
+    ax, title
+        As :func:`plot_characteristic`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
+    if isinstance(curves, CharacteristicDistortion):
+        curves = [curves.curve(i) for i in range(curves.n_planes)]
     if not curves:
         raise DataError("no curves to plot")
     if against not in ("field", "image"):
         raise ValueError(f"against must be 'field' or 'image', got {against!r}")
-    fig = Figure(figsize=(7.0, 4.6))
-    ax = fig.subplots()
-    ax.axhline(0.0, color="0.4", lw=0.8)
-    styles = ["-o", "--s", "-.^", ":D", "-v", "--x"]
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
+    ax.axhline(0.0, **ZERO)
+    handles, labels = [], []
+    traces: dict = {}
     for i, c in enumerate(curves):
+        d = dense_curve(c, cache=traces)
         x = c.fields if against == "field" else c.y0p
-        ax.plot(
-            x, c.D0, styles[i % len(styles)], color=f"C{i}", ms=4, label=c.plane or f"plane {i + 1}"
+        dx = None if d is None else (d.fields if against == "field" else d.y0p)
+        ls, mk = _STYLES[i % len(_STYLES)]
+        h = dense_and_markers(
+            ax,
+            _interp(x, c.D0, dx, None if d is None else d.D0),
+            (x, c.D0),
+            color=f"C{i}",
+            ls=ls,
+            marker=mk,
+            ms=3.5,
         )
+        handles.append(h)
+        labels.append(_plane_text(c) or f"plane {i + 1}")
     c0 = curves[0]
     ax.set_xlabel(
-        c0.field_label.replace("α", "field angle α")
-        if against == "field"
-        else "ideal image size y0' (mm)"
+        _field_axis_label(c0.field_kind) if against == "field" else "ideal image size $y_0'$ (mm)"
     )
-    ax.set_ylabel("linear distortion D0 (mm)")
-    ax.grid(True, color="0.85", lw=0.6)
-    ax.legend(frameon=False, fontsize=9)
-    ax.set_title(
-        title or _title(c0.name, "", "Characteristic linear distortion in several image planes"),
-        fontsize=10,
-    )
-    fig.tight_layout()
+    ax.set_ylabel("linear distortion $D_0$ (mm)")
+    ax.grid(True, **GRID)
+    legend(ax, handles, labels)
+    head = "Characteristic linear distortion in several image planes"
+    set_title(ax, title or (f"{head} — {c0.name}" if c0.name else head))
     return fig
+
+
+# ------------------------------------------------------------------ the one entry point
+
+
+def plot_distortion(
+    distortion: DistortionCurve | CharacteristicDistortion,
+    calibration: CalibrationResult | None = None,
+    *,
+    ax=None,
+    title: str | None = None,
+):
+    """The chart that fits the result: the calibrated curve (Fig. 3) when ``calibration`` is
+    given, the curves of several image planes (Fig. 6) for a multi-plane result, else the
+    characteristic linear and relative distortion (Fig. 2).
+
+    ``distortion`` is a :class:`~distortion.characteristic.CharacteristicDistortion` (traced again
+    densely for smooth lines) or a :class:`~distortion.curve.DistortionCurve` (a table: monotone
+    spline through its points). ``ax``: draw there (default a new pyplot figure), e.g.
+    ``fig, (a, b) = plt.subplots(1, 2); osc.plot_distortion(d, ax=a)``. Returns the Figure.
+    """
+    if calibration is not None:
+        return plot_calibrated(calibration, ax=ax, title=title)
+    if isinstance(distortion, CharacteristicDistortion) and distortion.n_planes > 1:
+        return plot_planes(distortion, ax=ax, title=title)
+    return plot_characteristic(distortion, ax=ax, title=title)
 
 
 def png_bytes(fig, dpi: int = 100) -> bytes:
@@ -170,18 +391,3 @@ def png_bytes(fig, dpi: int = 100) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     return buf.getvalue()
-
-
-def plot_distortion(distortion, calibration: CalibrationResult | None = None):
-    """The chart that fits the result: a calibrated curve (Fig. 3) when ``calibration`` is given,
-    the curves of several image planes (Fig. 6) for a multi-plane result, else the characteristic
-    linear and relative distortion (Fig. 2). ``distortion`` is a
-    :class:`~distortion.characteristic.CharacteristicDistortion` or a
-    :class:`~distortion.curve.DistortionCurve`. Returns the Figure."""
-    if calibration is not None:
-        return plot_calibrated(calibration)
-    if isinstance(distortion, DistortionCurve):
-        return plot_characteristic(distortion)
-    if distortion.n_planes > 1:
-        return plot_planes([distortion.curve(i) for i in range(distortion.n_planes)])
-    return plot_characteristic(distortion.curve(0))

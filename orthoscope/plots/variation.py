@@ -4,10 +4,14 @@
   in their plane of focus solid ("12×"), object planes off focus dashed ("8×(12×)": object plane
   at 8× with the lens focused at 12×), as in Fig. 2.
 * :func:`plot_g` — g_ss' against radial distance, per object plane; radii where
-  |δr_s' − δr_s| is below the threshold dashed (weak determination, Figs. 5–6), the least-squares
-  g as a thin horizontal line.
+  |δr_s' − δr_s| is below the threshold dashed with open markers (weak determination,
+  Figs. 5–6), the least-squares g as a thin horizontal line.
 
-Both return the matplotlib Figure (no pyplot, no backend needed); ``path`` saves a PNG.
+Markers sit at the radii of the profiles (measured, or the common grid of a traced study); the
+lines join them with the monotone cubic spline of Fritsch & Carlson
+(``scipy.interpolate.PchipInterpolator``), the interpolant the analysis itself uses: it passes
+through every point and never overshoots between two of them — nothing is invented between the
+radii. Both functions take ``ax=`` and return the Figure (:mod:`orthoscope.plots.common`).
 """
 
 from __future__ import annotations
@@ -16,78 +20,159 @@ from pathlib import Path
 
 import matplotlib
 import numpy as np
-from matplotlib.figure import Figure
 
 from distortion.variation.analysis import VariationAnalysis
 
+from .common import (
+    FIGSIZE,
+    GRID,
+    ZERO,
+    dense_and_markers,
+    figure_and_axes,
+    legend,
+    monotone_spline,
+    set_title,
+)
 
-def plot_profiles(
-    a: VariationAnalysis, *, title: str | None = None
-):
-    """Radial distortion profiles i×(j×) of an analysis (Figs. 1–4 style)."""
-    fig = Figure(figsize=(7, 5))
-    ax = fig.subplots()
-    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
+
+def _colours() -> list:
+    return matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
+
+
+def _source(a: VariationAnalysis) -> str:
+    """The data's name for a title: a file's name, or the text as given (e.g. a lens name)."""
+    s = a.source or ""
+    return (Path(s).name if s.lower().endswith(".csv") else s) or "profiles"
+
+
+def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
+    """Radial distortion profiles i×(j×) of an analysis (Fraser & Shortis Figs. 1–4 style):
+    δr (µm) against the radial distance r (mm); Gaussian profiles (object plane = plane of
+    focus) solid with filled markers, off-focus object planes dashed with open markers.
+
+    Parameters
+    ----------
+    a : VariationAnalysis
+        From :func:`distortion.variation.analyze_variation` or ``trace_variation(...).analysis``.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
+    colours = _colours()
+    handles, labels = [], []
     for i, p in enumerate(a.profiles):
         gauss = p.focus == p.obj
-        ax.plot(
-            p.r_mm,
-            p.dr_um,
-            "-" if gauss else "--",
-            marker="o" if gauss else ".",
-            ms=3,
-            color=colors[i % len(colors)],
-            label=p.label,
+        c = colours[i % len(colours)]
+        h = dense_and_markers(
+            ax,
+            monotone_spline(p.r_mm, p.dr_um),
+            (p.r_mm, p.dr_um),
+            color=c,
+            ls="-" if gauss else "--",
+            marker="o" if gauss else "s",
+            ms=3.5 if gauss else 3.0,
+            mfc=None if gauss else "white",
+            lw=1.3,
         )
-    ax.axhline(0.0, color="0.6", lw=0.6)
+        handles.append(h)
+        labels.append(p.label)
+    ax.axhline(0.0, **ZERO)
     ax.set_xlabel("radial distance r (mm)")
-    ax.set_ylabel("radial distortion δr (µm)")
-    ax.set_title(title or f"Radial distortion profiles — {Path(a.source).name or 'profiles'}")
-    ax.grid(True, lw=0.3)
-    ax.legend(title="i×(j×): object i×, focus j×", fontsize=8, title_fontsize=8)
-    fig.tight_layout()
+    ax.set_ylabel(r"radial distortion $\delta r$ (µm)")
+    set_title(ax, title or f"Radial distortion profiles — {_source(a)}")
+    ax.grid(True, **GRID)
+    if handles:
+        legend(
+            ax,
+            handles,
+            labels,
+            title="object plane (plane of focus)",
+            fontsize=8,
+            title_fontsize=8,
+        )
     return fig
 
 
-def plot_g(a: VariationAnalysis, *, title: str | None = None):
-    """g_ss' against radial distance (Figs. 5–7 style); weak radii dashed."""
-    fig = Figure(figsize=(7, 5))
-    ax = fig.subplots()
-    colors = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
+def _strong_segments(r: np.ndarray, strong: np.ndarray, rd: np.ndarray) -> np.ndarray:
+    """Mask of dense radii ``rd`` lying between two neighbouring strong radii of ``r``."""
+    k = np.clip(np.searchsorted(r, rd, side="right") - 1, 0, r.size - 2)
+    return strong[k] & strong[k + 1]
+
+
+def plot_g(a: VariationAnalysis, *, ax=None, title: str | None = None):
+    """g_ss' (Fraser & Shortis Eq. 6) against the radial distance r (mm) per object plane
+    (Figs. 5–7 style). Radii of weak determination (|δr_s' − δr_s| below the analysis threshold)
+    are open markers on a dashed line; the estimated g of each plane is a thin horizontal line.
+    ``ax``, ``title``: as :func:`plot_profiles`. Returns the Figure."""
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
+    colours = _colours()
     k = 0
     finite = []
+    handles, labels = [], []
     for fs in a.focus_summaries:
         for pl in fs.planes:
             e = pl.estimate
-            c = colors[k % len(colors)]
+            c = colours[k % len(colours)]
             k += 1
-            lab = f"{pl.obj.label}({pl.focus.label})"
-            ax.plot(e.r_mm, e.g_pointwise, "--", color=c, lw=0.9)
-            strong = np.where(e.weak, np.nan, e.g_pointwise)
-            g_txt = f"g = {e.g:.3f} ± {e.se:.3f}" if e.determined else "undetermined"
-            ax.plot(e.r_mm, strong, "-", marker="o", ms=3, color=c, label=f"{lab}: {g_txt}")
+            ok = np.isfinite(e.g_pointwise)
+            r, g, weak = e.r_mm[ok], e.g_pointwise[ok], e.weak[ok]
+            if r.size == 0:
+                continue
+            rd, gd = monotone_spline(r, g)
+            # the whole curve dashed (thin); the stretches between two strong radii solid on top
+            ax.plot(rd, gd, "--", color=c, lw=0.9)
+            if r.size > 1 and rd.size == np.unique(rd).size:
+                solid = np.where(_strong_segments(r, ~weak, rd), gd, np.nan)
+            else:
+                solid = np.where(~weak, g, np.nan)
+                rd = r
+            h = dense_and_markers(
+                ax,
+                (rd, solid),
+                (r[~weak], g[~weak]),
+                color=c,
+                marker="o",
+                ms=3.5,
+                lw=1.4,
+            )
+            ax.plot(r[weak], g[weak], ls="none", marker="o", ms=3.5, color=c, mfc="white")
+            g_txt = f"$g$ = {e.g:.3f} ± {e.se:.3f}" if e.determined else "undetermined"
+            handles.append(h)
+            labels.append(f"{pl.obj.label}({pl.focus.label}): {g_txt}")
             if e.determined:
                 ax.axhline(e.g, color=c, lw=0.6, alpha=0.7)
-            finite.extend(strong[np.isfinite(strong)])
+            finite.extend(g[~weak])
     if finite:
         lo, hi = np.percentile(finite, [2, 98])
         pad = max(0.1, 0.25 * (hi - lo))
         ax.set_ylim(lo - pad, hi + pad)
     ax.set_xlabel("radial distance r (mm)")
-    ax.set_ylabel("g_ss' (dimensionless)")
-    ax.set_title(title or f"Distortion factor g_ss' (Eq. 6) — {Path(a.source).name or 'profiles'}")
-    ax.grid(True, lw=0.3)
-    if k:
-        ax.legend(
-            fontsize=8, title=f"dashed: |δr_s' − δr_s| < {a.threshold_um:g} µm", title_fontsize=8
+    ax.set_ylabel("distortion factor $g_{ss'}$ (dimensionless)")
+    set_title(ax, title or f"Distortion factor $g_{{ss'}}$ (Eq. 6) — {_source(a)}")
+    ax.grid(True, **GRID)
+    if handles:
+        legend(
+            ax,
+            handles,
+            labels,
+            fontsize=8,
+            title=(
+                rf"dashed, open: $|\delta r_{{s'}} - \delta r_s|$ < {a.threshold_um:g} µm (weak)"
+            ),
+            title_fontsize=8,
         )
     else:
         ax.text(
             0.5,
             0.5,
-            "no g_ss' determinable from these profiles",
+            "no $g_{ss'}$ determinable from these profiles",
             ha="center",
             transform=ax.transAxes,
         )
-    fig.tight_layout()
     return fig

@@ -74,10 +74,10 @@ def resolve_lens_path(name_or_path: str | Path) -> Path:
     """The file for ``name_or_path``: an existing file path wins; otherwise a bundled lens name,
     with or without ``.toml``. Raises :class:`PrescriptionError` listing the bundled names."""
     p = Path(name_or_path)
-    if p.is_file():
-        return p
     if p.is_dir():
         raise PrescriptionError("is a directory, not a lens file", path=str(p))
+    if p.exists():  # a file, or a FIFO / /dev/fd/N / process substitution
+        return p
     names = bundled_names()
     key = str(name_or_path)
     stem = key.removesuffix(".toml")

@@ -59,6 +59,17 @@ def check_output(
     return p
 
 
+def _mode(p: Path) -> int:
+    """The permissions the written file gets: those of the file it replaces, else the usual
+    0666 less the process umask (a temporary file starts at 0600)."""
+    try:
+        return p.stat().st_mode & 0o7777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
 def write_atomic(
     path: str | os.PathLike,
     data: bytes | str,
@@ -86,6 +97,7 @@ def write_atomic(
             os.fsync(fh.fileno())
         if p.exists() and not overwrite:  # appeared while we were writing
             raise OutputError(f"{p}: the file appeared while writing; give {flag} to replace it")
+        os.chmod(tmp, _mode(p))
         os.replace(tmp, p)
         tmp = None
     except OSError as e:

@@ -90,11 +90,22 @@ def decode_text(raw: bytes, path: str | None, what: str, *, latin1: bool = True)
     return text
 
 
+#: The largest lens file read (bytes): real lens files are kilobytes; this stops /dev/zero.
+MAX_FILE_BYTES = 64 * 1024 * 1024
+
+
 def read_bytes(path: str | Path) -> bytes:
-    """Read a file, turning OS errors into PrescriptionError."""
+    """Read a file (or a pipe), turning OS errors into PrescriptionError; a file larger than
+    :data:`MAX_FILE_BYTES` is refused."""
     p = Path(path)
     try:
-        return p.read_bytes()
+        with open(p, "rb") as fh:
+            data = fh.read(MAX_FILE_BYTES + 1)
+        if len(data) > MAX_FILE_BYTES:
+            raise PrescriptionError(
+                f"larger than {MAX_FILE_BYTES // (1024 * 1024)} MB: not a lens file", path=str(p)
+            )
+        return data
     except FileNotFoundError:
         raise PrescriptionError("no such file", path=str(p)) from None
     except IsADirectoryError:

@@ -78,11 +78,14 @@ _UNITS = {"MM": 1.0, "CM": 10.0, "IN": 25.4, "M": 1000.0, "METER": 1000.0, "METR
 # Commands skipped silently: display, reporting, tolerancing, coating, merit function, solves
 # (the solved value is stored), configuration bookkeeping, non-optical metadata.
 _IGNORED_GLOBAL = set(
-    """VERS PFIL LANG ENVD GFAC RAIM PUSH SDMA ROPD PICB FWGN FWGT VDXN VDYN VCXN VCYN VANN
+    """VERS PFIL LANG GFAC RAIM PUSH SDMA ROPD PICB FWGN FWGT VDXN VDYN VCXN VCYN VANN
     POLS GLRS GSTD NSCD COFN TOL TOLE MOFF BLNK TRAC OPDX HYPR EFLY DMFS OMMA OEMA RCMF AUTH
-    DBDT WWGT WAVN XFIE PUCN TCMM TOTR FLAN WFAN SSOB SGLI ZVDX ZVDY ZVCX ZVCY ZVAN PMAG
-    MAZH TCED""".split()
+    DBDT WAVN XFIE PUCN TCMM TOTR FLAN WFAN SSOB SGLI ZVDX ZVDY ZVCX ZVCY ZVAN PMAG
+    MAZH TCED WFNO""".split()
 )
+# WFNO is a merit-function / default-merit setting line (``WFNO 0 0 0 ...``), not an aperture:
+# the aperture is ENPD, FNUM (flag 0 image-space F/#, 1 paraxial working F/#), OBNA (flag 0 NA,
+# 1 object cone angle) or FLOA (float by stop size).
 _IGNORED_SURFACE = set(
     """HIDE MIRR SLAB POPS VDSZ FLAP MEMA FIMP COAT PZUP PPAR VPAR VCON EDGE UDAD USAP BLNK
     TCED OBDC CDCS DCPM THMP""".split()
@@ -220,12 +223,19 @@ class _ZmxParser:
                         lineno,
                     )
                 h["UNIT"] = (_UNITS[u], lineno)
+            elif cmd in ("FNUM", "OBNA") and len(args) > 1 and args[1] not in ("0", "0.0"):
+                meaning = "paraxial working F/#" if cmd == "FNUM" else "object cone angle"
+                raise self.err(
+                    f"{cmd} {' '.join(args[:2])}: aperture type '{meaning}' is not supported; in "
+                    "OpticStudio set the system aperture to Entrance Pupil Diameter (ENPD), Image "
+                    "Space F/# (FNUM) or Object Space NA (OBNA) and save again",
+                    lineno,
+                )
             elif cmd in ("ENPD", "FNUM", "OBNA"):
                 h["APER"] = (cmd, self.num(args, 0, cmd, lineno), lineno)
-            elif cmd in ("FLOA", "WFNO", "OBCA", "PWFN"):
+            elif cmd in ("FLOA", "OBCA", "PWFN"):
                 meaning = {
                     "FLOA": "float by stop size",
-                    "WFNO": "paraxial working F/#",
                     "OBCA": "object cone angle",
                     "PWFN": "paraxial working F/#",
                 }[cmd]
@@ -248,12 +258,19 @@ class _ZmxParser:
                 i = self.integer(args, 0, "WAVM", lineno)
                 if len(args) < 2:
                     raise self.err("WAVM needs 'WAVM index wavelength_um weight'", lineno)
-                wavm[i] = (micron_to_nm(args[1], self.fail, lineno, "WAVM"), lineno)
+                w = self.num(args, 2, "WAVM weight", lineno) if len(args) > 2 else 1.0
+                wavm[i] = (micron_to_nm(args[1], self.fail, lineno, "WAVM"), w, lineno)
             elif cmd == "WAVL":
                 wavl = (
                     [micron_to_nm(a, self.fail, lineno, "WAVL") for a in args],
                     lineno,
                 )
+            elif cmd == "WWGT":
+                h["WWGT"] = ([self.num(args, i, "WWGT", lineno) for i in range(len(args))], lineno)
+            elif cmd == "ENVD":
+                t = self.num(args, 0, "ENVD temperature", lineno)
+                pr = self.num(args, 1, "ENVD pressure", lineno) if len(args) > 1 else 1.0
+                h["ENVD"] = (t, pr, lineno)
             elif cmd == "PWAV":
                 h["PWAV"] = (self.integer(args, 0, "PWAV", lineno), lineno)
             elif cmd == "GCAT":
@@ -432,6 +449,53 @@ class _ZmxParser:
         return tuple(coef.get(i, 0.0) * scale ** (1 - 2 * i) for i in range(2, n + 1))
 
     # ------------------------------------------------------------------------------------
+    def wavelengths(self, h, wavm, wavl):
+        """(wavelengths nm, weights, line, primary nm): the WAVM slots 1..n with n the FTYP
+        wavelength count (all slots when FTYP gives none), or the WAVL list with WWGT weights;
+        the primary is slot PWAV. Each wavelength goes through raytrace.units.wavelength_nm."""
+        from ..units import UnitError, wavelength_nm
+
+        nw = h.get("FTYP", (0, None, None, None))[2]
+        pw, pw_line = h.get("PWAV", (1, None))
+        if wavm:
+            slots = sorted(i for i in wavm if i >= 1 and (nw is None or nw <= 0 or i <= nw))
+            if not slots:
+                raise self.err(
+                    f"FTYP asks for {nw} wavelength(s) but there are no WAVM 1..{nw} lines",
+                    min(v[2] for v in wavm.values()),
+                )
+            if pw not in slots:
+                raise self.err(
+                    f"PWAV {pw}: there is no active WAVM {pw} line (wavelengths: "
+                    f"{', '.join(str(i) for i in slots)})",
+                    pw_line or min(v[2] for v in wavm.values()),
+                )
+            entries = [(wavm[i][0], wavm[i][1], wavm[i][2]) for i in slots]
+            primary_pos = slots.index(pw)
+        elif wavl is not None:
+            vals, line = wavl
+            wts = h.get("WWGT", ([], None))[0]
+            if not 1 <= pw <= len(vals):
+                raise self.err(f"PWAV {pw}: WAVL lists {len(vals)} wavelength(s)", line)
+            entries = [(v, wts[i] if i < len(wts) else 1.0, line) for i, v in enumerate(vals)]
+            primary_pos = pw - 1
+        else:
+            self.warn("no wavelength (WAVM/WAVL): the d line 587.5618 nm is used")
+            return (LAMBDA_D,), (1.0,), 1, LAMBDA_D
+        for v, w, line in entries:
+            try:
+                wavelength_nm(v)
+            except UnitError:
+                raise self.err(
+                    f"the wavelength {v / 1000:g} µm is outside {100 / 1000:g}-{30000 / 1000:g} "
+                    "µm (WAVM/WAVL are in µm)",
+                    line,
+                ) from None
+            if not (math.isfinite(w) and w >= 0.0):
+                raise self.err(f"wavelength weight {w!r} must be a number >= 0", line)
+        wls = tuple(e[0] for e in entries)
+        return wls, tuple(e[1] for e in entries), entries[primary_pos][2], wls[primary_pos]
+
     def build(self, surfaces, h, notes_meta, plain_notes, xfln, yfln, wavm, wavl, gcat):
         last_line = len(self.text.split("\n"))
         if len(surfaces) < 3:
@@ -482,13 +546,20 @@ class _ZmxParser:
             mat = self.material(z.glas, gcat, z.number)
             sd = math.inf
             if z.diam_fixed:
-                if not z.diam > 0.0:
+                if z.diam == 0.0:
+                    # a dummy surface with a fixed semi-diameter of 0: nothing to clip with
+                    self.warn(
+                        f"line {z.diam_line}: DIAM 0 (fixed) on surface {z.number}: no "
+                        "semi-diameter, the surface does not clip"
+                    )
+                elif not z.diam > 0.0:
                     raise self.err(
                         f"DIAM: a fixed semi-diameter must be positive, got {z.diam!r}",
                         z.diam_line,
                         z.number,
                     )
-                sd = z.diam * scale
+                else:
+                    sd = z.diam * scale
             if math.isfinite(z.clap):
                 sd = min(sd, z.clap * scale)
             th = z.disz * scale
@@ -511,31 +582,8 @@ class _ZmxParser:
                     line=z.line,
                 )
             )
-        # wavelength (nm)
-        wl = None
-        pw, pw_line = h.get("PWAV", (1, None))
-        if wavm:
-            if pw not in wavm:
-                raise self.err(
-                    f"PWAV {pw}: there is no WAVM {pw} line (wavelengths: "
-                    f"{', '.join(str(i) for i in sorted(wavm))})",
-                    pw_line or min(v[1] for v in wavm.values()),
-                )
-            wl, wl_line = wavm[pw]
-        elif wavl is not None:
-            vals, wl_line = wavl
-            if not 1 <= pw <= len(vals):
-                raise self.err(f"PWAV {pw}: WAVL lists {len(vals)} wavelength(s)", wl_line)
-            wl = vals[pw - 1]
-        if wl is None:
-            wl, wl_line = LAMBDA_D, 1
-            self.warn("no wavelength (WAVM/WAVL): the d line 587.5618 nm is used")
-        if not (200.0 <= wl <= 20000.0):
-            raise self.err(
-                f"the primary wavelength {wl / 1000:g} µm is outside 0.2-20 µm (WAVM/WAVL are "
-                "in µm)",
-                wl_line,
-            )
+        # wavelengths (nm): the first FTYP-count WAVM slots (or WAVL), PWAV the primary
+        wls, wts, _wl_line, primary = self.wavelengths(h, wavm, wavl)
         # aperture
         if "APER" not in h:
             raise self.err(
@@ -559,6 +607,15 @@ class _ZmxParser:
             aperture = Aperture("na", aval)
         # field
         ft, nf, _nw, fline = h.get("FTYP", (0, None, None, None))
+        temperature = pressure = None
+        if "ENVD" in h:
+            t, pr, eline = h["ENVD"]
+            if not (-273.15 < t < 1000.0 and 0.0 <= pr < 100.0):
+                raise self.err(
+                    f"ENVD {t!r} {pr!r}: temperature (°C) and pressure (atm) out of range", eline
+                )
+            if (t, pr) != (20.0, 1.0):
+                temperature, pressure = t, pr
         if ft not in (0, 1):
             raise self.err(
                 f"FTYP {ft}: field type {'paraxial image height' if ft == 2 else 'real image height' if ft == 3 else ft} "  # noqa: E501
@@ -619,7 +676,11 @@ class _ZmxParser:
                 aperture=aperture,
                 field=fld,
                 object_distance=od,
-                wavelength=wl,
+                wavelength=primary,
+                wavelengths=wls,
+                weights=wts,
+                temperature_c=temperature,
+                pressure_atm=pressure,
                 source=source,
                 notes=notes,
                 units="mm",
@@ -673,7 +734,16 @@ def _glas(m: Material) -> str | None:
 def _gcat(lens: Lens) -> list[str]:
     """The GCAT catalogs of the lens's catalog glasses, in order of first use; raises when a
     name would resolve to another catalog under OpticStudio's first-catalog-wins rule."""
+    from ..glass import CATALOGS
+
     mats = [lens.object_material, *(s.material for s in lens.surfaces)]
+    for m in mats:
+        if m.kind == "catalog" and m.catalog not in CATALOGS:
+            raise PrescriptionError(
+                f"glass {m.name} is a {m.catalog} glass defined in the lens file, which a .zmx "
+                "file cannot hold (OpticStudio needs it in a glass catalog); write the lens as "
+                ".toml instead"
+            )
     cats = list(dict.fromkeys(m.catalog for m in mats if m.kind == "catalog"))
     for m in mats:
         if m.kind == "catalog":
@@ -709,6 +779,9 @@ def dumps_zmx(lens: Lens) -> str:
     for k, v in meta.items():
         out.append(f"NOTE 0 orthoscope.{k}: {json.dumps(v, ensure_ascii=True)}")
     out.append("UNIT MM X W X CM MR CPMM")
+    env = lens.environment
+    if env is not None:
+        out.append(f"ENVD {_r(env[0])} {_r(env[1])} 0")
     gcat = _gcat(lens)
     if gcat:
         out.append("GCAT " + " ".join(gcat))
@@ -720,13 +793,15 @@ def dumps_zmx(lens: Lens) -> str:
     )
     fv = float(lens.field.value)
     fields = [0.0] if fv == 0.0 else [0.0, 0.7 * fv, fv]
-    out.append(f"FTYP {0 if lens.field.kind == 'angle' else 1} 0 {len(fields)} 1 0 0 0")
+    nw = len(lens.wavelengths)
+    out.append(f"FTYP {0 if lens.field.kind == 'angle' else 1} 0 {len(fields)} {nw} 0 0 0")
     pad = fields + [0.0] * (12 - len(fields))
     out.append("XFLN " + " ".join("0" for _ in pad))
     out.append("YFLN " + " ".join(_r(v) if v else "0" for v in pad))
     out.append("FWGN " + " ".join("1" for _ in pad))
-    out.append(f"WAVM 1 {nm_to_micron_text(lens.wavelength)} 1")
-    out.append("PWAV 1")
+    for i, (w, wt) in enumerate(zip(lens.wavelengths, lens.weights, strict=True), start=1):
+        out.append(f"WAVM {i} {nm_to_micron_text(w)} {_r(wt)}")
+    out.append(f"PWAV {lens.wavelengths.index(lens.wavelength) + 1}")
     # object surface
     out += ["SURF 0", "  TYPE STANDARD", '  CURV 0.0 0 0 0 0 ""']
     od = lens.object_distance

@@ -126,9 +126,36 @@ def _solve_field(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, 
 
 
 @kernel(error_model="numpy")
-def aim_chief(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
-              hscale, clip, start, last, status, surface, evals, residual):  # fmt: skip
-    """Aim the meridional chief ray (through the stop vertex) for every field; one call.
+def aim_chief(lens, stop, finite, z_obj, fields, slope0, tol, hscale, clip, start, last, status,
+              surface, evals, residual):  # fmt: skip
+    """Aim the meridional chief ray (through the stop vertex) for every wavelength × field; one
+    call.
+
+    lens: the tuple :attr:`raytrace.packing.PackedLens.lens_arrays` — kind, c, k, asph, zv,
+    n_in_w, n_out_w, sd, with the indices as (n_wavelengths, n_surfaces) arrays (row i =
+    wavelength i). fields: field values (α in rad for ``finite == 0``; object height in mm for
+    ``finite == 1``), the same for every wavelength, any order and sign (negative fields are
+    mirror images of positive ones). Per wavelength (arrays of n_wavelengths): slope0, the
+    paraxial du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object); tol,
+    the absolute stop-height tolerance (mm); hscale, the scale of u for finite-difference steps.
+
+    Outputs (filled in place): ``start`` and ``last`` (n_wavelengths, 4, n) float64 — rows y, z,
+    M, N of the object-space ray and of the final segment (see :func:`_aim_fields`);
+    ``status`` int8, ``surface`` int32, ``evals`` int32 and ``residual`` float64, each
+    (n_wavelengths, n).
+    """
+    kind, c, k, asph, zv, n_in_w, n_out_w, sd = lens
+    for iw in range(n_in_w.shape[0]):
+        _aim_fields(kind, c, k, asph, zv, n_in_w[iw], n_out_w[iw], sd, stop, finite, z_obj, fields,
+                    slope0[iw], tol[iw], hscale[iw], clip, start[iw], last[iw], status[iw],
+                    surface[iw], evals[iw], residual[iw])  # fmt: skip
+
+
+@kernel(error_model="numpy")
+def _aim_fields(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
+                hscale, clip, start, last, status, surface, evals, residual):  # fmt: skip
+    """Aim the meridional chief ray (through the stop vertex) for every field at one wavelength
+    (indices ``n_in``, ``n_out``).
 
     fields: field values (α in rad for ``finite == 0``; object height in mm for ``finite == 1``),
     any order and sign (negative fields are mirror images of positive ones). slope0: paraxial

@@ -117,3 +117,13 @@ def kernel(**options: Any) -> Callable:
             return numba.njit(cache=False, **options)(func)
 
     return decorate
+
+
+def cache_is_warm(*dispatchers) -> bool:
+    """True when every kernel in ``dispatchers`` has a cached compilation for the current sources
+    (so the first call loads machine code instead of compiling). Uses numba's cache index; when
+    that cannot be inspected the answer is True (nothing is claimed)."""
+    try:
+        return all(bool(d._cache._cache_file._load_index()) for d in dispatchers)
+    except Exception:  # noqa: BLE001 - a private numba API: never fail because of it
+        return True

@@ -52,7 +52,7 @@ NEWTON_TOL = 1e-14
 
 
 @kernel(error_model="numpy", inline="always")
-def _asphere_sag(c, k, asph, j, rho):
+def asphere_sag(c, k, asph, j, rho):
     """Even-asphere sag z(ρ) and dz/dρ at ρ = x² + y²; ok False outside the conic's domain."""
     arg = 1.0 - (1.0 + k) * c * c * rho
     if not (arg > 0.0):
@@ -70,7 +70,7 @@ def _asphere_sag(c, k, asph, j, rho):
 
 
 @kernel(error_model="numpy", inline="always")
-def _snell(LL, MM, NN, nx, ny, nz, mu, mu2):
+def snell(LL, MM, NN, nx, ny, nz, mu, mu2):
     """Vector Snell refraction of the unit direction (LL, MM, NN) at the unit normal (nx, ny,
     nz), either orientation, with mu = n/n' and mu2 = mu². Returns (L', M', N', sin²θ'); the
     caller flags TIR where sin²θ' > 1 (the direction is then meaningless)."""
@@ -83,7 +83,7 @@ def _snell(LL, MM, NN, nx, ny, nz, mu, mu2):
 
 
 @kernel(error_model="numpy", inline="always")
-def _quadric_root(c, k, x, y, L, M, N):
+def quadric_root(c, k, x, y, L, M, N):
     """Distance s along the unit direction (L, M, N) from the point (x, y) on a surface's vertex
     tangent plane to the quadric of curvature c and conic k, in the cancellation-free form
     s = C / (B + sqrt(B² − A C)) (exact as c → 0). Returns (s, hit); hit is False where the ray
@@ -110,7 +110,7 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
     ny = 0.0
     nz = 1.0
     if kind != KIND_PLANE:
-        s, have = _quadric_root(c, k, x, y, L, M, N)
+        s, have = quadric_root(c, k, x, y, L, M, N)
         if not have:
             s = 0.0
         if kind == KIND_QUADRIC:
@@ -131,7 +131,7 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
             zl = s * N
             converged = False
             for _ in range(NEWTON_MAX):
-                sag, dsag, ok = _asphere_sag(c, k, asph, j, x * x + y * y)
+                sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
                 if not ok:
                     return STATUS_MISSED, x, y, z, L, M, N
                 gp = N - 2.0 * dsag * (x * L + y * M)
@@ -146,7 +146,7 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
                     break
             if not converged:
                 return STATUS_MISSED, x, y, z, L, M, N
-            sag, dsag, ok = _asphere_sag(c, k, asph, j, x * x + y * y)
+            sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
             if not ok:
                 return STATUS_MISSED, x, y, z, L, M, N
             nx = -2.0 * x * dsag
@@ -160,7 +160,7 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
         nx *= inv
         ny *= inv
         nz *= inv
-        L2, M2, N2, sin2t = _snell(L, M, N, nx, ny, nz, mu, mu * mu)
+        L2, M2, N2, sin2t = snell(L, M, N, nx, ny, nz, mu, mu * mu)
         if sin2t > 1.0:
             return STATUS_TIR, x, y, z, L, M, N
         L, M, N = L2, M2, N2

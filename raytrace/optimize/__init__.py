@@ -1,23 +1,48 @@
-"""Lens design optimization: specs (:mod:`.spec`), operands (:mod:`.operands`), the damped
-least-squares solver (:mod:`.solver`). Imports scipy; nothing else in the engine needs it."""
+"""Lens design optimization: specs (:mod:`.spec`; the language in ``docs/spec.md``), operands
+(:mod:`.operands`), damped least squares (:mod:`.solver`), the glass-substitution pool
+(:mod:`.glasses`) and the global search (:mod:`.global_search`). Imports scipy; nothing else in
+the engine needs it."""
 
+from .glasses import GlassPool, availability, glass_pool
+from .global_search import GlassChoice, GlobalResult, SearchProgress, global_optimize
 from .operands import OperandValue, evaluate, merit
 from .solver import OptimizationResult, apply, check_spec, optimize
-from .spec import DesignSpec, Operand, Pickup, SpecError, Variable, read_spec, start_lens
+from .spec import (
+    DesignSpec,
+    GlassSettings,
+    Operand,
+    Pickup,
+    SearchSettings,
+    SpecError,
+    Variable,
+    parse_duration,
+    read_spec,
+    start_lens,
+)
 
 __all__ = [
     "DesignSpec",
+    "GlassChoice",
+    "GlassPool",
+    "GlassSettings",
+    "GlobalResult",
     "Operand",
     "OperandValue",
     "OptimizationResult",
     "Pickup",
+    "SearchProgress",
+    "SearchSettings",
     "SpecError",
     "Variable",
     "apply",
+    "availability",
     "check_spec",
     "evaluate",
+    "global_optimize",
+    "glass_pool",
     "merit",
     "optimize",
+    "parse_duration",
     "read_spec",
     "start_lens",
 ]

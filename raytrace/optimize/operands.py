@@ -1,34 +1,43 @@
-"""Damped-least-squares lens optimization on ``scipy.optimize.least_squares``.
+"""Operands: what a design spec can target, computed for a lens by :func:`evaluate`.
 
-A design is a :class:`DesignSpec` — variables (curvature, thickness, index, conic and the
-even-asphere coefficients A4–A10 of 1-based surfaces, with bounds), pick-ups (e.g. a curvature that
-follows another with factor −1), and operands with targets and weights — usually read
-from a TOML spec file (:func:`read_spec`). :func:`optimize` runs it and returns a
-:class:`OptimizationResult`; nothing is written unless the caller writes the lens.
+Operand types (all lengths in mm, angles in degrees, wavelengths in nm, signs as in
+docs/design.md, "Conventions"; the spec language is documented in ``docs/spec.md``):
 
-Operand types (all lengths in mm, angles in degrees, signs as in docs/design.md, "Conventions"):
-
-==================  ==========================================================================
-``efl``             equivalent focal length.
-``m_e``             Pestrecov's m_e (Eq. 6).
-``HE0``, ``HpE0p``  paraxial entrance / exit pupil from the principal points (Table III).
-``distortion``      characteristic linear distortion D0 = y' − F0 tan α (or y' − M0 y) at
-                    ``field`` in the image ``plane`` (Pestrecov Eqs. 8–9), real chief ray.
-``distortion_rel``  the same as a relative distortion Dr (fraction, not %).
-``image_height``    real chief-ray image height y' at ``field`` in ``plane``.
-``best_focus``      the plane of least RMS spot for a ``field`` bundle (default on axis) at
-                    ``aperture`` (fraction of the pupil radius), given as s' from H'.
-``rms_spot``        RMS spot radius at ``field`` in ``plane`` (``plane = "best"``: at the plane
-                    of least RMS spot of that bundle).
+====================  ========================================================================
+``efl``               equivalent focal length.
+``m_e``               Pestrecov's m_e (Eq. 6).
+``HE0``, ``HpE0p``    paraxial entrance / exit pupil from the principal points (Table III).
+``distortion``        characteristic linear distortion D0 = y' − F0 tan α (or y' − M0 y) at
+                      ``field`` in the image ``plane`` (Pestrecov Eqs. 8–9), real chief ray.
+``distortion_rel``    the same as a relative distortion Dr (fraction, not %).
+``distortion_slope``  ∂D0/∂s' at ``field`` for the operand's object (mm per mm of s'): D0 is
+                      affine in s' for a fixed object (straight final segment, M0 affine in s',
+                      Eq. 8), so the slope is exact and the same in every plane.
+``image_height``      real chief-ray image height y' at ``field`` in ``plane``.
+``landing_angle``     angle of the real chief ray with the axis after the last surface, degrees,
+                      signed like its direction cosine M (0 = telecentric in image space).
+``best_focus``        the plane of least RMS spot for a ``field`` bundle (default on axis) at
+                      ``aperture`` (fraction of the pupil radius), given as s' from H'.
+``rms_spot``          RMS spot radius at ``field`` in ``plane`` (``plane = "best"``: at the plane
+                      of least RMS spot of that bundle).
+``axial_color``       paraxial axial colour: the Gaussian image plane at ``wavelengths[0]`` minus
+                      the one at ``wavelengths[1]`` (default F 486.1327 − C 656.2725 nm), mm.
 ``center_thickness``  one-sided: thickness of ``surface`` ≥ ``min`` (and/or ≤ ``max``).
 ``edge_thickness``    one-sided: axial gap at height ``height`` between ``surface`` and the
-                    next surface ≥ ``min``.
-==================  ==========================================================================
+                      next surface ≥ ``min`` (and/or ≤ ``max``).
+====================  ========================================================================
 
 ``plane`` is ``"gaussian"`` (default), ``"file"`` (the lens file's image plane), or a table with
-one of ``s_prime`` (from H'), ``from_vertex`` (from the last vertex) or ``defocus`` (from the
-Gaussian plane). ``object_distance`` on an operand overrides the lens's (a positive magnitude
-from the first vertex, or "inf").
+one of ``s_prime`` (from H'), ``from_last_vertex`` (from the last vertex; ``from_vertex`` is
+the old spelling) or ``defocus`` (from the Gaussian plane). The object of an operand is the
+lens's unless it gives ``object_distance`` (a positive magnitude from the first vertex, "inf"
+or "Nx"), ``object_s`` (Pestrecov's s from H) or ``object_scale``. ``wavelength`` (nm) defaults
+to the lens's.
+
+Chief rays are aimed once per evaluation for each (object, field kind, wavelength): one kernel
+call for all the fields of all the chief-ray operands of that object, and each image plane is
+reached by moving the final segments analytically (as :mod:`raytrace.trace` does), so targets in
+several planes for one object cost one trace.
 """
 
 from __future__ import annotations
@@ -49,7 +58,8 @@ from ..paraxial import (
     paraxial,
     resolve_object_distance,
 )
-from .spec import Operand, SpecError
+from .spec import BOUND_OPERANDS, Operand, SpecError
+
 
 @dataclass(frozen=True)
 class OperandValue:
@@ -169,68 +179,102 @@ def _best_focus_z(stats) -> float:
     return float(-cov / var)
 
 
+_CHIEF_TYPES = ("distortion", "distortion_rel", "image_height", "distortion_slope", "landing_angle")
+LAMBDA_F, LAMBDA_C = 486.1327, 656.2725  # nm, hydrogen F and C lines
+
+
+def _wavelength(op: Operand) -> float | None:
+    w = op.params.get("wavelength")
+    return None if w is None else float(w)
+
+
+def _field_kind(lens: Lens, op: Operand, od: float) -> str:
+    return op.params.get("field_kind", "angle" if math.isinf(od) else lens.field.kind)
+
+
 def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, ...]:
-    """Compute every operand for ``lens``. Chief rays are batched: one kernel call per
-    (object distance, field kind) for all fields of all distortion / image-height operands."""
+    """Compute every operand for ``lens``.
+
+    Chief rays are batched: one kernel call per (object distance, field kind, wavelength) for all
+    fields of all chief-ray operands (distortion, distortion_rel, image_height,
+    distortion_slope, landing_angle); every image plane is reached by analytic transfer of the
+    final segments. Paraxial data are computed once per (object, wavelength), the lens is packed
+    once per wavelength for the spot operands.
+    """
     from ..trace import aim, trace_rays
 
-    pars: dict[float, ParaxialResult] = {}
-    packed = None
+    pars: dict[tuple[float, float | None], ParaxialResult] = {}
+    packs: dict[float | None, object] = {}
 
-    def par_for(od: float) -> ParaxialResult:
-        if od not in pars:
-            pars[od] = paraxial(lens, od)
-        return pars[od]
+    def par_for(od: float, wl: float | None = None) -> ParaxialResult:
+        if (od, wl) not in pars:
+            pars[(od, wl)] = paraxial(lens, od, wl)
+        return pars[(od, wl)]
 
-    # batch chief rays
-    groups: dict[tuple[float, str], list[float]] = {}
+    # batch chief rays: one aim per (object, field kind, wavelength)
+    groups: dict[tuple[float, str, float | None], set[float]] = {}
     for op in operands:
-        if op.type in ("distortion", "distortion_rel", "image_height"):
+        if op.type in _CHIEF_TYPES:
             od = _object_distance(lens, op)
-            kind = op.params.get("field_kind", "angle" if math.isinf(od) else lens.field.kind)
-            groups.setdefault((od, kind), []).append(float(op.params["field"]))
+            key = (od, _field_kind(lens, op, od), _wavelength(op))
+            groups.setdefault(key, set()).add(float(op.params["field"]))
     chief = {}
-    for (od, kind), fl in groups.items():
-        fields = np.array(sorted(set(fl)))
-        cr = aim(lens, fields, kind, od)
-        chief[(od, kind)] = (fields, cr)
+    for (od, kind, wl), fl in groups.items():
+        fields = np.array(sorted(fl))
+        chief[(od, kind, wl)] = (fields, aim(lens, fields, kind, od, wl))
 
     out = []
     for op in operands:
         t = op.type
         p = op.params
+        wl = _wavelength(op)
         if t in ("efl", "m_e", "HE0", "HpE0p"):
-            par = par_for(_object_distance(lens, op))
+            par = par_for(_object_distance(lens, op), wl)
             v = {"efl": par.efl, "m_e": par.m_e, "HE0": par.HE0, "HpE0p": par.HpE0p}[t]
-        elif t in ("distortion", "distortion_rel", "image_height"):
+        elif t == "axial_color":
             od = _object_distance(lens, op)
-            par = par_for(od)
-            kind = p.get("field_kind", "angle" if math.isinf(od) else lens.field.kind)
-            fields, cr = chief[(od, kind)]
+            w1, w2 = p.get("wavelengths", (LAMBDA_F, LAMBDA_C))
+            v = par_for(od, float(w1)).z_gauss - par_for(od, float(w2)).z_gauss
+        elif t in _CHIEF_TYPES:
+            od = _object_distance(lens, op)
+            par = par_for(od, wl)
+            kind = _field_kind(lens, op, od)
+            fields, cr = chief[(od, kind, wl)]
             j = int(np.searchsorted(fields, float(p["field"])))
-            z = _plane_z(par, p.get("plane"))
             if cr.status[j] != 0:
                 raise TraceError(f"{op.label()}: the chief ray fails (status {int(cr.status[j])})")
-            y_real = float(cr.heights_at(z)[j])
-            if t == "image_height":
-                v = y_real
-            else:  # Pestrecov Eqs. 8-9: D0 = y' - K0 x in the plane z
+            if t == "landing_angle":
+                v = float(cr.landing_angle_deg[j])
+            elif t == "distortion_slope":
+                # dD0/ds' = d y'/ds' - d y0'/ds': the final segment gives tan a'; y0' = K0 x
+                # with K0 affine in s' (Eq. 8), so its slope is the exact difference of Eq. 8
+                # one millimetre apart
                 x = orthoscopy_abscissa(par, fields[j], kind)
-                ideal = float(ideal_heights(par, x, par.s_prime_of(z)))
-                v = (
-                    y_real - ideal
-                    if t == "distortion"
-                    else (y_real / ideal - 1.0 if ideal else 0.0)
-                )
+                y0 = ideal_heights(par, x, np.array([0.0, 1.0]))
+                v = float(cr.tan_out[j]) - float(y0[1, 0] - y0[0, 0])
+            else:
+                z = _plane_z(par, p.get("plane"))
+                y_real = float(cr.heights_at(z)[j])
+                if t == "image_height":
+                    v = y_real
+                else:  # Pestrecov Eqs. 8-9: D0 = y' - K0 x in the plane z
+                    x = orthoscopy_abscissa(par, fields[j], kind)
+                    ideal = float(ideal_heights(par, x, par.s_prime_of(z)))
+                    v = (
+                        y_real - ideal
+                        if t == "distortion"
+                        else (y_real / ideal - 1.0 if ideal else 0.0)
+                    )
         elif t in ("best_focus", "rms_spot"):
             od = _object_distance(lens, op)
-            par = par_for(od)
-            kind = p.get("field_kind", "angle" if math.isinf(od) else lens.field.kind)
+            par = par_for(od, wl)
+            kind = _field_kind(lens, op, od)
             rays = _bundle(
                 lens, par, float(p.get("field", 0.0)), kind, float(p.get("aperture", 1.0))
             )
-            packed = packed or pack(lens)  # once per evaluation, for every spot operand
-            batch = trace_rays(packed, rays[:3], rays[3:], clip=False)
+            if wl not in packs:  # once per evaluation and wavelength, for every spot operand
+                packs[wl] = pack(lens, wl)
+            batch = trace_rays(packs[wl], rays[:3], rays[3:], clip=False)
             stats = _spot_stats(batch)
             if t == "best_focus":
                 v = _best_focus_z(stats) - par.z_Hp
@@ -250,7 +294,7 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
                 raise TraceError(f"{op.label()}: height {h} is beyond the surface's sphere")
         else:  # pragma: no cover - validated in read_spec / check_spec
             raise SpecError(f"unknown operand type {t!r}")
-        if t in ("center_thickness", "edge_thickness"):
+        if t in BOUND_OPERANDS:
             lo, hi = p.get("min", -math.inf), p.get("max", math.inf)
             viol = (lo - v) if v < lo else ((v - hi) if v > hi else 0.0)
             res = op.weight * viol
@@ -263,5 +307,3 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
 def merit(values: tuple[OperandValue, ...]) -> float:
     """Merit function: the sum of squared weighted residuals."""
     return float(sum(o.residual**2 for o in values))
-
-

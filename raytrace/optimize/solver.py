@@ -1,6 +1,7 @@
 """Damped least squares on ``scipy.optimize.least_squares`` (trust-region reflective with the
-variable bounds): the spec's variables applied to the start lens, the operands evaluated, the
-weighted residuals minimised."""
+variable bounds): the spec's continuous variables applied to the start lens, the operands
+evaluated, the weighted residuals minimised. ``glass`` variables are held (the global search,
+:mod:`.global_search`, substitutes them)."""
 
 from __future__ import annotations
 
@@ -18,16 +19,32 @@ from ..materials import Material
 from ..paraxial import paraxial
 from .operands import OperandValue, evaluate, merit
 from .spec import (
+    ABBE_BOUNDS,
     ASPHERIC_KINDS,
+    BOUND_OPERANDS,
     INDEX_BOUNDS,
-    OPERAND_TYPES,
+    PICKUP_KINDS,
     VARIABLE_KINDS,
     DesignSpec,
     SpecError,
+    Variable,
+    operand_problems,
+    suggest,
 )
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, eq=False)
 class OptimizationResult:
+    """The outcome of one damped-least-squares run.
+
+    lens: the optimized lens; x: the continuous variables' values (spec order, glass variables
+    left out); merit_start / merit: sum of squared weighted residuals before / after; operands:
+    every operand's value and residual; evaluations: merit evaluations used; converged: whether
+    the run met its stopping test (and the spec's merit goal); message: why it stopped;
+    seconds: wall time; stopped: ``""``, or why it was cut short from outside (``"time"``,
+    ``"interrupted"``) — the result is then the best design evaluated so far.
+    """
+
     lens: Lens
     x: np.ndarray
     merit_start: float
@@ -37,13 +54,33 @@ class OptimizationResult:
     converged: bool
     message: str
     seconds: float
+    stopped: str = ""
 
     @property
     def worst(self) -> OperandValue:
         return max(self.operands, key=lambda o: abs(o.residual))
 
+    def __repr__(self) -> str:
+        return (
+            f"OptimizationResult(merit {self.merit_start:.6g} -> {self.merit:.6g}, "
+            f"{self.evaluations} evaluations, converged={self.converged})"
+        )
+
+
+class Stopped(Exception):
+    """Raised inside a merit evaluation when the caller's ``stop()`` asks to stop."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+
 
 # ----------------------------------------------------------------------------- variables
+def continuous(spec: DesignSpec) -> tuple[Variable, ...]:
+    """The spec's variables that damped least squares varies (all but ``glass``)."""
+    return tuple(v for v in spec.variables if v.kind != "glass")
+
+
 def get_value(lens: Lens, kind: str, surface: int) -> float:
     s = lens.surfaces[surface - 1]
     if kind == "curvature":
@@ -52,17 +89,20 @@ def get_value(lens: Lens, kind: str, surface: int) -> float:
         return s.thickness
     if kind == "index":
         return s.material.nd
+    if kind == "abbe":
+        return s.material.vd
     if kind == "conic":
         return s.conic
     if kind in ASPHERIC_KINDS:
         j = ASPHERIC_KINDS.index(kind)
         return s.aspheric[j] if j < len(s.aspheric) else 0.0
-    raise SpecError(f"unknown variable kind {kind!r} (use one of {', '.join(VARIABLE_KINDS)})")
+    raise SpecError(f"unknown variable kind {kind!r}{suggest(kind, VARIABLE_KINDS)}")
 
 
 def set_values(lens: Lens, kinds_surfaces: list[tuple[str, int]], values) -> Lens:
     """A copy of ``lens`` with the given (kind, surface) parameters replaced (no validation of the
-    physical sense beyond the Lens model's own)."""
+    physical sense beyond the Lens model's own). ``index`` and ``abbe`` turn a catalog glass into
+    a model glass (``abbe``) or a fixed index (``index`` on a non-model medium)."""
     surfaces = list(lens.surfaces)
     for (kind, i), v in zip(kinds_surfaces, values, strict=True):
         s = surfaces[i - 1]
@@ -80,124 +120,193 @@ def set_values(lens: Lens, kinds_surfaces: list[tuple[str, int]], values) -> Len
             while a and a[-1] == 0.0:
                 a.pop()
             s = replace(s, aspheric=tuple(a))
-        else:
+        elif kind == "abbe":
+            m = s.material
+            s = replace(s, material=Material("model", m.nd, v, model=m.model))
+        elif kind == "index":
             m = s.material
             s = replace(s, material=Material("model" if m.kind == "model" else "index", v, m.vd))
+        else:
+            raise SpecError(f"variable kind {kind!r} has no continuous value")
         surfaces[i - 1] = s
     return replace(lens, surfaces=tuple(surfaces), image_solve=None)
 
 
+def set_materials(lens: Lens, materials: dict[int, Material]) -> Lens:
+    """A copy of ``lens`` with the media after the given 1-based surfaces replaced."""
+    if not materials:
+        return lens
+    surfaces = list(lens.surfaces)
+    for i, m in materials.items():
+        surfaces[i - 1] = replace(surfaces[i - 1], material=m)
+    return replace(lens, surfaces=tuple(surfaces))
+
+
 def apply(lens: Lens, spec: DesignSpec, x) -> Lens:
-    """The lens with variables ``x`` and the spec's pick-ups applied.
+    """The lens with the continuous variables ``x`` (in the order of :func:`continuous`) and the
+    spec's pick-ups applied (a ``glass`` pick-up copies the medium after its source).
 
     A start lens whose image plane is a Gaussian solve (``image_solve == "gaussian"``) keeps it:
     the last thickness is re-solved for every new lens unless it is itself a variable or pick-up.
     """
-    ks = [(v.kind, v.surface) for v in spec.variables]
+    ks = [(v.kind, v.surface) for v in continuous(spec)]
     out = set_values(lens, ks, x)
-    if spec.pickups:
-        vals = [p.factor * get_value(out, p.kind, p.source) + p.offset for p in spec.pickups]
-        out = set_values(out, [(p.kind, p.surface) for p in spec.pickups], vals)
+    glass_pk = {
+        p.surface: out.surfaces[p.source - 1].material for p in spec.pickups if p.kind == "glass"
+    }
+    out = set_materials(out, glass_pk)
+    num_pk = [p for p in spec.pickups if p.kind != "glass"]
+    if num_pk:
+        vals = [p.factor * get_value(out, p.kind, p.source) + p.offset for p in num_pk]
+        out = set_values(out, [(p.kind, p.surface) for p in num_pk], vals)
     last = ("thickness", lens.n_surfaces)
-    if lens.image_solve == "gaussian" and last not in ks + [
-        (p.kind, p.surface) for p in spec.pickups
-    ]:
+    if lens.image_solve == "gaussian" and last not in ks + [(p.kind, p.surface) for p in num_pk]:
         out = replace(
             out.with_image_distance(paraxial(out).gaussian_image_distance), image_solve="gaussian"
         )
     return out
 
 
-# ----------------------------------------------------------------------------- solver
-def check_spec(lens: Lens, spec: DesignSpec) -> None:
-    """Raise :class:`SpecError` for a spec that cannot apply to ``lens``."""
+def bounds(spec: DesignSpec) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of the continuous variables (index and Abbe variables are kept
+    within glass-like limits, :data:`INDEX_BOUNDS`, :data:`ABBE_BOUNDS`)."""
+    lo, hi = [], []
+    for v in continuous(spec):
+        b = {"index": INDEX_BOUNDS, "abbe": ABBE_BOUNDS}.get(v.kind, (-math.inf, math.inf))
+        lo.append(max(v.lower, b[0]))
+        hi.append(min(v.upper, b[1]))
+    return np.array(lo, dtype=float), np.array(hi, dtype=float)
+
+
+def start_values(lens: Lens, spec: DesignSpec) -> np.ndarray:
+    """The continuous variables' values in ``lens``, clipped into their bounds."""
+    x0 = np.array([get_value(lens, v.kind, v.surface) for v in continuous(spec)], dtype=float)
+    lo, hi = bounds(spec)
+    return np.clip(x0, lo, hi)
+
+
+# ----------------------------------------------------------------------------- checks
+def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) -> None:
+    """Raise :class:`SpecError` for a spec that cannot apply to ``lens`` (one line per problem).
+
+    ``need_continuous``: damped least squares needs at least one continuous variable; the global
+    search also accepts a spec whose only variables are glasses.
+    """
     n = lens.n_surfaces
+    probs: list[str] = []
     for v in spec.variables:
         if v.kind not in VARIABLE_KINDS:
-            raise SpecError(f"unknown variable kind {v.kind!r} (use {', '.join(VARIABLE_KINDS)})")
+            probs.append(f"unknown variable kind {v.kind!r}{suggest(v.kind, VARIABLE_KINDS)}")
+            continue
+        if not isinstance(v.surface, int) or isinstance(v.surface, bool):
+            probs.append(f"variable {v.kind}: surface must be an integer, got {v.surface!r}")
+            continue
         if not 1 <= v.surface <= n:
-            raise SpecError(f"variable {v.kind} on surface {v.surface}: the lens has {n} surfaces")
+            probs.append(f"variable {v.kind} on surface {v.surface}: the lens has {n} surfaces")
+            continue
         if v.lower >= v.upper:
-            raise SpecError(
-                f"variable {v.kind} {v.surface}: bounds inverted ({v.lower} ≥ {v.upper})"
+            probs.append(f"variable {v.kind} {v.surface}: bounds inverted ({v.lower} ≥ {v.upper})")
+        if v.kind in ("index", "abbe", "glass") and lens.surfaces[v.surface - 1].material.is_air:
+            probs.append(
+                f"variable {v.kind} {v.surface}: the medium after it is air (a {v.kind} "
+                "variable goes on the surface in front of the glass)"
             )
-        if v.kind == "index" and lens.surfaces[v.surface - 1].material.is_air:
-            raise SpecError(f"variable index {v.surface}: the medium after it is air")
     seen = {(v.kind, v.surface) for v in spec.variables}
+    if len(seen) < len(spec.variables):
+        probs.append("a variable is listed twice (same kind and surface)")
     for pk in spec.pickups:
-        if pk.kind not in VARIABLE_KINDS:
-            raise SpecError(f"unknown pick-up kind {pk.kind!r}")
-        for s in (pk.surface, pk.source):
-            if not 1 <= s <= n:
-                raise SpecError(
-                    f"pick-up {pk.kind} {pk.surface} <- {pk.source}: surface {s} "
-                    f"does not exist (the lens has {n})"
-                )
+        if pk.kind not in PICKUP_KINDS:
+            probs.append(f"unknown pick-up kind {pk.kind!r}{suggest(pk.kind, PICKUP_KINDS)}")
+            continue
+        bad = [s for s in (pk.surface, pk.source) if not 1 <= s <= n]
+        if bad:
+            probs.append(
+                f"pick-up {pk.kind} {pk.surface} <- {pk.source}: surface {bad[0]} "
+                f"does not exist (the lens has {n})"
+            )
+            continue
         if (pk.kind, pk.surface) in seen:
-            raise SpecError(f"{pk.kind} {pk.surface} is both a variable and a pick-up")
+            probs.append(f"{pk.kind} {pk.surface} is both a variable and a pick-up")
+        if pk.kind == "glass" and lens.surfaces[pk.surface - 1].material.is_air:
+            probs.append(f"glass pick-up on surface {pk.surface}: the medium after it is air")
     if not spec.variables:
-        raise SpecError("the spec has no variables")
+        probs.append("the spec has no variables")
+    elif need_continuous and not continuous(spec):
+        probs.append(
+            "the spec has only glass variables: glass substitution is the global search's "
+            "(orthoscope optimize --global); damped least squares needs a continuous variable"
+        )
     if not spec.operands:
-        raise SpecError("the spec has no operands")
+        probs.append("the spec has no operands")
     for op in spec.operands:
-        if op.type not in OPERAND_TYPES:
-            raise SpecError(f"unknown operand type {op.type!r} (use {', '.join(OPERAND_TYPES)})")
-        if op.type in ("distortion", "distortion_rel", "image_height") and "field" not in op.params:
-            raise SpecError(f"operand {op.type} needs a 'field'")
-        if op.type in ("center_thickness", "edge_thickness"):
-            s = op.params.get("surface")
-            last = n - 1 if op.type == "edge_thickness" else n
-            if not isinstance(s, int) or not 1 <= s <= last:
-                raise SpecError(
-                    f"operand {op.type}: surface {s!r} does not exist (1..{last} for this lens)"
-                )
-            if "min" not in op.params and "max" not in op.params:
-                raise SpecError(f"operand {op.type} on surface {s} needs 'min' and/or 'max'")
-            if op.type == "edge_thickness" and "height" not in op.params:
-                raise SpecError(f"operand edge_thickness on surface {s} needs 'height'")
-        if not (math.isfinite(op.weight) and op.weight >= 0):
-            raise SpecError(f"operand {op.label()}: weight must be a non-negative number")
+        bad = operand_problems(op.type, op.params, op.target, op.weight)
+        probs += [f"operand {op.type}: {b}" for b in bad]
+        if bad or op.type not in BOUND_OPERANDS:
+            continue
+        s = op.params["surface"]
+        last = n - 1 if op.type == "edge_thickness" else n
+        if not 1 <= s <= last:
+            probs.append(
+                f"operand {op.type}: surface {s!r} does not exist (1..{last} for this lens)"
+            )
+    if len(probs) == 1:
+        raise SpecError(probs[0])
+    if probs:
+        raise SpecError(f"{len(probs)} problems:\n" + "\n".join(f"  {p}" for p in probs))
+
+
+# ----------------------------------------------------------------------------- solver
+def _scales(lens: Lens, spec: DesignSpec) -> np.ndarray:
+    """The solver works on x / scale: aspheric coefficients are tiny numbers (mm^(1-k)), scaled
+    so that a unit change is a sag change of the order of a tenth of the EFL at a tenth of the
+    EFL; every other kind is left unscaled."""
+    rref = 0.1 * abs(paraxial(lens).efl)
+    return np.array(
+        [
+            rref ** (1 - (4 + 2 * ASPHERIC_KINDS.index(v.kind)))
+            if v.kind in ASPHERIC_KINDS
+            else 1.0
+            for v in continuous(spec)
+        ]
+    )
 
 
 def optimize(
     lens: Lens,
     spec: DesignSpec,
     progress: Callable[[int, float, OperandValue], None] | None = None,
+    *,
+    stop: Callable[[], str | None] | None = None,
+    max_evaluations: int | None = None,
 ) -> OptimizationResult:
     """Run damped least squares (``least_squares``, trust-region reflective with the variable
-    bounds). ``progress(evaluation, merit, worst_operand)`` is called after each evaluation.
+    bounds) over the spec's continuous variables; ``glass`` variables keep the start lens's
+    glass. ``progress(evaluation, merit, worst_operand)`` is called after each evaluation.
+
+    ``stop()`` is asked before each evaluation; when it returns a reason (a non-empty string)
+    the run ends at once and returns the best design evaluated so far with ``stopped`` set.
+    ``max_evaluations`` overrides the spec's limit.
 
     A run that stops on the evaluation limit, or ends above ``spec.merit_goal``, is returned with
     ``converged=False`` and a message saying why; the caller must not present it as a success.
     """
     check_spec(lens, spec)
-    x0 = np.array([get_value(lens, v.kind, v.surface) for v in spec.variables])
-    lo = np.array(
-        [max(v.lower, INDEX_BOUNDS[0]) if v.kind == "index" else v.lower for v in spec.variables]
-    )
-    hi = np.array(
-        [min(v.upper, INDEX_BOUNDS[1]) if v.kind == "index" else v.upper for v in spec.variables]
-    )
-    x0 = np.clip(x0, lo, hi)  # a start value outside its bounds starts on the nearest bound
-    # The solver works on x / scale: aspheric coefficients are tiny numbers (mm^(1-k)), scaled
-    # so that a unit change is a sag change of the order of a tenth of the EFL at a tenth of the
-    # EFL; every other kind is left unscaled.
-    rref = 0.1 * abs(paraxial(lens).efl)
-    sc = np.array(
-        [
-            rref ** (1 - (4 + 2 * ASPHERIC_KINDS.index(v.kind)))
-            if v.kind in ASPHERIC_KINDS
-            else 1.0
-            for v in spec.variables
-        ]
-    )
+    limit = spec.max_evaluations if max_evaluations is None else int(max_evaluations)
+    lo, hi = bounds(spec)
+    x0 = start_values(lens, spec)  # a start value outside its bounds starts on the nearest bound
+    sc = _scales(lens, spec)
     start_vals = evaluate(apply(lens, spec, x0), spec.operands)
     m0 = merit(start_vals)
     n_ev = [0]
+    best = [m0, x0.copy()]
     big = math.sqrt(m0 + 1.0) * 1e3
     t0 = time.perf_counter()
 
     def fun(xs):
+        if stop is not None:
+            why = stop()
+            if why:
+                raise Stopped(why)
         n_ev[0] += 1
         try:
             vals = evaluate(apply(lens, spec, xs * sc), spec.operands)
@@ -205,36 +314,46 @@ def optimize(
             # an impossible lens in the middle of a step: a large, smooth-ish penalty
             return np.full(len(spec.operands), big)
         r = np.array([o.residual for o in vals])
+        m = float(r @ r)
+        if m < best[0]:
+            best[0], best[1] = m, xs * sc
         if progress is not None:
-            progress(n_ev[0], float(r @ r), max(vals, key=lambda o: abs(o.residual)))
+            progress(n_ev[0], m, max(vals, key=lambda o: abs(o.residual)))
         return r
 
-    sol = least_squares(
-        fun,
-        x0 / sc,
-        bounds=(lo / sc, hi / sc),
-        method="trf",
-        x_scale="jac",
-        xtol=spec.tolerance,
-        ftol=spec.tolerance,
-        gtol=spec.tolerance,
-        max_nfev=spec.max_evaluations,
-        diff_step=1e-7,
-    )
-    x_final = sol.x * sc
+    stopped = ""
+    try:
+        sol = least_squares(
+            fun,
+            x0 / sc,
+            bounds=(lo / sc, hi / sc),
+            method="trf",
+            x_scale="jac",
+            xtol=spec.tolerance,
+            ftol=spec.tolerance,
+            gtol=spec.tolerance,
+            max_nfev=limit,
+            diff_step=1e-7,
+        )
+        x_final, status, message = sol.x * sc, sol.status, sol.message
+    except Stopped as e:
+        stopped = e.reason
+        x_final, status, message = best[1], -99, f"stopped ({e.reason}): the best design so far"
     final = apply(lens, spec, x_final)
     vals = evaluate(final, spec.operands)
     m = merit(vals)
-    converged = sol.status > 0
-    msg = sol.message
-    if spec.merit_goal is not None and m > spec.merit_goal:
+    converged = status > 0
+    msg = message
+    if stopped:
         converged = False
-        msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g} ({sol.message})"
-    elif sol.status == 0:
-        msg = f"stopped at the evaluation limit ({spec.max_evaluations}) before converging"
+    elif spec.merit_goal is not None and m > spec.merit_goal:
+        converged = False
+        msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g} ({message})"
+    elif status == 0:
+        msg = f"stopped at the evaluation limit ({limit}) before converging"
     return OptimizationResult(
         lens=final,
-        x=x_final,
+        x=np.asarray(x_final, dtype=float),
         merit_start=m0,
         merit=m,
         operands=vals,
@@ -242,6 +361,5 @@ def optimize(
         converged=converged,
         message=msg,
         seconds=time.perf_counter() - t0,
+        stopped=stopped,
     )
-
-

@@ -1,55 +1,177 @@
-"""Design specs: variables, pick-ups and operands with targets, read from a TOML spec file.
+"""Design specs: variables, pick-ups, operands with targets, glass and global-search settings.
 
-See :mod:`raytrace.optimize.operands` for what each operand type computes and
-``lenses/specs/*.toml`` for complete examples.
+A spec is usually read from a TOML file (:func:`read_spec`; the language is documented in
+``docs/spec.md``, complete examples in ``lenses/specs/*.toml``). Every key is checked: an unknown
+key or a value of the wrong type is an error that names where it is and, for a misspelt key, the
+nearest valid one; all problems of a file are reported together, one line each.
+
+See :mod:`raytrace.optimize.operands` for what each operand type computes.
 """
 
 from __future__ import annotations
 
+import difflib
 import math
-import tomllib
-from dataclasses import dataclass, field
+import re
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+import tomllib
 
 from ..errors import OrthoscopeError, PrescriptionError
 from ..lens import Lens
 
-VARIABLE_KINDS = ("curvature", "thickness", "index", "conic", "A4", "A6", "A8", "A10")
-ASPHERIC_KINDS = ("A4", "A6", "A8", "A10")  # coefficients of r^4, r^6, r^8, r^10
-OPERAND_TYPES = (
-    "efl",
-    "m_e",
-    "HE0",
-    "HpE0p",
-    "distortion",
-    "distortion_rel",
-    "image_height",
-    "best_focus",
-    "rms_spot",
-    "center_thickness",
-    "edge_thickness",
+#: continuous variables (damped least squares) and the discrete ``glass`` substitution variable
+CONTINUOUS_KINDS = (
+    "curvature",
+    "thickness",
+    "index",
+    "abbe",
+    "conic",
+    "A4",
+    "A6",
+    "A8",
+    "A10",
 )
+VARIABLE_KINDS = CONTINUOUS_KINDS + ("glass",)
+ASPHERIC_KINDS = ("A4", "A6", "A8", "A10")  # coefficients of r^4, r^6, r^8, r^10
+PICKUP_KINDS = CONTINUOUS_KINDS + ("glass",)
 INDEX_BOUNDS = (1.40, 2.05)  # glass-like bounds for index variables
+ABBE_BOUNDS = (15.0, 100.0)  # glass-like bounds for Abbe-number variables
+
+#: The operand types and the parameters each takes besides type / target / weight.
+_OBJECT = ("object_distance", "object_s", "object_scale")
+_CHIEF = ("field", "field_kind", "wavelength", *_OBJECT)
+OPERAND_PARAMS: dict[str, tuple[str, ...]] = {
+    "efl": ("wavelength", *_OBJECT),
+    "m_e": ("wavelength", *_OBJECT),
+    "HE0": ("wavelength", *_OBJECT),
+    "HpE0p": ("wavelength", *_OBJECT),
+    "distortion": (*_CHIEF, "plane"),
+    "distortion_rel": (*_CHIEF, "plane"),
+    "image_height": (*_CHIEF, "plane"),
+    "distortion_slope": _CHIEF,
+    "landing_angle": _CHIEF,
+    "best_focus": ("field", "field_kind", "aperture", "wavelength", *_OBJECT),
+    "rms_spot": ("field", "field_kind", "aperture", "plane", "wavelength", *_OBJECT),
+    "axial_color": ("wavelengths", *_OBJECT),
+    "center_thickness": ("surface", "min", "max"),
+    "edge_thickness": ("surface", "height", "min", "max"),
+}
+OPERAND_TYPES = tuple(OPERAND_PARAMS)
+#: parameters an operand type cannot do without
+OPERAND_REQUIRED: dict[str, tuple[str, ...]] = {
+    "distortion": ("field",),
+    "distortion_rel": ("field",),
+    "image_height": ("field",),
+    "distortion_slope": ("field",),
+    "landing_angle": ("field",),
+    "center_thickness": ("surface",),
+    "edge_thickness": ("surface", "height"),
+}
+#: one-sided (bound) operands: their residual is the violation of ``min`` / ``max``
+BOUND_OPERANDS = ("center_thickness", "edge_thickness")
+PLANE_KEYS = ("s_prime", "from_last_vertex", "from_vertex", "defocus")
+
+#: glass catalogs the substitution searches by default (``Misc``, crystals and plastics, only
+#: when named)
+DEFAULT_CATALOGS = ("Schott", "Ohara", "Hoya", "CDGM", "Hikari", "Sumita")
+#: availability classes of catalog glasses, from the catalog's status (see
+#: :func:`raytrace.optimize.glasses.availability`)
+AVAILABILITY = ("current", "withdrawn", "legacy")
 
 
 class SpecError(OrthoscopeError):
-    """A design spec is invalid (unknown variable, operand on a missing surface, bad bounds)."""
+    """A design spec is invalid (unknown key or variable, wrong type, missing surface, ...)."""
+
+
+@dataclass(frozen=True)
+class GlassSettings:
+    """Which real glasses a ``glass`` variable may take (the substitution pool).
+
+    catalogs:
+        vendor catalogs searched (names of :data:`raytrace.glass.CATALOGS`).
+    availability:
+        classes allowed (:data:`AVAILABILITY`): ``current`` (in the vendor's current catalog
+        edition), ``withdrawn`` (only in the previous edition), ``legacy`` (only in the
+        refractiveindex.info shelf of older glasses).
+    nd, vd:
+        closed windows (min, max) on the catalog's d-line index and Abbe number.
+    glasses:
+        an explicit list of glass names (a designer's preferred list): the pool is exactly
+        these (looked up in ``catalogs``); the filters above still apply.
+    neighbours:
+        a substitution move replaces a glass by one of its ``neighbours`` nearest candidates
+        on the glass map (glass-code distance, :func:`raytrace.glass.search_glass`).
+    model_phase:
+        first optimize each glass as a continuous nd/vd model glass inside the pool's window,
+        then snap to the nearest real glasses (CODE V's glass fitting); otherwise substitute
+        real glasses only.
+    """
+
+    catalogs: tuple[str, ...] = DEFAULT_CATALOGS
+    availability: tuple[str, ...] = ("current",)
+    nd: tuple[float, float] = (-math.inf, math.inf)
+    vd: tuple[float, float] = (-math.inf, math.inf)
+    glasses: tuple[str, ...] = ()
+    neighbours: int = 6
+    model_phase: bool = True
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """Settings of the global search (:func:`raytrace.optimize.global_optimize`).
+
+    starts:
+        independent starts; start 0 is the spec's start lens, the others are perturbed copies.
+    seed:
+        root of the random streams (``numpy.random.SeedSequence(seed)``; start k uses child k).
+    hops:
+        basin hops per start: perturb the start's best design (and substitute one glass),
+        re-optimize, keep it when the merit improves.
+    perturbation, hop_perturbation:
+        relative size of the start perturbation and of a hop's perturbation (a curvature moves by
+        about ``p × (|c| + 0.1/|EFL|)``, a thickness by a factor ``exp(p N(0,1))``).
+    time_budget_s:
+        wall-clock budget in seconds (None: none); when spent the search stops and keeps the best.
+    workers:
+        worker processes (1: in this process).
+    local_evaluations:
+        merit evaluations per local damped-least-squares run (None: the spec's
+        ``max_evaluations``); the best design is polished with ``max_evaluations`` at the end.
+    """
+
+    starts: int = 8
+    seed: int = 0
+    hops: int = 4
+    perturbation: float = 0.1
+    hop_perturbation: float = 0.05
+    time_budget_s: float | None = None
+    workers: int = 1
+    local_evaluations: int | None = None
 
 
 @dataclass(frozen=True)
 class Variable:
-    """A free parameter: ``kind`` of ``surface`` (1-based), within [lower, upper]."""
+    """A free parameter: ``kind`` of ``surface`` (1-based), within [lower, upper].
+
+    ``kind = "glass"`` is the glass-substitution variable: the medium after ``surface`` is
+    chosen among real catalog glasses (``glass``: this variable's pool settings, default the
+    spec's); damped least squares holds it, the global search substitutes it.
+    """
 
     kind: str
     surface: int
     lower: float = -math.inf
     upper: float = math.inf
+    glass: GlassSettings | None = None
 
 
 @dataclass(frozen=True)
 class Pickup:
     """``kind`` of ``surface`` := factor × (``kind`` of ``source``) + offset, applied after the
-    variables (e.g. ``R5 = −R4`` is curvature 5 = −1 × curvature 4)."""
+    variables (e.g. ``R5 = −R4`` is curvature 5 = −1 × curvature 4). A ``glass`` pick-up copies
+    the medium after ``source``."""
 
     kind: str
     surface: int
@@ -60,7 +182,7 @@ class Pickup:
 
 @dataclass(frozen=True)
 class Operand:
-    """A target: ``type`` (see module docstring), ``target``, ``weight`` and its parameters."""
+    """A target: ``type`` (see :mod:`.operands`), ``target``, ``weight`` and its parameters."""
 
     type: str
     target: float = 0.0
@@ -74,7 +196,8 @@ class Operand:
 
 @dataclass(frozen=True)
 class DesignSpec:
-    """A reproducible design: start lens, variables, pick-ups, operands, solver settings."""
+    """A reproducible design: start lens, variables, pick-ups, operands, solver settings, the
+    glass pool and the global-search settings."""
 
     start: str
     variables: tuple[Variable, ...]
@@ -85,22 +208,300 @@ class DesignSpec:
     tolerance: float = 1e-12
     merit_goal: float | None = None  # a run that ends above it is reported as failed
     path: str | None = None
+    glass: GlassSettings = GlassSettings()
+    search: SearchSettings = SearchSettings()
+
+    def glass_settings(self, v: Variable) -> GlassSettings:
+        """The pool settings of glass variable ``v`` (its own, else the spec's)."""
+        return v.glass if v.glass is not None else self.glass
 
 
-# ----------------------------------------------------------------------------- spec files
-def _num(d: dict, key: str, where: str, default=None) -> float:
-    v = d.get(key, default)
-    if v is None:
-        raise SpecError(f"{where}: missing '{key}'")
-    if isinstance(v, str) and v.strip().lower() in ("inf", "-inf"):
-        return float(v)
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise SpecError(f"{where}: '{key}' must be a number, got {v!r}")
-    return float(v)
+# ----------------------------------------------------------------------------- durations
+_DURATION = re.compile(r"(\d+(?:\.\d*)?|\.\d+)\s*(h|m|min|s|sec)?", re.IGNORECASE)
+
+
+def parse_duration(text: str | float | int) -> float:
+    """A duration in seconds from ``"10m"``, ``"90s"``, ``"1h30m"``, ``"2.5h"`` or a number of
+    seconds. Raises :class:`SpecError` for anything else or a duration that is not positive."""
+    if isinstance(text, bool):
+        raise SpecError(f"bad duration {text!r}: use e.g. 90s, 10m, 1h30m or seconds")
+    if isinstance(text, (int, float)):
+        v = float(text)
+    else:
+        t = str(text).strip().replace(" ", "")
+        pos, v = 0, 0.0
+        unit = {"h": 3600.0, "m": 60.0, "min": 60.0, "s": 1.0, "sec": 1.0, None: 1.0}
+        while pos < len(t):
+            m = _DURATION.match(t, pos)
+            if not m or m.end() == pos:
+                raise SpecError(f"bad duration {text!r}: use e.g. 90s, 10m, 1h30m or seconds")
+            v += float(m.group(1)) * unit[m.group(2).lower() if m.group(2) else None]
+            pos = m.end()
+        if not t:
+            raise SpecError("empty duration: use e.g. 90s, 10m, 1h30m or seconds")
+    if not (math.isfinite(v) and v > 0):
+        raise SpecError(f"bad duration {text!r}: it must be a positive time")
+    return v
+
+
+# ----------------------------------------------------------------------------- checking
+class _Problems:
+    """Collects one line per problem; raises them together."""
+
+    def __init__(self, where: str) -> None:
+        self.where = where
+        self.lines: list[str] = []
+
+    def add(self, msg: str) -> None:
+        self.lines.append(msg)
+
+    def unknown_keys(self, d: dict, allowed, at: str) -> None:
+        for k in d:
+            if k not in allowed:
+                self.add(f"{at}: unknown key {k!r}{suggest(k, allowed)}")
+
+    def raise_if_any(self) -> None:
+        if not self.lines:
+            return
+        if len(self.lines) == 1:
+            raise SpecError(f"{self.where}: {self.lines[0]}")
+        body = "\n".join(f"  {ln}" for ln in self.lines)
+        raise SpecError(f"{self.where}: {len(self.lines)} problems:\n{body}")
+
+
+def suggest(word: str, choices) -> str:
+    """`` (did you mean 'x'?)`` for the nearest of ``choices``, or the list of choices."""
+    choices = list(choices)
+    near = difflib.get_close_matches(str(word), choices, n=1, cutoff=0.6)
+    if near:
+        return f" (did you mean {near[0]!r}?)"
+    return f" (use one of: {', '.join(choices)})"
+
+
+def _is_int(v) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_num(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _num_or_inf(v) -> bool:
+    return _is_num(v) or (isinstance(v, str) and v.strip().lower() in ("inf", "+inf", "-inf"))
+
+
+def _as_float(v) -> float:
+    return float(v) if not isinstance(v, str) else float(v.strip().lower())
+
+
+def _range(v) -> bool:
+    return (
+        isinstance(v, list)
+        and len(v) == 2
+        and all(_num_or_inf(x) for x in v)
+        and _as_float(v[0]) <= _as_float(v[1])
+    )
+
+
+def operand_problems(type_: str, params: dict, target, weight) -> list[str]:
+    """Problems of one operand (unknown type or keys, wrong types); empty when it is valid."""
+    out: list[str] = []
+    if type_ not in OPERAND_PARAMS:
+        return [f"unknown operand type {type_!r}{suggest(type_, OPERAND_TYPES)}"]
+    allowed = OPERAND_PARAMS[type_]
+    for k in params:
+        if k not in allowed:
+            out.append(
+                f"unknown key {k!r} for operand {type_}"
+                + suggest(k, ("type", "target", "weight", *allowed))
+            )
+    for k in OPERAND_REQUIRED.get(type_, ()):
+        if k not in params:
+            out.append(f"operand {type_} needs a {k!r}")
+    if not _is_num(target):
+        out.append(f"'target' must be a number, got {target!r}")
+    if not (_is_num(weight) and math.isfinite(weight) and weight >= 0):
+        out.append(f"'weight' must be a non-negative number, got {weight!r}")
+    p = params
+    if "field" in p and not (_is_num(p["field"]) and math.isfinite(p["field"])):
+        out.append(f"'field' must be a number (degrees or mm), got {p['field']!r}")
+    if "field_kind" in p and p["field_kind"] not in ("angle", "height"):
+        out.append(f'\'field_kind\' must be "angle" or "height", got {p["field_kind"]!r}')
+    if "surface" in p and not _is_int(p["surface"]):
+        out.append(f"'surface' must be an integer (1-based), got {p['surface']!r}")
+    for k in ("min", "max"):
+        if k in p and not _is_num(p[k]):
+            out.append(f"{k!r} must be a number (mm), got {p[k]!r}")
+    if type_ in BOUND_OPERANDS and "min" not in p and "max" not in p:
+        out.append(f"operand {type_} needs 'min' and/or 'max'")
+    if "height" in p and not (_is_num(p["height"]) and p["height"] >= 0):
+        out.append(f"'height' must be a non-negative number (mm), got {p['height']!r}")
+    if "aperture" in p and not (_is_num(p["aperture"]) and 0 < p["aperture"] <= 1):
+        out.append(
+            f"'aperture' must be a fraction of the pupil radius in (0, 1], got {p['aperture']!r}"
+        )
+    if "wavelength" in p and not (_is_num(p["wavelength"]) and p["wavelength"] > 0):
+        out.append(f"'wavelength' must be a positive number (nm), got {p['wavelength']!r}")
+    if "wavelengths" in p:
+        w = p["wavelengths"]
+        if not (isinstance(w, list) and len(w) == 2 and all(_is_num(x) and x > 0 for x in w)):
+            out.append(f"'wavelengths' must be two positive numbers (nm), got {w!r}")
+    given = [k for k in _OBJECT if k in p]
+    if len(given) > 1:
+        out.append(f"give the object one way, not {' and '.join(given)}")
+    if "object_distance" in p:
+        v = p["object_distance"]
+        ok = (_is_num(v) and v > 0) or (
+            isinstance(v, str) and re.fullmatch(r"\s*(inf|[0-9.]+\s*[xX×])\s*", v) is not None
+        )
+        if not ok:
+            out.append(
+                f"'object_distance' must be a positive number (mm from the first vertex), "
+                f'"inf" or "Nx", got {v!r}'
+            )
+    if "object_s" in p and not (_is_num(p["object_s"]) and p["object_s"] != 0):
+        out.append(f"'object_s' must be a non-zero number (mm from H), got {p['object_s']!r}")
+    if "object_scale" in p and not (_is_num(p["object_scale"]) and p["object_scale"] > 0):
+        out.append(f"'object_scale' must be a positive number, got {p['object_scale']!r}")
+    if "plane" in p:
+        out += plane_problems(p["plane"], allow_best=type_ == "rms_spot")
+    return out
+
+
+def plane_problems(plane, *, allow_best: bool = False) -> list[str]:
+    """Problems of a spec ``plane`` value (see :func:`.operands.spec_plane`)."""
+    names = ("gaussian", "file", "best") if allow_best else ("gaussian", "file")
+    if isinstance(plane, str):
+        if plane in names:
+            return []
+        return [
+            f"plane {plane!r} is not one of {', '.join(map(repr, names))}{suggest(plane, names)}"
+        ]
+    if isinstance(plane, dict):
+        if len(plane) != 1:
+            return [
+                f"plane {plane!r}: give exactly one of {', '.join(PLANE_KEYS[:1] + PLANE_KEYS[2:])}"
+                " (mm)"
+            ]
+        ((k, v),) = plane.items()
+        if k not in PLANE_KEYS:
+            return [f"plane: unknown key {k!r}{suggest(k, PLANE_KEYS)}"]
+        if not (_is_num(v) and math.isfinite(v)):
+            return [f"plane {k} must be a number (mm), got {v!r}"]
+        return []
+    return [
+        f'plane {plane!r}: use "gaussian", "file" or a table {{ s_prime | from_last_vertex | '
+        "defocus = mm }"
+    ]
+
+
+def _glass_settings(d: dict, base: GlassSettings, at: str, probs: _Problems) -> GlassSettings:
+    """Glass pool settings from a table (the spec's ``[glass]`` or a glass variable's keys)."""
+    from ..glass import CATALOGS
+
+    kw: dict = {}
+    if "catalogs" in d:
+        c = d["catalogs"]
+        if not (isinstance(c, list) and c and all(isinstance(x, str) for x in c)):
+            probs.add(f"{at}: 'catalogs' must be a list of catalog names, got {c!r}")
+        else:
+            known = {x.lower(): x for x in CATALOGS}
+            bad = [x for x in c if x.lower() not in known]
+            for x in bad:
+                probs.add(f"{at}: unknown glass catalog {x!r}{suggest(x, CATALOGS)}")
+            if not bad:
+                kw["catalogs"] = tuple(known[x.lower()] for x in c)
+    if "availability" in d:
+        a = d["availability"]
+        if not (isinstance(a, list) and a and all(isinstance(x, str) for x in a)):
+            probs.add(f"{at}: 'availability' must be a list of classes, got {a!r}")
+        else:
+            bad = [x for x in a if x not in AVAILABILITY]
+            for x in bad:
+                probs.add(f"{at}: unknown availability class {x!r}{suggest(x, AVAILABILITY)}")
+            if not bad:
+                kw["availability"] = tuple(a)
+    for k in ("nd", "vd"):
+        if k in d:
+            if _range(d[k]):
+                kw[k] = (_as_float(d[k][0]), _as_float(d[k][1]))
+            else:
+                probs.add(f"{at}: {k!r} must be a window [min, max], got {d[k]!r}")
+    if "glasses" in d:
+        g = d["glasses"]
+        if not (isinstance(g, list) and g and all(isinstance(x, str) for x in g)):
+            probs.add(f"{at}: 'glasses' must be a list of glass names, got {g!r}")
+        else:
+            kw["glasses"] = tuple(g)
+    if "neighbours" in d:
+        if _is_int(d["neighbours"]) and d["neighbours"] >= 1:
+            kw["neighbours"] = d["neighbours"]
+        else:
+            probs.add(f"{at}: 'neighbours' must be a positive integer, got {d['neighbours']!r}")
+    if "model_phase" in d:
+        if isinstance(d["model_phase"], bool):
+            kw["model_phase"] = d["model_phase"]
+        else:
+            probs.add(f"{at}: 'model_phase' must be true or false, got {d['model_phase']!r}")
+    return replace(base, **kw)
+
+
+GLASS_KEYS = ("catalogs", "availability", "nd", "vd", "glasses", "neighbours", "model_phase")
+SEARCH_KEYS = (
+    "starts",
+    "seed",
+    "hops",
+    "perturbation",
+    "hop_perturbation",
+    "time",
+    "workers",
+    "local_evaluations",
+)
+TOP_KEYS = (
+    "name",
+    "start",
+    "notes",
+    "variables",
+    "pickups",
+    "operands",
+    "max_evaluations",
+    "tolerance",
+    "merit_goal",
+    "glass",
+    "global",
+)
+
+
+def _search_settings(d: dict, at: str, probs: _Problems) -> SearchSettings:
+    kw: dict = {}
+    for k, lo in (("starts", 1), ("seed", 0), ("hops", 0), ("workers", 1)):
+        if k in d:
+            if _is_int(d[k]) and d[k] >= lo:
+                kw[k] = d[k]
+            else:
+                probs.add(f"{at}: {k!r} must be an integer >= {lo}, got {d[k]!r}")
+    if "local_evaluations" in d:
+        v = d["local_evaluations"]
+        if _is_int(v) and v >= 1:
+            kw["local_evaluations"] = v
+        else:
+            probs.add(f"{at}: 'local_evaluations' must be a positive integer, got {v!r}")
+    for k in ("perturbation", "hop_perturbation"):
+        if k in d:
+            if _is_num(d[k]) and d[k] >= 0:
+                kw[k] = float(d[k])
+            else:
+                probs.add(f"{at}: {k!r} must be a non-negative number, got {d[k]!r}")
+    if "time" in d:
+        try:
+            kw["time_budget_s"] = parse_duration(d["time"])
+        except SpecError as e:
+            probs.add(f"{at}: 'time': {e}")
+    return SearchSettings(**kw)
 
 
 def read_spec(path: str | Path) -> DesignSpec:
-    """Read a TOML design spec (see ``lenses/*.spec.toml`` for examples)::
+    """Read a TOML design spec (the language: ``docs/spec.md``; examples: ``lenses/specs/``)::
 
     name = "my-design"
     start = "cooke-triplet-f4"        # bundled name or a path relative to the spec
@@ -109,12 +510,22 @@ def read_spec(path: str | Path) -> DesignSpec:
     variables = [
       { kind = "curvature", surface = 1 },
       { kind = "thickness", surface = 2, min = 0.5, max = 12 },
+      { kind = "glass", surface = 1, nd = [1.5, 1.7] },
     ]
     pickups = [ { kind = "curvature", surface = 6, source = 1, factor = -1 } ]
     operands = [
       { type = "efl", target = 50.0, weight = 10 },
       { type = "distortion", field = 20, target = 0.0, plane = "gaussian" },
     ]
+    [glass]                            # the substitution pool of glass variables
+    catalogs = ["Schott", "Ohara"]
+    [global]                           # settings of the global search (optimize --global)
+    starts = 16
+    seed = 1
+    time = "10m"
+
+    Raises :class:`SpecError` listing every problem (unknown keys with the nearest valid one,
+    wrong types, missing keys), one line each.
     """
     p = Path(path)
     try:
@@ -122,76 +533,140 @@ def read_spec(path: str | Path) -> DesignSpec:
         d = tomllib.loads(raw.decode("utf-8"))
     except FileNotFoundError:
         raise SpecError(f"{p}: no such spec file") from None
+    except IsADirectoryError:
+        raise SpecError(f"{p}: is a folder, not a spec file") from None
     except UnicodeDecodeError:
         raise SpecError(f"{p}: not a UTF-8 text file") from None
     except tomllib.TOMLDecodeError as e:
         raise SpecError(f"{p}: {e}") from None
-    known = {
-        "name",
-        "start",
-        "variables",
-        "pickups",
-        "operands",
-        "max_evaluations",
-        "tolerance",
-        "merit_goal",
-        "notes",
-    }
-    for k in d:
-        if k not in known:
-            raise SpecError(f"{p}: unknown key {k!r} (known: {', '.join(sorted(known))})")
+    probs = _Problems(str(p))
+    probs.unknown_keys(d, TOP_KEYS, "top level")
     if "start" not in d or not isinstance(d["start"], str):
-        raise SpecError(f"{p}: 'start' (the start lens: bundled name or path) is required")
+        probs.add("'start' (the start lens: bundled name or path) is required, as a string")
+    for k in ("name", "notes"):
+        if k in d and not isinstance(d[k], str):
+            probs.add(f"{k!r} must be a string, got {d[k]!r}")
+    top: dict = {}
+    if "max_evaluations" in d:
+        if _is_int(d["max_evaluations"]) and d["max_evaluations"] >= 1:
+            top["max_evaluations"] = d["max_evaluations"]
+        else:
+            probs.add(f"'max_evaluations' must be a positive integer, got {d['max_evaluations']!r}")
+    if "tolerance" in d:
+        if _is_num(d["tolerance"]) and d["tolerance"] > 0:
+            top["tolerance"] = float(d["tolerance"])
+        else:
+            probs.add(f"'tolerance' must be a positive number, got {d['tolerance']!r}")
+    if "merit_goal" in d:
+        if _is_num(d["merit_goal"]) and d["merit_goal"] >= 0:
+            top["merit_goal"] = float(d["merit_goal"])
+        else:
+            probs.add(f"'merit_goal' must be a non-negative number, got {d['merit_goal']!r}")
+
+    glass = GlassSettings()
+    if "glass" in d:
+        if isinstance(d["glass"], dict):
+            probs.unknown_keys(d["glass"], GLASS_KEYS, "[glass]")
+            glass = _glass_settings(d["glass"], glass, "[glass]", probs)
+        else:
+            probs.add("'glass' must be a table ([glass])")
+    search = SearchSettings()
+    if "global" in d:
+        if isinstance(d["global"], dict):
+            probs.unknown_keys(d["global"], SEARCH_KEYS, "[global]")
+            search = _search_settings(d["global"], "[global]", probs)
+        else:
+            probs.add("'global' must be a table ([global])")
+
     variables = []
-    for i, v in enumerate(d.get("variables", []), 1):
-        w = f"{p}: variables[{i}]"
-        if not isinstance(v, dict) or "kind" not in v or "surface" not in v:
-            raise SpecError(f"{w}: needs 'kind' and 'surface'")
-        extra = set(v) - {"kind", "surface", "min", "max"}
-        if extra:
-            raise SpecError(f"{w}: unknown key(s) {', '.join(sorted(extra))}")
-        variables.append(
-            Variable(
-                str(v["kind"]),
-                int(_num(v, "surface", w)),
-                _num(v, "min", w, -math.inf),
-                _num(v, "max", w, math.inf),
-            )
-        )
-    pickups = []
-    for i, v in enumerate(d.get("pickups", []), 1):
-        w = f"{p}: pickups[{i}]"
+    for i, v in enumerate(_list(d, "variables", probs), 1):
+        at = f"variables[{i}]"
         if not isinstance(v, dict):
-            raise SpecError(f"{w}: must be a table")
-        pickups.append(
-            Pickup(
-                str(v.get("kind", "")),
-                int(_num(v, "surface", w)),
-                int(_num(v, "source", w)),
-                _num(v, "factor", w, 1.0),
-                _num(v, "offset", w, 0.0),
+            probs.add(f"{at}: must be a table {{ kind = ..., surface = ... }}")
+            continue
+        kind = v.get("kind")
+        if not isinstance(kind, str):
+            probs.add(f"{at}: needs 'kind' (one of {', '.join(VARIABLE_KINDS)})")
+            continue
+        if kind not in VARIABLE_KINDS:
+            probs.add(f"{at}: unknown variable kind {kind!r}{suggest(kind, VARIABLE_KINDS)}")
+            continue
+        allowed = ("kind", "surface") + (GLASS_KEYS if kind == "glass" else ("min", "max"))
+        probs.unknown_keys(v, allowed, at)
+        s = v.get("surface")
+        if not _is_int(s):
+            probs.add(f"{at}: 'surface' must be an integer (1-based), got {s!r}")
+            continue
+        lo, hi = v.get("min", -math.inf), v.get("max", math.inf)
+        if not (_num_or_inf(lo) and _num_or_inf(hi)):
+            probs.add(f"{at}: 'min' and 'max' must be numbers, got {lo!r}, {hi!r}")
+            continue
+        gs = None
+        if kind == "glass":
+            own = {k: v[k] for k in GLASS_KEYS if k in v}
+            gs = _glass_settings(own, glass, at, probs) if own else None
+        variables.append(Variable(kind, s, _as_float(lo), _as_float(hi), gs))
+
+    pickups = []
+    for i, v in enumerate(_list(d, "pickups", probs), 1):
+        at = f"pickups[{i}]"
+        if not isinstance(v, dict):
+            probs.add(f"{at}: must be a table {{ kind, surface, source, factor, offset }}")
+            continue
+        probs.unknown_keys(v, ("kind", "surface", "source", "factor", "offset"), at)
+        kind = v.get("kind")
+        if not isinstance(kind, str) or kind not in PICKUP_KINDS:
+            probs.add(f"{at}: unknown pick-up kind {kind!r}{suggest(str(kind), PICKUP_KINDS)}")
+            continue
+        if not (_is_int(v.get("surface")) and _is_int(v.get("source"))):
+            probs.add(
+                f"{at}: 'surface' and 'source' must be integers (1-based), got "
+                f"{v.get('surface')!r}, {v.get('source')!r}"
             )
-        )
+            continue
+        f, o = v.get("factor", 1.0), v.get("offset", 0.0)
+        if not (_is_num(f) and _is_num(o)):
+            probs.add(f"{at}: 'factor' and 'offset' must be numbers, got {f!r}, {o!r}")
+            continue
+        if kind == "glass" and ("factor" in v or "offset" in v):
+            probs.add(f"{at}: a glass pick-up copies the glass; it takes no factor or offset")
+            continue
+        pickups.append(Pickup(kind, v["surface"], v["source"], float(f), float(o)))
+
     operands = []
-    for i, o in enumerate(d.get("operands", []), 1):
-        w = f"{p}: operands[{i}]"
-        if not isinstance(o, dict) or "type" not in o:
-            raise SpecError(f"{w}: needs 'type'")
+    for i, o in enumerate(_list(d, "operands", probs), 1):
+        at = f"operands[{i}]"
+        if not isinstance(o, dict) or not isinstance(o.get("type"), str):
+            probs.add(f"{at}: needs 'type' (one of {', '.join(OPERAND_TYPES)})")
+            continue
+        t = o["type"]
         params = {k: v for k, v in o.items() if k not in ("type", "target", "weight")}
-        operands.append(
-            Operand(str(o["type"]), _num(o, "target", w, 0.0), _num(o, "weight", w, 1.0), params)
-        )
+        target, weight = o.get("target", 0.0), o.get("weight", 1.0)
+        bad = operand_problems(t, params, target, weight)
+        for b in bad:
+            probs.add(f"{at} ({t}): {b}")
+        if not bad:
+            operands.append(Operand(t, float(target), float(weight), params))
+    probs.raise_if_any()
     return DesignSpec(
         start=d["start"],
         variables=tuple(variables),
         operands=tuple(operands),
         pickups=tuple(pickups),
         name=str(d.get("name", p.stem)),
-        max_evaluations=int(d.get("max_evaluations", 2000)),
-        tolerance=float(d.get("tolerance", 1e-12)),
-        merit_goal=None if d.get("merit_goal") is None else float(d["merit_goal"]),
         path=str(p),
+        glass=glass,
+        search=search,
+        **top,
     )
+
+
+def _list(d: dict, key: str, probs: _Problems) -> list:
+    v = d.get(key, [])
+    if not isinstance(v, list):
+        probs.add(f"{key!r} must be a list of tables, [ {{ ... }}, ... ]")
+        return []
+    return v
 
 
 def start_lens(spec: DesignSpec) -> Lens:
@@ -206,5 +681,3 @@ def start_lens(spec: DesignSpec) -> Lens:
         return load_lens(spec.start)
     except PrescriptionError as e:
         raise SpecError(f"start lens {spec.start!r}: {e}") from None
-
-

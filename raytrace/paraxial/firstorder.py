@@ -88,6 +88,18 @@ class ParaxialResult:
     n_image: float
     wavelength: float
 
+    def __repr__(self) -> str:
+        obj = (
+            "object at infinity"
+            if self.infinite
+            else f"object {self.object_distance:g} mm (s = {self.s:.6g} mm, m0 = {self.m0:.6g})"
+        )
+        return (
+            f"ParaxialResult(EFL {self.efl:.6f} mm, BFL {self.bfl:.6f} mm, EPD {self.epd:.6g} mm, "
+            f"m_e {self.m_e:.6f}, HE0 {self.HE0:.6g} mm, H'E0' {self.HpE0p:.6g} mm, {obj}, "
+            f"{self.wavelength:g} nm)"
+        )
+
     @property
     def infinite(self) -> bool:
         """True for an object at infinity."""
@@ -121,9 +133,8 @@ def _system(lens: Lens, wavelength: float) -> tuple[np.ndarray, np.ndarray, np.n
     ss = lens.surfaces
     c = np.array([s.curvature for s in ss], dtype=float)
     t = np.array([s.thickness for s in ss[:-1]], dtype=float)
-    n_out = np.array([s.material.index(wavelength) for s in ss], dtype=float)
-    n_in = np.concatenate(([lens.object_material.index(wavelength)], n_out[:-1]))
-    return c, t, n_in, n_out
+    idx = lens.indices(wavelength)[0]  # object space, then after each surface
+    return c, t, idx[:-1], idx[1:]
 
 
 def _trace(

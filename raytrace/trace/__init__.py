@@ -9,7 +9,9 @@ from ..kernels.codes import (
     STATUS_OK,
     STATUS_TIR,
 )
-from .chief import ChiefRays, aim, chief_rays
+from .chief import ChiefRays, ChromaticChiefRays, aim, chief_rays
+from .fans import RayFan, SpotDiagram, ray_fan, spot_diagram
+from .pupil import Bundle, aimed_bundle, pupil_points
 from .rays import PARALLEL_THRESHOLD, RayBatch, RayPaths, packed_lens, ray_paths, trace_rays
 
 __all__ = [
@@ -20,7 +22,15 @@ __all__ = [
     "STATUS_NAMES",
     "STATUS_OK",
     "STATUS_TIR",
+    "Bundle",
     "ChiefRays",
+    "RayFan",
+    "SpotDiagram",
+    "aimed_bundle",
+    "pupil_points",
+    "ray_fan",
+    "spot_diagram",
+    "ChromaticChiefRays",
     "RayBatch",
     "RayPaths",
     "aim",

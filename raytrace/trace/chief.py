@@ -36,21 +36,42 @@ from ..paraxial.firstorder import aim_geometry
 
 @dataclass(frozen=True, eq=False)
 class _AimSetup:
-    packed: PackedLens
-    z_E0: float  # paraxial entrance pupil (absolute z)
-    r_stop: float  # stop radius used for the tolerance
-    tol: float
+    packed: PackedLens  # at the wavelengths of the call
+    z_E0: np.ndarray  # paraxial entrance pupil per wavelength (absolute z)
+    r_stop: np.ndarray  # stop radius used for the tolerance, per wavelength
+    tol: np.ndarray  # absolute aim tolerance per wavelength
+    slope0: np.ndarray  # paraxial du/df at f = 0 per wavelength (kernel argument)
+    hscale: np.ndarray  # scale of u for finite differences per wavelength
+    z_E0_field: float  # entrance pupil that turns nominal angles into object heights
 
 
 @functools.lru_cache(maxsize=256)
-def _aim_setup(lens: Lens, wavelength: float | None, object_distance: float) -> _AimSetup:
-    p = pack(lens, wavelength)
-    try:
-        z_E0, r_par = aim_geometry(lens, object_distance, wavelength)
-    except LensError as e:
-        raise TraceError(str(e)) from None
-    r_stop = float(p.sd[p.stop]) if math.isfinite(p.sd[p.stop]) else r_par
-    return _AimSetup(p, float(z_E0), r_stop, 1e-12 * max(1.0, r_stop))
+def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: float) -> _AimSetup:
+    p = pack(lens, wavelengths=wavelengths)
+    nw = len(wavelengths)
+    z_E0 = np.empty(nw)
+    r_stop = np.empty(nw)
+    sd_stop = float(p.sd[p.stop])
+    for i, wl in enumerate(wavelengths):
+        try:
+            z, r_par = aim_geometry(lens, object_distance, wl)
+        except LensError as e:
+            raise TraceError(str(e)) from None
+        z_E0[i] = z
+        r_stop[i] = sd_stop if math.isfinite(sd_stop) else r_par
+    if math.isfinite(object_distance):
+        den = z_E0 + object_distance  # z_E0 − z_obj
+        slope0 = np.array([-1.0 / d if d != 0.0 else 0.0 for d in den])
+        hscale = np.ones(nw)
+    else:
+        slope0 = -z_E0
+        hscale = np.maximum(1.0, r_stop)
+    # one wavelength: its own pupil (as a monochromatic lens); several: the reference
+    # wavelength's, so that every wavelength traces the same object points
+    z_field = z_E0[0] if nw == 1 else _aim_setup(lens, (lens.wavelength,), object_distance).z_E0[0]
+    return _AimSetup(
+        p, z_E0, r_stop, 1e-12 * np.maximum(1.0, r_stop), slope0, hscale, float(z_field)
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,6 +173,95 @@ class ChiefRays:
         )
 
 
+@dataclass(frozen=True, eq=False)
+class ChromaticChiefRays:
+    """Real chief rays at several wavelengths, aimed in one kernel call (wavelength × field).
+
+    ``rays[i]`` is the :class:`ChiefRays` at ``wavelengths[i]``; every wavelength has the same
+    object points (``fields``, ``field_kind``, ``object_distance``; a nominal angle with a finite
+    object is turned into an object height with the reference wavelength's paraxial entrance
+    pupil). Stacked attributes have shape (n_wavelengths, n_fields).
+
+    Attributes
+    ----------
+    rays : tuple of ChiefRays
+    wavelengths : ndarray
+        nm, in the order asked for.
+    reference_wavelength : float
+        nm: the lens's reference wavelength (it need not be among ``wavelengths``).
+    """
+
+    rays: tuple[ChiefRays, ...]
+    wavelengths: np.ndarray
+    reference_wavelength: float
+
+    @property
+    def fields(self) -> np.ndarray:
+        return self.rays[0].fields
+
+    @property
+    def field_kind(self) -> str:
+        return self.rays[0].field_kind
+
+    @property
+    def object_distance(self) -> float:
+        return self.rays[0].object_distance
+
+    @property
+    def n_wavelengths(self) -> int:
+        return len(self.rays)
+
+    def __getitem__(self, i: int) -> ChiefRays:
+        return self.rays[i]
+
+    def __iter__(self):
+        return iter(self.rays)
+
+    def at(self, wavelength: float) -> ChiefRays:
+        """The rays at ``wavelength`` (nm; one of :attr:`wavelengths`)."""
+        hit = np.nonzero(self.wavelengths == float(wavelength))[0]
+        if hit.size == 0:
+            raise TraceError(
+                f"{wavelength:g} nm is not one of the traced wavelengths "
+                f"({', '.join(f'{w:g}' for w in self.wavelengths)} nm)"
+            )
+        return self.rays[int(hit[0])]
+
+    def stacked(self, name: str) -> np.ndarray:
+        """Attribute ``name`` of every wavelength's :class:`ChiefRays`, stacked: (n_w, n)."""
+        return np.stack([getattr(r, name) for r in self.rays])
+
+    @property
+    def status(self) -> np.ndarray:
+        return self.stacked("status")
+
+    @property
+    def ok(self) -> np.ndarray:
+        """(n_wavelengths, n_fields) mask of rays that reached the last surface."""
+        return self.status == STATUS_OK
+
+    @property
+    def y_last(self) -> np.ndarray:
+        return self.stacked("y_last")
+
+    @property
+    def tan_out(self) -> np.ndarray:
+        return self.stacked("tan_out")
+
+    def heights_at(self, z_planes: float | npt.ArrayLike) -> np.ndarray:
+        """Chief-ray heights (mm) on plane(s) z (absolute, mm): (n_wavelengths, n_fields) for a
+        scalar, (n_wavelengths, n_planes, n_fields) for an array."""
+        return np.stack([r.heights_at(z_planes) for r in self.rays])
+
+    def __repr__(self) -> str:
+        wl = ", ".join(f"{w:g}" for w in self.wavelengths)
+        bad = int(np.count_nonzero(self.status != STATUS_OK))
+        return (
+            f"ChromaticChiefRays({self.fields.size} fields x {self.n_wavelengths} wavelengths "
+            f"[{wl}] nm, reference {self.reference_wavelength:g} nm, {bad} failed)"
+        )
+
+
 def chief_rays(
     lens: Lens,
     fields_deg: npt.ArrayLike | None = None,
@@ -160,10 +270,12 @@ def chief_rays(
     object_distance: float | str | None = None,
     object_s: float | None = None,
     object_scale: float | None = None,
-    wavelength: float | None = None,
+    wavelength: float | str | None = None,
+    wavelengths: npt.ArrayLike | None = None,
     clip: bool = True,
-) -> ChiefRays:
-    """Aim real chief rays through the centre of the real stop (one kernel call for all fields).
+) -> ChiefRays | ChromaticChiefRays:
+    """Aim real chief rays through the centre of the real stop (one kernel call for all fields
+    and wavelengths).
 
     Parameters
     ----------
@@ -178,22 +290,30 @@ def chief_rays(
     object_distance, object_s, object_scale
         The object plane (at most one): mm from the first vertex (or ``inf`` / ``"12x"``),
         Pestrecov's signed s from H (mm), or an image scale N ("N×"). Default: the lens's.
-    wavelength : float, optional
-        nm; default the lens's.
+        Resolved with the paraxial data at the reference wavelength.
+    wavelength : float or str, optional
+        nm (or a string with a unit, ``"0.5876um"``); default the lens's reference wavelength.
+        A bare number below 100 is refused as looking like µm.
+    wavelengths : sequence of float, optional
+        Several wavelengths (nm) in one kernel call, or ``"lens"`` for the lens's own; returns a
+        :class:`ChromaticChiefRays`. Give ``wavelength`` or ``wavelengths``, not both.
     clip : bool
         Apply semi-diameters to the aimed ray (status CLIPPED); aiming itself is unclipped.
 
     Returns
     -------
-    ChiefRays
-        Named arrays per field, with a status per field; a failed field has NaN coordinates.
+    ChiefRays or ChromaticChiefRays
+        Named arrays per field (per wavelength and field), with a status per ray; a failed ray
+        has NaN coordinates.
     """
+    if wavelength is not None and wavelengths is not None:
+        raise TraceError("give wavelength= or wavelengths=, not both")
     od = resolve_object_distance(
         lens,
         object_distance=object_distance,
         object_s=object_s,
         object_scale=object_scale,
-        wavelength=wavelength,
+        wavelength=None if wavelengths is not None else _wl(wavelength),
     )
     if fields_deg is not None and object_heights_mm is not None:
         raise TraceError("give fields_deg or object_heights_mm, not both")
@@ -203,7 +323,34 @@ def chief_rays(
     else:
         fk = "angle" if fields_deg is not None else "height"
         f = np.atleast_1d(np.asarray(fields_deg if fk == "angle" else object_heights_mm, float))
+    if wavelengths is not None:
+        return aim(lens, f, fk, od, clip=clip, wavelengths=wavelengths)
     return aim(lens, f, fk, od, wavelength, clip)
+
+
+def _wl(value, what: str = "wavelength") -> float | None:
+    """A wavelength in nm through the one check (:func:`raytrace.units.wavelength_nm`)."""
+    if value is None:
+        return None
+    from ..units import UnitError, wavelength_nm
+
+    try:
+        return wavelength_nm(value, what)
+    except UnitError as e:
+        raise TraceError(str(e)) from None
+
+
+def resolve_wavelengths(lens: Lens, wavelengths) -> tuple[float, ...]:
+    """``wavelengths`` (nm; a sequence, a number, or ``"lens"`` for the lens's own) as a tuple
+    of checked floats."""
+    if isinstance(wavelengths, str):
+        if wavelengths.strip().lower() != "lens":
+            return (_wl(wavelengths, "wavelengths"),)
+        return tuple(lens.wavelengths)
+    vals = np.atleast_1d(np.asarray(wavelengths, dtype=object)).ravel()
+    if vals.size == 0:
+        raise TraceError("wavelengths: give at least one wavelength (nm)")
+    return tuple(_wl(v, "wavelengths") for v in vals)
 
 
 def aim(
@@ -213,9 +360,13 @@ def aim(
     object_distance: float,
     wavelength: float | None = None,
     clip: bool = True,
-) -> ChiefRays:
+    *,
+    wavelengths=None,
+) -> ChiefRays | ChromaticChiefRays:
     """:func:`chief_rays` for fields already resolved: ``fields`` (deg or mm) of ``field_kind``
-    ``"angle"`` | ``"height"``, ``object_distance`` mm from the first vertex (inf)."""
+    ``"angle"`` | ``"height"``, ``object_distance`` mm from the first vertex (inf). With
+    ``wavelengths`` (a sequence, nm) all wavelengths are aimed in one kernel call and a
+    :class:`ChromaticChiefRays` is returned."""
     from ..kernels.aim import aim_chief
 
     fk = field_kind
@@ -234,34 +385,38 @@ def aim(
         raise TraceError("object heights need a finite object distance")
     if fk == "angle" and np.any(np.abs(f) >= 90.0):
         raise TraceError("field angles must lie strictly between -90 and 90 degrees")
-    wl = None if wavelength is None else float(wavelength)
-    su = _aim_setup(lens, wl, od)
-    z_obj = -od if finite else 0.0
-    if finite:
-        kf = (z_obj - su.z_E0) * np.tan(np.radians(f)) if fk == "angle" else f
-        den = su.z_E0 - z_obj
-        slope0 = -1.0 / den if den != 0.0 else 0.0
-        hscale = 1.0
+    chromatic = wavelengths is not None
+    if chromatic:
+        if wavelength is not None:
+            raise TraceError("give wavelength= or wavelengths=, not both")
+        wls = resolve_wavelengths(lens, wavelengths)
     else:
+        wls = (lens.wavelength if wavelength is None else _wl(wavelength),)
+    su = _aim_setup(lens, wls, od)
+    z_obj = -od if finite else 0.0
+    nw = len(wls)
+    if not finite:
         kf = np.radians(f)
-        slope0 = -su.z_E0
-        hscale = max(1.0, su.r_stop)
+    elif fk == "angle":
+        kf = (z_obj - su.z_E0_field) * np.tan(np.radians(f))  # nominal angle → object height
+    else:
+        kf = f
     n = f.size
-    start = np.empty((4, n))
-    last = np.empty((4, n))
-    status = np.empty(n, dtype=np.int8)
-    surface = np.empty(n, dtype=np.int32)
-    evals = np.empty(n, dtype=np.int32)
-    residual = np.empty(n)
+    start = np.empty((nw, 4, n))
+    last = np.empty((nw, 4, n))
+    status = np.empty((nw, n), dtype=np.int8)
+    surface = np.empty((nw, n), dtype=np.int32)
+    evals = np.empty((nw, n), dtype=np.int32)
+    residual = np.empty((nw, n))
     aim_chief(
-        *su.packed.arrays,
+        su.packed.lens_arrays,
         su.packed.stop,
         1 if finite else 0,
         z_obj,
         np.ascontiguousarray(kf, dtype=np.float64),
-        float(slope0),
+        su.slope0,
         su.tol,
-        float(hscale),
+        su.hscale,
         bool(clip),
         start,
         last,
@@ -270,28 +425,35 @@ def aim(
         evals,
         residual,
     )
-    y0, z0, M0, N0 = start
-    with np.errstate(divide="ignore", invalid="ignore"):
-        zE = np.where(M0 != 0.0, z0 - y0 * N0 / M0, np.inf)
-    zE = np.where(kf == 0.0, su.z_E0, zE)
-    return ChiefRays(
-        fields=f,
-        field_kind=fk,
-        object_distance=od,
-        wavelength=su.packed.wavelength,
-        y_start=y0,
-        z_start=z0,
-        M_start=M0,
-        N_start=N0,
-        y_last=last[0],
-        z_last=last[1],
-        M_last=last[2],
-        N_last=last[3],
-        status=status,
-        surface=surface,
-        iterations=evals,
-        stop_residual=residual,
-        entrance_pupil_z=zE,
-        stop_radius=su.r_stop,
-        tolerance=su.tol,
-    )
+    rays = []
+    for i in range(nw):
+        y0, z0, M0, N0 = start[i]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            zE = np.where(M0 != 0.0, z0 - y0 * N0 / M0, np.inf)
+        zE = np.where(kf == 0.0, su.z_E0[i], zE)
+        rays.append(
+            ChiefRays(
+                fields=f,
+                field_kind=fk,
+                object_distance=od,
+                wavelength=wls[i],
+                y_start=y0,
+                z_start=z0,
+                M_start=M0,
+                N_start=N0,
+                y_last=last[i, 0],
+                z_last=last[i, 1],
+                M_last=last[i, 2],
+                N_last=last[i, 3],
+                status=status[i],
+                surface=surface[i],
+                iterations=evals[i],
+                stop_residual=residual[i],
+                entrance_pupil_z=zE,
+                stop_radius=float(su.r_stop[i]),
+                tolerance=float(su.tol[i]),
+            )
+        )
+    if not chromatic:
+        return rays[0]
+    return ChromaticChiefRays(tuple(rays), np.array(wls), float(lens.wavelength))

@@ -28,6 +28,10 @@ from ..packing import PackedLens, pack
 #: most ~0.8 ms on a quiet machine.
 PARALLEL_THRESHOLD = 32768
 
+#: Rays per kernel call: a larger batch is traced in chunks of this size (contiguous views, no
+#: copies), so that Ctrl-C stops a long trace within a fraction of a second.
+CHUNK_RAYS = 1 << 20
+
 #: numba's parallel layer is not re-entrant from several Python threads (workqueue layer): every
 #: parallel kernel launch and thread-count change holds this lock.
 PARALLEL_LOCK = threading.RLock()
@@ -171,29 +175,44 @@ def trace_rays(
     out = [np.empty(n) for _ in range(6)]
     st = np.empty(n, dtype=np.int8)
     sf = np.empty(n, dtype=np.int32)
-    args = (*packed.arrays, bool(clip), *xs, *out, st, sf)
     if threads is not None and not (1 <= int(threads)):
         raise TraceError(f"threads must be >= 1, got {threads}")
+    for i0 in range(0, n, CHUNK_RAYS):
+        i1 = min(n, i0 + CHUNK_RAYS)
+        args = (
+            *packed.arrays,
+            bool(clip),
+            *(a[i0:i1] for a in xs),
+            *(a[i0:i1] for a in out),
+            st[i0:i1],
+            sf[i0:i1],
+        )
+        _launch(bulk, args, i1 - i0, threads)
+    return RayBatch(*out, st, sf)
+
+
+def _launch(bulk, args: tuple, n: int, threads: int | None) -> None:
+    """One kernel call: serial for small batches or one thread, else the prange kernel (under
+    :data:`PARALLEL_LOCK`)."""
     if n < PARALLEL_THRESHOLD or threads == 1:
         bulk.trace_batch_serial(*args)
-    else:
-        import numba
+        return
+    import numba
 
-        with PARALLEL_LOCK:
-            top = numba.config.NUMBA_NUM_THREADS
-            want = top if threads is None else min(int(threads), top)
-            if want == 1:
-                bulk.trace_batch_serial(*args)
-            else:
-                old = numba.get_num_threads()
-                try:
-                    if threads is not None:
-                        numba.set_num_threads(want)
-                    bulk.trace_batch_parallel(*args)
-                finally:
-                    if threads is not None:
-                        numba.set_num_threads(old)
-    return RayBatch(*out, st, sf)
+    with PARALLEL_LOCK:
+        top = numba.config.NUMBA_NUM_THREADS
+        want = top if threads is None else min(int(threads), top)
+        if want == 1:
+            bulk.trace_batch_serial(*args)
+            return
+        old = numba.get_num_threads()
+        try:
+            if threads is not None:
+                numba.set_num_threads(want)
+            bulk.trace_batch_parallel(*args)
+        finally:
+            if threads is not None:
+                numba.set_num_threads(old)
 
 
 @dataclass(frozen=True, eq=False)

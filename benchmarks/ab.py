@@ -1,0 +1,198 @@
+"""A/B benchmark: this checkout against an earlier git revision, interleaved in one run.
+
+    python benchmarks/ab.py                      # against f4081fc (before the reorganisation)
+    python benchmarks/ab.py --ref HEAD~3 --rounds 5
+
+For each revision a git worktree is made in a temporary folder; every measurement runs in a fresh
+Python process with that tree first on ``sys.path``, in the order A B A B ... (``--rounds``
+rounds), so machine load falls on both alike; the result is the median over rounds. Before the
+rounds each tree is run once so its numba cache is warm (stated in the output): no measurement
+includes compilation.
+
+Measured per revision:
+
+* bulk throughput: 1e6 random rays through the Cooke triplet (``cooke-triplet-f4``), 1 and 2
+  threads, best of 5 calls inside the process, in M ray-surfaces/s (6 refracting surfaces);
+* the 50-field chief-ray curve (Cooke, 0–20°): median of 300 calls, ms;
+* CLI wall time, warm: ``distortion topogon-like-pestrecov`` and ``paraxial cooke-triplet-f4``
+  (the console entry of each revision: ``python -m distortion.cli`` before the reorganisation,
+  ``python -m orthoscope`` after), with byte-compiled sources.
+
+Prints a table with the ratio B/A and writes benchmarks/results/ab.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+
+CHILD = r"""
+import sys, time, json
+import numpy as np
+import numba
+new = {new}
+from {lib} import load_lens
+lens = load_lens("cooke-triplet-f4")
+if new:
+    from raytrace.packing import pack
+    from raytrace.trace import chief_rays, trace_rays
+    def tr(p, r, threads): return trace_rays(p, r[:3], r[3:], threads=threads)
+    def cr(l, f): return chief_rays(l, f)
+else:
+    from raytrace.lens import pack
+    from raytrace.trace import chief_rays, trace_rays
+    def tr(p, r, threads): return trace_rays(p, *r, threads=threads)
+    def cr(l, f): return chief_rays(l, f)
+p = pack(lens)
+rng = np.random.default_rng(0)
+n = 1_000_000
+r = 6.25 * 0.9 * np.sqrt(rng.uniform(0, 1, n)); t = rng.uniform(0, 2 * np.pi, n)
+a, b = np.radians(rng.uniform(-20, 20, (2, n)))
+d = np.stack([np.tan(a), np.tan(b), np.ones(n)]); d /= np.linalg.norm(d, axis=0)
+rays = (r * np.cos(t), r * np.sin(t), np.full(n, -1.0), d[0].copy(), d[1].copy(), d[2].copy())
+out = {{}}
+for th in (1, 2):
+    if th > numba.config.NUMBA_NUM_THREADS:
+        continue
+    tr(p, rays, th)
+    best = 1e9
+    for _ in range(5):
+        t0 = time.perf_counter(); rb = tr(p, rays, th); rb.at_plane(p.z_image)
+        best = min(best, time.perf_counter() - t0)
+    out[f"bulk_mrs_{{th}}t"] = 6 * n / best / 1e6
+f = np.linspace(0.0, 20.0, 50)
+cr(lens, f)
+ts = []
+for _ in range(300):
+    t0 = time.perf_counter(); cr(lens, f); ts.append(time.perf_counter() - t0)
+out["chief50_ms"] = float(np.median(ts) * 1e3)
+print("RESULT", json.dumps(out))
+"""
+
+
+def _tree(ref: str, tmp: Path) -> Path:
+    dest = tmp / ref.replace("/", "_").replace("~", "_")
+    subprocess.run(
+        ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(dest), ref],
+        check=True,
+        capture_output=True,
+    )
+    return dest
+
+
+def _env(tree: Path, tmp: Path) -> dict:
+    """Environment of a child that imports the project from ``tree`` only. The children run with
+    ``python -S`` (no site hooks: an editable install's import finder would otherwise pick the
+    installed tree), with site-packages on PYTHONPATH for numpy / numba."""
+    import site
+
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(tree), str(_lenses_pkg(tree, tmp)), *site.getsitepackages()]
+    )
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    return env
+
+
+def _is_new(tree: Path) -> bool:
+    return (tree / "orthoscope" / "cli" / "__init__.py").is_file()
+
+
+def _lenses_pkg(tree: Path, tmp: Path) -> Path:
+    """A folder holding ``orthoscope_lenses`` (the bundled lens package) for ``tree``."""
+    d = tmp / f"lenses_{tree.name}"
+    if not d.exists():
+        d.mkdir()
+        (d / "orthoscope_lenses").symlink_to(tree / "lenses")
+    return d
+
+
+def _run_child(tree: Path, tmp: Path) -> dict:
+    new = _is_new(tree)
+    lib = "raytrace.files.library" if new else "raytrace.library"
+    env = _env(tree, tmp)
+    code = CHILD.format(new=new, lib=lib)
+    r = subprocess.run(
+        [sys.executable, "-S", "-c", code], env=env, capture_output=True, text=True, cwd=tmp
+    )
+    if r.returncode:
+        raise RuntimeError(r.stderr[-2000:])
+    return json.loads(r.stdout.split("RESULT", 1)[1])
+
+
+def _cli(tree: Path, tmp: Path, args: list[str]) -> float:
+    env = _env(tree, tmp)
+    mod = "orthoscope" if _is_new(tree) else "distortion.cli"
+    t0 = time.perf_counter()
+    r = subprocess.run(
+        [sys.executable, "-S", "-m", mod, *args], env=env, capture_output=True, text=True, cwd=tmp
+    )
+    dt = time.perf_counter() - t0
+    if r.returncode:
+        raise RuntimeError(r.stderr[-2000:])
+    return dt
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--ref", default="f4081fc", help="the A revision (default: f4081fc)")
+    ap.add_argument("--rounds", type=int, default=5)
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        a = _tree(args.ref, tmp)
+        b = ROOT
+        trees = {"A": a, "B": b}
+        try:
+            for t in trees.values():  # compile once, byte-compile the sources: warm caches
+                pkgs = [str(t / p) for p in ("raytrace", "distortion", "orthoscope") if (t / p).is_dir()]
+                subprocess.run([sys.executable, "-m", "compileall", "-q", *pkgs], check=False)
+                _run_child(t, tmp)
+            cli_cmds = {
+                "cli_distortion_s": ["distortion", "topogon-like-pestrecov"],
+                "cli_paraxial_s": ["paraxial", "cooke-triplet-f4"],
+            }
+            for t in trees.values():
+                for c in cli_cmds.values():
+                    _cli(t, tmp, c)
+            rows: dict[str, dict[str, list[float]]] = {"A": {}, "B": {}}
+            load0 = os.getloadavg()
+            for _ in range(args.rounds):
+                for key, t in trees.items():
+                    for k, v in _run_child(t, tmp).items():
+                        rows[key].setdefault(k, []).append(v)
+                    for k, c in cli_cmds.items():
+                        rows[key].setdefault(k, []).append(_cli(t, tmp, c))
+            load1 = os.getloadavg()
+        finally:
+            subprocess.run(
+                ["git", "-C", str(ROOT), "worktree", "remove", "--force", str(a)],
+                capture_output=True,
+            )
+    med = {k: {m: statistics.median(v) for m, v in r.items()} for k, r in rows.items()}
+    print(f"A = {args.ref}, B = this checkout; {args.rounds} interleaved rounds, medians; ")
+    print(f"numba caches warm (each tree run once before); load average {load0} -> {load1}")
+    print(f"{'measurement':24} {'A':>10} {'B':>10} {'B/A':>7}")
+    for m in med["A"]:
+        va, vb = med["A"][m], med["B"].get(m, float("nan"))
+        print(f"{m:24} {va:10.4g} {vb:10.4g} {vb / va:7.3f}")
+    out = HERE / "results"
+    out.mkdir(exist_ok=True)
+    (out / "ab.json").write_text(
+        json.dumps({"ref": args.ref, "rounds": rows, "median": med, "load": [load0, load1]})
+    )
+    print(f"wrote {out / 'ab.json'}")
+
+
+if __name__ == "__main__":
+    main()

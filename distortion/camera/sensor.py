@@ -1,0 +1,323 @@
+"""The image sensor: its size in mm, its pixels, and where the principal point lies on it.
+
+Pixel coordinates follow :mod:`distortion.camera.conventions` (OpenCV pixels are the common frame;
+COLMAP and Metashape at +0.5; photogrammetric mm with y up, origin at the sensor centre).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError
+from .conventions import (
+    from_opencv_pixels,
+    image_centre,
+    opencv_pixels_to_photo_mm,
+    photo_mm_to_opencv_pixels,
+    pixel_centre_offset,
+    to_opencv_pixels,
+)
+
+# plausible ranges: phone sensors have ~0.5 µm pixels, scientific CCDs up to ~30 µm, film
+# scanners / line arrays rarely more; a sensor is between a fraction of a mm and ~0.5 m.
+PITCH_RANGE_UM = (0.3, 100.0)
+SIZE_RANGE_MM = (0.5, 1000.0)
+MAX_PIXELS = 1_000_000
+
+_PAIR = re.compile(r"^\s*([^x×*,]+?)\s*(?:[x×*,]\s*([^x×*,]+?))?\s*$", re.IGNORECASE)
+_NUM_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zA-Zµμ]*)\s*$")
+_UM = {
+    "": 1.0,
+    "um": 1.0,
+    "µm": 1.0,
+    "μm": 1.0,
+    "micron": 1.0,
+    "microns": 1.0,
+    "mm": 1000.0,
+    "nm": 1e-3,
+}
+_MM = {"": 1.0, "mm": 1.0, "cm": 10.0, "m": 1000.0, "um": 1e-3, "µm": 1e-3, "μm": 1e-3}
+
+
+def _split_pair(text: str, what: str, example: str) -> tuple[str, str | None]:
+    m = _PAIR.match(text)
+    if not m:
+        raise DataError(f"{what} {text!r}: not understood; write it as {example}")
+    return m.group(1), m.group(2)
+
+
+def _number(text: str, what: str, units: dict[str, float], default_unit: str) -> tuple[float, bool]:
+    """(value in the default unit, True when a unit was written)."""
+    m = _NUM_UNIT.match(text)
+    if not m:
+        raise DataError(f"{what} {text!r}: not a number")
+    unit = m.group(2)
+    if unit.lower() not in units and unit not in units:
+        raise DataError(
+            f"{what} {text!r}: unknown unit {unit!r}; use {', '.join(u for u in units if u)} "
+            f"(a bare number is {default_unit})"
+        )
+    scale = units.get(unit, units.get(unit.lower()))
+    return float(m.group(1)) * scale, bool(unit)
+
+
+def parse_size_mm(size: str | Sequence[float]) -> tuple[float, float]:
+    """``"36x24"``, ``"36 x 24 mm"``, ``"23.5×15.6"`` or ``(36, 24)`` → (width, height) in mm."""
+    if isinstance(size, str):
+        a, b = _split_pair(size, "sensor size", "'36x24' (mm)")
+        if b is None:
+            raise DataError(f"sensor size {size!r}: give width and height, e.g. '36x24' (mm)")
+        h, _ = _number(b, "sensor height", _MM, "mm")
+        mb, ma = _NUM_UNIT.match(b), _NUM_UNIT.match(a)
+        if ma and mb and not ma.group(2) and mb.group(2):
+            a = a + mb.group(2)  # '36x24mm': the unit written once applies to both
+        w, _ = _number(a, "sensor width", _MM, "mm")
+    else:
+        vals = tuple(size)
+        if len(vals) != 2:
+            raise DataError(f"sensor size {size!r}: give (width, height) in mm")
+        w, h = float(vals[0]), float(vals[1])
+    return w, h
+
+
+def parse_pixels(pixels: str | Sequence[int]) -> tuple[int, int]:
+    """``"6000x4000"`` or ``(6000, 4000)`` → (columns, rows)."""
+    if isinstance(pixels, str):
+        a, b = _split_pair(pixels.lower().replace("px", ""), "pixel count", "'6000x4000'")
+        if b is None:
+            raise DataError(f"pixel count {pixels!r}: give columns and rows, e.g. '6000x4000'")
+        vals = (a.strip(), b.strip())
+        try:
+            fv = (float(vals[0]), float(vals[1]))
+        except ValueError:
+            raise DataError(f"pixel count {pixels!r}: not two numbers; e.g. '6000x4000'") from None
+    else:
+        fv = tuple(float(v) for v in pixels)
+        if len(fv) != 2:
+            raise DataError(f"pixel count {pixels!r}: give (columns, rows)")
+    for v in fv:
+        if not (math.isfinite(v) and v == int(v)):
+            raise DataError(f"pixel count {pixels!r}: pixel counts are whole numbers")
+    return int(fv[0]), int(fv[1])
+
+
+def parse_pitch_um(pitch: str | float | Sequence[float]) -> tuple[float, float]:
+    """Pixel pitch → (x, y) in µm. A bare number is µm; ``"6um"``, ``"0.006mm"``, ``"6x6.2"``
+    and ``(6, 6.2)`` are accepted. A bare number below 0.3 that would be a plausible pitch in
+    mm is refused with that hint (``0.006`` is 6 nm, not 6 µm)."""
+    if isinstance(pitch, str):
+        a, b = _split_pair(pitch, "pixel pitch", "'6' (µm) or '6x6' or '0.006mm'")
+        px, ux = _number(a, "pixel pitch", _UM, "µm")
+        py, uy = _number(b, "pixel pitch", _UM, "µm") if b is not None else (px, ux)
+        explicit = ux or uy
+        vals = (px, py)
+    elif isinstance(pitch, int | float | np.floating | np.integer):
+        vals, explicit = (float(pitch), float(pitch)), False
+    else:
+        vals = tuple(float(v) for v in pitch)
+        if len(vals) != 2:
+            raise DataError(f"pixel pitch {pitch!r}: give one value or (x, y) in µm")
+        explicit = False
+    lo, hi = PITCH_RANGE_UM
+    for v in vals:
+        if not (math.isfinite(v) and v > 0):
+            raise DataError(f"pixel pitch {pitch!r}: must be positive (µm)")
+        if v < lo:
+            if not explicit and lo <= v * 1000.0 <= hi:
+                raise DataError(
+                    f"pixel pitch {v:g} µm looks like millimetres ({v * 1000:g} µm = {v:g} mm);"
+                    f" give the pitch in micrometres ({v * 1000:g}) or write '{v:g}mm'"
+                )
+            raise DataError(f"pixel pitch {v:g} µm is below {lo} µm; give the pitch in micrometres")
+        if v > hi:
+            raise DataError(
+                f"pixel pitch {v:g} µm is above {hi:g} µm; give the pitch in micrometres (e.g. 4.3)"
+            )
+    return vals[0], vals[1]
+
+
+def _parse_offset(off) -> tuple[float, float]:
+    if isinstance(off, str):
+        parts = [p for p in re.split(r"[,\s]+", off.strip()) if p]
+        if len(parts) != 2:
+            raise DataError(f"principal-point offset {off!r}: give 'dx,dy' in mm (x right, y up)")
+        vals = tuple(_number(p, "principal-point offset", _MM, "mm")[0] for p in parts)
+    else:
+        vals = tuple(float(v) for v in off)
+        if len(vals) != 2:
+            raise DataError(f"principal-point offset {off!r}: give (dx, dy) in mm")
+    if not all(math.isfinite(v) for v in vals):
+        raise DataError(f"principal-point offset {off!r}: must be finite")
+    return vals[0], vals[1]
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """An image sensor (the frame of a camera).
+
+    Attributes
+    ----------
+    width_mm, height_mm:
+        Size of the active pixel array in mm (columns × pitch_x, rows × pitch_y).
+    width_px, height_px:
+        Pixel counts (columns, rows).
+    principal_point_offset_mm:
+        (dx, dy) of the principal point (where the optical axis meets the sensor) from the sensor
+        centre, in mm, photogrammetric axes: **x right, y up** (Australis' xp, yp of a camera
+        whose image centre is the sensor centre).
+
+    Build it from strings or numbers with :meth:`from_spec`; the constructor checks
+    consistency and ranges and raises :class:`~distortion.errors.DataError` naming the fix.
+    """
+
+    width_mm: float
+    height_mm: float
+    width_px: int
+    height_px: int
+    principal_point_offset_mm: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        for name in ("width_px", "height_px"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not float(v) == int(v) or not 0 < int(v) <= MAX_PIXELS:
+                raise DataError(f"Sensor {name}={v!r}: a whole number of pixels, 1..{MAX_PIXELS}")
+            object.__setattr__(self, name, int(v))
+        lo, hi = SIZE_RANGE_MM
+        for name in ("width_mm", "height_mm"):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0):
+                raise DataError(f"Sensor {name}={v!r}: must be positive (mm)")
+            if not lo <= v <= hi:
+                raise DataError(
+                    f"Sensor {name}={v:g} mm is outside {lo:g}..{hi:g} mm; sizes are in mm "
+                    "(a full-frame sensor is 36x24)"
+                )
+            object.__setattr__(self, name, v)
+        object.__setattr__(
+            self, "principal_point_offset_mm", _parse_offset(self.principal_point_offset_mm)
+        )
+        parse_pitch_um(self.pixel_pitch_um)  # range check with the mm hint
+
+    # ---- construction -----------------------------------------------------------------------
+    @classmethod
+    def from_spec(
+        cls,
+        size: str | Sequence[float] | None = None,
+        pixels: str | Sequence[int] | None = None,
+        pitch_um: str | float | Sequence[float] | None = None,
+        principal_point_offset_mm: str | Sequence[float] = (0.0, 0.0),
+    ) -> Sensor:
+        """A sensor from any two (or all three, checked) of size, pixel count and pitch.
+
+        Parameters
+        ----------
+        size:
+            ``"36x24"`` (mm; ``"36x24mm"``, ``"23.5×15.6"``) or (w, h) in mm.
+        pixels:
+            ``"6000x4000"`` or (columns, rows).
+        pitch_um:
+            Pixel pitch in µm (``6``, ``"6x6"``, ``"6um"``, ``"0.006mm"``). With a size and no
+            pixel count the count is size / pitch rounded to whole pixels and the size becomes
+            count × pitch.
+        principal_point_offset_mm:
+            (dx, dy) from the sensor centre in mm, x right, y up (or ``"dx,dy"``).
+        """
+        given = [
+            n
+            for n, v in (("size", size), ("pixels", pixels), ("pitch_um", pitch_um))
+            if v is not None
+        ]
+        if len(given) < 2:
+            raise DataError(
+                "Sensor.from_spec: give two of size (e.g. '36x24' mm), pixels (e.g. '6000x4000') "
+                "and pitch_um (e.g. 6); got " + (", ".join(given) or "none")
+            )
+        w_mm = h_mm = None
+        if size is not None:
+            w_mm, h_mm = parse_size_mm(size)
+        cols = rows = None
+        if pixels is not None:
+            cols, rows = parse_pixels(pixels)
+        if pitch_um is not None:
+            px, py = parse_pitch_um(pitch_um)
+            if cols is None:
+                cols_f, rows_f = w_mm / (px / 1000.0), h_mm / (py / 1000.0)
+                cols, rows = round(cols_f), round(rows_f)
+                if cols < 1 or rows < 1:
+                    raise DataError(
+                        f"sensor {w_mm:g}x{h_mm:g} mm with a {px:g} µm pitch has no whole pixel"
+                    )
+            elif w_mm is not None:
+                for what, mm, n, p in (("width", w_mm, cols, px), ("height", h_mm, rows, py)):
+                    if abs(mm - n * p / 1000.0) > 0.005 * mm:
+                        raise DataError(
+                            f"sensor {what} {mm:g} mm disagrees with {n} pixels × {p:g} µm = "
+                            f"{n * p / 1000.0:g} mm; give two of size, pixels and pitch, or "
+                            "consistent values"
+                        )
+            w_mm, h_mm = cols * px / 1000.0, rows * py / 1000.0
+        return cls(w_mm, h_mm, cols, rows, _parse_offset(principal_point_offset_mm))
+
+    # ---- derived ----------------------------------------------------------------------------
+    @property
+    def pixel_size_mm(self) -> tuple[float, float]:
+        """(pitch_x, pitch_y) in mm."""
+        return self.width_mm / self.width_px, self.height_mm / self.height_px
+
+    @property
+    def pixel_pitch_um(self) -> tuple[float, float]:
+        """(pitch_x, pitch_y) in µm."""
+        px, py = self.pixel_size_mm
+        return px * 1000.0, py * 1000.0
+
+    @property
+    def image_size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return self.width_px, self.height_px
+
+    @property
+    def diagonal_mm(self) -> float:
+        return math.hypot(self.width_mm, self.height_mm)
+
+    def centre(self, convention: str = "opencv") -> tuple[float, float]:
+        """The sensor centre in absolute pixels of ``convention``."""
+        return image_centre(self.width_px, self.height_px, convention)
+
+    def principal_point(self, convention: str = "opencv") -> tuple[float, float]:
+        """The principal point as the target writes cx, cy: absolute pixels for ``"opencv"``
+        and ``"colmap"``; for ``"metashape"`` the offset from the image centre in pixels (x
+        right, y down)."""
+        px, py = self.pixel_size_mm
+        dx, dy = self.principal_point_offset_mm
+        if convention == "metashape":
+            return dx / px, -dy / py
+        cu, cv = self.centre(convention)
+        return cu + dx / px, cv - dy / py
+
+    def mm_to_pixels(self, xy_mm: np.ndarray, convention: str = "opencv") -> np.ndarray:
+        """Photogrammetric image coordinates (mm, x right, y up, origin at the sensor centre)
+        → absolute pixels of ``convention`` (…, 2)."""
+        cv_px = photo_mm_to_opencv_pixels(xy_mm, self.width_px, self.height_px, self.pixel_size_mm)
+        return from_opencv_pixels(cv_px, convention) if pixel_centre_offset(convention) else cv_px
+
+    def pixels_to_mm(self, uv: np.ndarray, convention: str = "opencv") -> np.ndarray:
+        """Absolute pixels of ``convention`` → photogrammetric mm (inverse of
+        :meth:`mm_to_pixels`)."""
+        return opencv_pixels_to_photo_mm(
+            to_opencv_pixels(uv, convention), self.width_px, self.height_px, self.pixel_size_mm
+        )
+
+    def __repr__(self) -> str:
+        px, py = self.pixel_pitch_um
+        pitch = f"{px:.4g} µm" if abs(px - py) <= 1e-12 * px else f"{px:.4g}x{py:.4g} µm"
+        dx, dy = self.principal_point_offset_mm
+        off = "" if dx == dy == 0 else f", principal point offset ({dx:g}, {dy:g}) mm"
+        return (
+            f"Sensor({self.width_mm:g}x{self.height_mm:g} mm, "
+            f"{self.width_px}x{self.height_px} px, pitch {pitch}{off})"
+        )

@@ -1,0 +1,156 @@
+"""``orthoscope fan`` and ``orthoscope spot``: transverse ray aberrations and spot diagrams."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import add_object_args, add_output_args, add_plane_args, add_wavelength_arg
+
+#: Quick runs of these commands for the per-command tests (tests/test_hardening.py).
+SAMPLES = [
+    ["fan", "cooke-triplet-f4", "--field", "10", "--n", "5"],
+    ["spot", "cooke-triplet-f4", "--fields", "0,10", "--rings", "2"],
+]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("--plot", ".png")]
+
+
+def _common(lens, args):
+    from .common import CliError, resolve_object, resolve_planes
+
+    od = resolve_object(lens, args)
+    planes = resolve_planes(lens, args)
+    if len(planes) != 1:
+        raise CliError("give one image plane")
+    return {"object_distance": od, "plane": planes[0], "wavelength": args.wavelength}
+
+
+def _field_kw(value: float, kind: str) -> dict:
+    return {"field_deg": value} if kind == "angle" else {"object_height_mm": value}
+
+
+def _check_plot(args, lens) -> None:
+    from .distortion import check_plot_path
+
+    args._inputs = [lens.path] if lens.path else []
+    check_plot_path(args.plot, "--plot", args)
+
+
+def _save(fig, args) -> None:
+    from ..plots.save import save_figure
+
+    save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
+
+
+def cmd_fan(args) -> int:
+    from raytrace.trace import ray_fan
+
+    from ..report.rays import fan_to_dict, fans_csv, format_fans
+    from .common import MAX_SAMPLES, check_size, load, number, print_json
+
+    lens = load(args.lens)
+    _check_plot(args, lens)
+    kind = args.field_kind or lens.field.kind
+    field = number(args.field, "--field")
+    axes = ["y", "x"] if args.axis == "both" else [args.axis]
+    n = check_size(args.n, MAX_SAMPLES, "--n", args)
+    fans = [
+        ray_fan(lens, **_field_kw(field, kind), n=n, axis=a, **_common(lens, args)) for a in axes
+    ]
+    if args.json:
+        print_json({"lens": lens.name, "fans": [fan_to_dict(f) for f in fans]})
+    elif args.csv:
+        print(fans_csv(fans))
+    else:
+        print(format_fans(fans))
+    if args.plot:
+        from ..plots.common import offscreen_figures
+        from ..plots.rays import plot_ray_fan
+
+        with offscreen_figures():
+            _save(plot_ray_fan(fans, title=f"{lens.name}: ray fans"), args)
+    return 0
+
+
+def cmd_spot(args) -> int:
+    from raytrace.trace import spot_diagram
+
+    from ..report.rays import format_spots, spot_to_dict, spots_csv
+    from .common import check_size, load, print_json, resolve_fields
+
+    lens = load(args.lens)
+    _check_plot(args, lens)
+    fields, kind = resolve_fields(lens, args)
+    check_size(args.rings, 1000, "--rings", args, per_item_bytes=6 * 200 * args.rings)
+    spots = [
+        spot_diagram(
+            lens, **_field_kw(float(f), kind), pattern=args.pattern, n=args.rings,
+            **_common(lens, args),
+        )
+        for f in fields
+    ]  # fmt: skip
+    if args.json:
+        print_json({"lens": lens.name, "spots": [spot_to_dict(s) for s in spots]})
+    elif args.csv:
+        print(spots_csv(spots))
+    else:
+        print(format_spots(spots))
+    if args.plot:
+        from ..plots.common import offscreen_figures
+        from ..plots.rays import plot_spot
+
+        with offscreen_figures():
+            _save(plot_spot(spots, title=f"{lens.name}: spot diagrams"), args)
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from .common import add_field_args
+    from .distortion import add_force_arg
+
+    q = sub.add_parser(
+        "fan",
+        help="Ray fan: transverse ray aberrations of one field across the pupil.",
+        description="Trace a fan of real rays across the paraxial entrance pupil, centred on the "
+        "real chief ray of one field, and report the transverse ray aberration (intercept "
+        "minus the chief ray's, mm) in the image plane: tangential (eps_y against py) and/or "
+        "sagittal (eps_x against px).",
+        epilog="Example: orthoscope fan cooke-triplet-f4 --field 14 --axis both --plot fan.png",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    q.add_argument("--field", default="0", metavar="F", help="Field: degrees or object mm.")
+    q.add_argument("--field-kind", choices=["angle", "height"], help="What --field is.")
+    q.add_argument("--axis", choices=["y", "x", "both"], default="y", help="Fan direction.")
+    q.add_argument("--n", type=int, default=21, help="Rays across the pupil.")
+    add_object_args(q)
+    add_plane_args(q)
+    add_wavelength_arg(q)
+    q.add_argument("--plot", metavar="FILE", help="Save the ray-fan plot (.png/.svg/.pdf).")
+    add_force_arg(q)
+    add_output_args(q)
+    q.set_defaults(func=cmd_fan)
+
+    q = sub.add_parser(
+        "spot",
+        help="Spot diagrams with RMS and geometric radius per field.",
+        description="Trace rays over the pupil (aimed about the real chief ray) for each field "
+        "and report the spot in the image plane relative to the chief ray: centroid, RMS radius "
+        "and geometric radius about the centroid (mm in JSON, µm in the table).",
+        epilog="Example: orthoscope spot cooke-triplet-f4 --fields 0,10,20 --plot spots.png",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_field_args(q)
+    q.add_argument(
+        "--pattern", choices=["hexapolar", "rings", "square"], default="hexapolar",
+        help="Pupil sampling.",
+    )  # fmt: skip
+    q.add_argument("--rings", type=int, default=8, help="Rings (or points across) of the pattern.")
+    add_object_args(q)
+    add_plane_args(q)
+    add_wavelength_arg(q)
+    q.add_argument("--plot", metavar="FILE", help="Save the spot diagrams (.png/.svg/.pdf).")
+    add_force_arg(q)
+    add_output_args(q)
+    q.set_defaults(func=cmd_spot)

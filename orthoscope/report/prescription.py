@@ -1,0 +1,52 @@
+"""JSON of a lens prescription (``orthoscope prescription --json``); the text table is
+:func:`raytrace.listing.format_prescription` (also ``str(lens)``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict
+
+from raytrace.lens import Lens
+
+
+def material_dict(m) -> dict:
+    d = {"kind": m.kind, "description": m.describe()}
+    if m.kind in ("index", "model", "catalog"):
+        d.update(nd=m.nd, vd=m.vd if m.kind != "index" else None)
+    if m.kind == "model":
+        d["model"] = m.model
+    if m.kind == "catalog":
+        d.update(name=m.name, catalog=m.catalog, formula=m.formula)
+    return d
+
+
+def prescription_to_dict(lens: Lens) -> dict:
+    """The lens as JSON-ready data: every surface with units in the keys."""
+    surfaces = []
+    for i, s in enumerate(lens.surfaces, start=1):
+        surfaces.append(
+            {
+                "surface": i,
+                "radius_mm": s.radius,
+                "curvature_per_mm": s.curvature,
+                "thickness_mm": s.thickness,
+                "medium_after": material_dict(s.material),
+                "semi_diameter_mm": s.semi_diameter if math.isfinite(s.semi_diameter) else None,
+                "conic": s.conic,
+                "aspheric": list(s.aspheric),
+                "stop": s.stop,
+                "label": s.label,
+            }
+        )
+    return {
+        "name": lens.name,
+        "source": lens.source,
+        "units": "mm",
+        "wavelength_nm": lens.wavelength,
+        "object_distance_mm": lens.object_distance,
+        "object_medium": material_dict(lens.object_material),
+        "aperture": asdict(lens.aperture),
+        "field": asdict(lens.field),
+        "image_solve": lens.image_solve,
+        "surfaces": surfaces,
+    }

@@ -1,0 +1,114 @@
+"""The prescription of a lens as a table (text and HTML): what ``str(lens)``, the notebook view
+``lens._repr_html_()`` and ``orthoscope prescription LENS`` show.
+
+One row per surface: number, radius (mm, ``inf`` for a plane), thickness to the next vertex (mm),
+the medium after the surface, semi-diameter (mm, ``-`` when not limited), conic, aspheric terms,
+stop mark and label; then the first-order summary (EFL, BFL, EPD, f-number, pupils, m_e) at the
+lens's wavelength. Plain floats, units in the headers.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+from .lens import Lens
+
+COLUMNS = ("#", "radius (mm)", "thickness (mm)", "medium after", "semi-diam (mm)", "conic", "asph")
+
+
+def _g(v: float, digits: int = 6) -> str:
+    if math.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return f"{v:.{digits}g}"
+
+
+def surface_rows(lens: Lens) -> list[list[str]]:
+    """The surface table as strings (see :data:`COLUMNS`); the stop row is marked ``STO``."""
+    rows = []
+    for i, s in enumerate(lens.surfaces, start=1):
+        tag = "STO" if s.stop else str(i)
+        thick = _g(s.thickness, 8)
+        if i == lens.n_surfaces and lens.image_solve == "gaussian":
+            thick += " (Gaussian)"
+        asph = ", ".join(f"{a:.4g}" for a in s.aspheric) if any(s.aspheric) else ""
+        rows.append(
+            [
+                tag,
+                _g(s.radius, 8),
+                thick,
+                s.material.describe(),
+                "-" if math.isinf(s.semi_diameter) else _g(s.semi_diameter),
+                _g(s.conic) if s.conic else "",
+                asph,
+            ]
+            + ([s.label] if s.label else [])
+        )
+    return rows
+
+
+def summary_lines(lens: Lens) -> list[str]:
+    """The first-order summary under the table (or why it is undefined)."""
+    from .errors import LensError
+    from .paraxial.firstorder import paraxial
+
+    obj = (
+        "object at infinity"
+        if math.isinf(lens.object_distance)
+        else f"object {lens.object_distance:g} mm before the first vertex"
+    )
+    head = f"{obj}; {lens.wavelength:g} nm"
+    try:
+        p = paraxial(lens)
+    except LensError as e:
+        return [head, f"first-order data undefined: {e}"]
+    fno = abs(p.efl) / p.epd if p.epd else math.inf
+    return [
+        head,
+        f"EFL {p.efl:.6f} mm   BFL {p.bfl:.6f} mm   EPD {p.epd:.6g} mm   f/{fno:.4g}   "
+        f"m_e {p.m_e:.6f}",
+        f"entrance pupil z {p.z_E0:.6g} mm, exit pupil z {p.z_E0p:.6g} mm (from the first vertex); "
+        f"HE0 {p.HE0:.6g} mm, H'E0' {p.HpE0p:.6g} mm",
+    ]
+
+
+def format_prescription(lens: Lens, *, summary: bool = True) -> str:
+    """The lens as a text table with its first-order summary."""
+    rows = surface_rows(lens)
+    ncol = len(COLUMNS)
+    widths = [
+        max(len(COLUMNS[j]), *(len(r[j]) for r in rows)) if rows else len(COLUMNS[j])
+        for j in range(ncol)
+    ]
+    ap = {"fnumber": "f/{:g}", "epd": "EPD {:g} mm", "na": "NA {:g}"}[lens.aperture.kind]
+    fld = "{:g} deg" if lens.field.kind == "angle" else "{:g} mm"
+    out = [
+        f"{lens.name}",
+        f"aperture {ap.format(lens.aperture.value)}; field {fld.format(lens.field.value)}",
+        "  ".join(c.rjust(w) for c, w in zip(COLUMNS, widths, strict=True))
+        + ("  label" if any(len(r) > ncol for r in rows) else ""),
+        "  ".join("-" * w for w in widths),
+    ]
+    for r in rows:
+        line = "  ".join(c.rjust(w) for c, w in zip(r[:ncol], widths, strict=True))
+        out.append((line + (f"  {r[ncol]}" if len(r) > ncol else "")).rstrip())
+    if summary:
+        out += summary_lines(lens)
+    return "\n".join(out)
+
+
+def html_prescription(lens: Lens) -> str:
+    """The same table as HTML (Jupyter's rich display)."""
+    esc = html.escape
+    head = "".join(f"<th>{esc(c)}</th>" for c in COLUMNS) + "<th>label</th>"
+    body = "".join(
+        "<tr>"
+        + "".join(f"<td>{esc(c)}</td>" for c in r[: len(COLUMNS)])
+        + f"<td>{esc(r[len(COLUMNS)] if len(r) > len(COLUMNS) else '')}</td></tr>"
+        for r in surface_rows(lens)
+    )
+    summ = "<br>".join(esc(s) for s in summary_lines(lens))
+    return (
+        f"<div><b>{esc(lens.name)}</b><table><thead><tr>{head}</tr></thead>"
+        f"<tbody>{body}</tbody></table><p>{summ}</p></div>"
+    )

@@ -1,0 +1,626 @@
+"""Global search: many starts and basin hopping around damped least squares, with glass
+substitution over the shipped catalogs (in the manner of OpticStudio's Hammer / global search
+and CODE V's global synthesis).
+
+One *start* (start 0 is the spec's start lens as given; start k > 0 perturbs its continuous
+variables and draws a random real glass for every glass variable):
+
+1. glass fitting (when the spec has glass variables and ``model_phase``): each glass becomes a
+   continuous nd / vd model glass inside its pool's window, damped least squares runs over all
+   variables, then each glass snaps to the nearest real glass and, variable by variable, takes
+   the best of its ``neighbours`` nearest real glasses, each judged after a local run;
+2. a local damped-least-squares run (:func:`raytrace.optimize.optimize`);
+3. ``hops`` basin hops: perturb the start's best design, substitute one glass by one of its
+   ``neighbours`` nearest on the glass map, run damped least squares, keep the trial when its
+   merit is lower.
+
+The starts run in worker processes (``concurrent.futures.ProcessPoolExecutor``, spawn start
+method) or, with one worker, in this process. A worker receives the spec, the start lens and the
+start's number, nothing else. Start k draws its random numbers from
+``numpy.random.SeedSequence(seed).spawn(starts)[k]`` only, and every local run is deterministic,
+so the same seed gives the same result — bit for bit — whatever the number of workers, as long as
+no time budget or interruption cuts the search short. The best start (lowest merit, then lowest
+number) is polished with the spec's ``max_evaluations``.
+
+Stopping: a time budget (``time_budget_s``) or Ctrl-C (KeyboardInterrupt in the calling process)
+stops every start at its next merit evaluation; the result is the best design found so far, with
+``stopped`` saying why. Workers ignore SIGINT themselves; the caller's process tells them.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing as mp
+import queue as queue_mod
+import signal
+import time
+from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import OrthoscopeError
+from ..lens import Lens
+from ..materials import model_glass
+from ..paraxial import paraxial
+from .glasses import GlassPool, availability, glass_pool
+from .operands import OperandValue, evaluate, merit
+from .solver import (
+    ASPHERIC_KINDS,
+    apply,
+    bounds,
+    check_spec,
+    continuous,
+    optimize,
+    set_materials,
+    set_values,
+    start_values,
+)
+from .spec import DesignSpec, SearchSettings, SpecError, Variable
+
+
+@dataclass(frozen=True)
+class GlassChoice:
+    """The glass a glass variable took: the medium after ``surface`` (1-based)."""
+
+    surface: int
+    name: str
+    catalog: str
+    nd: float
+    vd: float
+    availability: str
+
+
+@dataclass(frozen=True)
+class SearchProgress:
+    """A progress report of the global search.
+
+    event: ``"local"`` (a local run of a start ended), ``"start"`` (a start ended) or
+    ``"polish"`` (the final polish ended); start: the start's number; hop: the basin hop (-1 for
+    the start's first local runs); merit: that start's best merit so far; best: the best merit
+    reported so far in the whole search; starts_done / starts: finished / requested starts;
+    elapsed_s: seconds since the search began.
+    """
+
+    event: str
+    start: int
+    hop: int
+    merit: float
+    best: float
+    starts_done: int
+    starts: int
+    elapsed_s: float
+
+
+@dataclass(frozen=True, eq=False)
+class StartOutcome:
+    """What one start found (picklable; the parent rebuilds the lens from it).
+
+    x: the continuous variables (spec order, :func:`~raytrace.optimize.solver.continuous`);
+    glasses: pool indices per glass variable; merit: its best merit (``nan`` when the start did
+    not run); evaluations / local_runs / hops: work done; stopped: ``""``, ``"time"`` or
+    ``"interrupted"``.
+    """
+
+    index: int
+    merit: float
+    x: np.ndarray
+    glasses: tuple[int, ...]
+    evaluations: int
+    local_runs: int
+    hops: int
+    stopped: str
+    seconds: float
+
+
+@dataclass(frozen=True, eq=False)
+class GlobalResult:
+    """The result of :func:`global_optimize`.
+
+    lens: the best design; merit: its merit (sum of squared weighted residuals); merit_start:
+    the start lens's merit; start_merits: the best merit of each start (``nan`` for a start that
+    did not run); best_start: the start the design came from; seed: the root seed; glasses: the
+    glass of each glass variable; operands: every operand on the best design; evaluations: merit
+    evaluations in all starts and the polish; seconds: wall time; workers: processes used;
+    stopped: ``""``, ``"time"`` (budget spent) or ``"interrupted"``; converged: the spec's merit
+    goal is met (always true without a goal); message: a one-line summary.
+    """
+
+    lens: Lens
+    merit: float
+    merit_start: float
+    start_merits: np.ndarray
+    best_start: int
+    seed: int
+    glasses: tuple[GlassChoice, ...]
+    operands: tuple[OperandValue, ...]
+    evaluations: int
+    seconds: float
+    workers: int
+    stopped: str
+    converged: bool
+    message: str
+
+    @property
+    def starts(self) -> int:
+        return int(self.start_merits.size)
+
+    @property
+    def starts_done(self) -> int:
+        return int(np.count_nonzero(np.isfinite(self.start_merits)))
+
+    def __repr__(self) -> str:
+        return (
+            f"GlobalResult(merit {self.merit:.6g} from start {self.best_start}, "
+            f"{self.starts_done}/{self.starts} starts, seed {self.seed}, "
+            f"{self.seconds:.1f} s{', stopped: ' + self.stopped if self.stopped else ''})"
+        )
+
+
+# ----------------------------------------------------------------------------- the design
+def _glass_vars(spec: DesignSpec) -> tuple[Variable, ...]:
+    return tuple(v for v in spec.variables if v.kind == "glass")
+
+
+def _pools(spec: DesignSpec) -> tuple[GlassPool, ...]:
+    return tuple(glass_pool(spec.glass_settings(v)) for v in _glass_vars(spec))
+
+
+def _base(lens: Lens, spec: DesignSpec, x: np.ndarray, g, pools) -> Lens:
+    """The start lens with glasses ``g`` (pool indices) and continuous values ``x`` set in it
+    (pick-ups not yet applied; ``image_solve`` kept), the lens damped least squares starts from."""
+    mats = {v.surface: pools[j].material(g[j]) for j, v in enumerate(_glass_vars(spec))}
+    out = set_materials(lens, mats)
+    ks = [(v.kind, v.surface) for v in continuous(spec)]
+    if ks:
+        out = replace(set_values(out, ks, x), image_solve=lens.image_solve)
+    return out
+
+
+def design(lens: Lens, spec: DesignSpec, x: np.ndarray, g, pools=None) -> Lens:
+    """The full design of a state: glasses ``g`` (pool indices), continuous values ``x``,
+    pick-ups applied."""
+    pools = _pools(spec) if pools is None else pools
+    return apply(_base(lens, spec, x, g, pools), spec, x)
+
+
+def _merit_of(lens: Lens, spec: DesignSpec) -> float:
+    try:
+        return merit(evaluate(lens, spec.operands))
+    except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
+        return math.inf
+
+
+def perturb(
+    x: np.ndarray, variables: tuple[Variable, ...], efl: float, rng, sigma: float, lo, hi
+) -> np.ndarray:
+    """A random perturbation of the continuous variables ``x`` of relative size ``sigma``
+    (one standard normal draw per variable, always, so the random stream does not depend on
+    the values): curvature c + σ z (|c| + 0.1/|EFL|); thickness t·exp(σ z) (t + σ z for
+    t ≤ 0); index n + 0.1 σ z; Abbe number ν·exp(σ z); conic k + σ z; aspheric A_k + σ z ×
+    0.01 (0.1 EFL)^(1−k). Clipped into the bounds."""
+    z = rng.standard_normal(len(x))
+    out = np.array(x, dtype=float)
+    r = 0.1 * abs(efl)
+    for i, v in enumerate(variables):
+        s = sigma * z[i]
+        if v.kind == "curvature":
+            out[i] = x[i] + s * (abs(x[i]) + 0.1 / abs(efl))
+        elif v.kind == "thickness":
+            out[i] = x[i] * math.exp(s) if x[i] > 0 else x[i] + s
+        elif v.kind == "index":
+            out[i] = x[i] + 0.1 * s
+        elif v.kind == "abbe":
+            out[i] = x[i] * math.exp(s)
+        elif v.kind == "conic":
+            out[i] = x[i] + s
+        elif v.kind in ASPHERIC_KINDS:
+            out[i] = x[i] + 0.01 * s * r ** (1 - (4 + 2 * ASPHERIC_KINDS.index(v.kind)))
+    return np.clip(out, lo, hi)
+
+
+class _Start:
+    """The state of one start while it runs."""
+
+    def __init__(self, lens, spec, k, seed, should_stop, report) -> None:
+        self.lens, self.spec, self.k = lens, spec, k
+        self.rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(k,)))
+        self.should_stop, self.report = should_stop, report
+        self.pools = _pools(spec)
+        self.gvars = _glass_vars(spec)
+        self.cont = continuous(spec)
+        self.lo, self.hi = bounds(spec)
+        s = spec.search
+        self.local_n = s.local_evaluations or spec.max_evaluations
+        self.evaluations = 0
+        self.local_runs = 0
+        self.hops = 0
+        self.stopped = ""
+        self.best_m = math.inf
+        self.best_x = np.zeros(len(self.cont))
+        self.best_g: tuple[int, ...] = ()
+
+    # one local run from (x, g): returns (merit, x)
+    def local(self, x: np.ndarray, g, spec: DesignSpec | None = None, lens: Lens | None = None):
+        spec = self.spec if spec is None else spec
+        lens = self.lens if lens is None else lens
+        self.local_runs += 1
+        if not continuous(spec):
+            m = _merit_of(design(lens, spec, x, g, self.pools), spec)
+            self.evaluations += 1
+            return m, x
+        base = _base(lens, spec, x, g, self.pools) if spec is self.spec else lens
+        try:
+            res = optimize(base, spec, stop=self.should_stop, max_evaluations=self.local_n)
+        except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
+            return math.inf, x  # the start design itself cannot be evaluated
+        self.evaluations += res.evaluations + 2
+        if res.stopped:
+            self.stopped = res.stopped
+        return res.merit, res.x
+
+    def offer(self, m: float, x, g, hop: int) -> None:
+        if m < self.best_m:
+            self.best_m, self.best_x, self.best_g = m, np.array(x, dtype=float), tuple(g)
+        self.report("local", self.k, hop, self.best_m)
+
+    def initial(self) -> tuple[np.ndarray, list[int]]:
+        """Start values: the lens's own for start 0; perturbed, with random glasses, else."""
+        x0 = start_values(self.lens, self.spec)
+        g0 = []
+        for v, pool in zip(self.gvars, self.pools, strict=True):
+            m = self.lens.surfaces[v.surface - 1].material
+            i = pool.index_of(m)
+            g0.append(int(pool.nearest(m.nd, m.vd, 1)[0]) if i is None else i)
+        if self.k == 0:
+            return x0, g0
+        efl = paraxial(self.lens).efl
+        sigma = self.spec.search.perturbation
+        x = perturb(x0, self.cont, efl, self.rng, sigma, self.lo, self.hi)
+        g = [int(self.rng.integers(len(pool))) for pool in self.pools]
+        return x, g
+
+    def fit_glasses(self, x: np.ndarray, g: list[int]) -> tuple[np.ndarray, list[int]]:
+        """Glass fitting: nd / vd model glasses optimized, then snapped to real glasses."""
+        spec, gv = self.spec, self.gvars
+        extra = []
+        mats = {}
+        for v, pool, gi in zip(gv, self.pools, g, strict=True):
+            (n0, n1), (v0, v1) = pool.window()
+            extra += [Variable("index", v.surface, n0, n1), Variable("abbe", v.surface, v0, v1)]
+            if self.k == 0:
+                m = self.lens.surfaces[v.surface - 1].material
+                nd, vd = (m.nd, m.vd) if math.isfinite(m.vd) else (pool.nd[gi], pool.vd[gi])
+            else:
+                nd, vd = pool.nd[gi], pool.vd[gi]
+            mats[v.surface] = model_glass(float(np.clip(nd, n0, n1)), float(np.clip(vd, v0, v1)))
+        mspec = replace(spec, variables=self.cont + tuple(extra))
+        mlens = set_materials(_base(self.lens, spec, x, g, self.pools), mats)
+        m, xm = self.local(start_values(mlens, mspec), g, mspec, mlens)
+        nc = len(self.cont)
+        x = np.array(xm[:nc])
+        if self.stopped:
+            return x, g
+        # snap: nearest real glass to each fitted nd / vd
+        fitted = np.asarray(xm[nc:]).reshape(-1, 2)
+        g = [int(p.nearest(nd, vd, 1)[0]) for p, (nd, vd) in zip(self.pools, fitted, strict=True)]
+        best_m, best_x = self.local(x, g)
+        self.offer(best_m, best_x, g, -1)
+        # each glass in turn: the best of its nearest real glasses, the others held
+        for j, (pool, (nd, vd)) in enumerate(zip(self.pools, fitted, strict=True)):
+            n = pool.settings.neighbours
+            for c in pool.nearest(nd, vd, n)[1:]:
+                if self.stopped or self.should_stop():
+                    return best_x, g
+                trial = list(g)
+                trial[j] = int(c)
+                mt, xt = self.local(x, trial)
+                self.offer(mt, xt, trial, -1)
+                if mt < best_m:
+                    best_m, best_x, g = mt, xt, trial
+        return best_x, g
+
+    def run(self) -> None:
+        if self.should_stop():
+            self.stopped = self.should_stop() or ""
+            return
+        x, g = self.initial()
+        if (
+            self.gvars
+            and self.spec.glass.model_phase
+            and all(p.settings.model_phase for p in self.pools)
+        ):
+            x, g = self.fit_glasses(x, g)
+        if not self.stopped:
+            m, x = self.local(x, g)
+            self.offer(m, x, g, -1)
+        efl = paraxial(self.lens).efl
+        s = self.spec.search
+        for h in range(s.hops):
+            if self.stopped or self.should_stop():
+                self.stopped = self.stopped or self.should_stop() or ""
+                break
+            if not math.isfinite(self.best_m):
+                break
+            xt = perturb(
+                self.best_x, self.cont, efl, self.rng, s.hop_perturbation, self.lo, self.hi
+            )
+            gt = list(self.best_g)
+            if self.gvars:
+                j = int(self.rng.integers(len(self.gvars)))
+                nb = self.pools[j].neighbours(gt[j], self.pools[j].settings.neighbours)
+                gt[j] = int(nb[int(self.rng.integers(len(nb)))]) if len(nb) else gt[j]
+            mt, xt = self.local(xt, gt)
+            self.hops += 1
+            self.offer(mt, xt, gt, h)
+
+    def outcome(self, seconds: float) -> StartOutcome:
+        return StartOutcome(
+            self.k,
+            self.best_m if math.isfinite(self.best_m) else math.nan,
+            self.best_x,
+            self.best_g,
+            self.evaluations,
+            self.local_runs,
+            self.hops,
+            self.stopped,
+            seconds,
+        )
+
+
+def run_start(
+    lens: Lens,
+    spec: DesignSpec,
+    k: int,
+    seed: int,
+    should_stop: Callable[[], str | None],
+    report: Callable[[str, int, int, float], None],
+) -> StartOutcome:
+    """Run start ``k`` of the search (see the module docstring); a KeyboardInterrupt ends it
+    with its best design so far."""
+    t0 = time.perf_counter()
+    st = _Start(lens, spec, k, seed, should_stop, report)
+    try:
+        st.run()
+    except KeyboardInterrupt:
+        st.stopped = "interrupted"
+    return st.outcome(time.perf_counter() - t0)
+
+
+# ----------------------------------------------------------------------------- workers
+_WORKER: dict = {}
+
+
+def _init_worker(event, q) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides when to stop
+    _WORKER["event"], _WORKER["queue"] = event, q
+
+
+def _worker_start(lens: Lens, spec: DesignSpec, k: int, seed: int, deadline: float):
+    event, q = _WORKER["event"], _WORKER["queue"]
+
+    def should_stop() -> str | None:
+        if event.is_set():
+            return "interrupted"
+        return "time" if time.time() > deadline else None
+
+    def report(kind, start, hop, m) -> None:
+        q.put((kind, start, hop, m))
+
+    return run_start(lens, spec, k, seed, should_stop, report)
+
+
+# ----------------------------------------------------------------------------- the search
+def _settings(spec: DesignSpec, **over) -> SearchSettings:
+    s = spec.search
+    kw = {k: v for k, v in over.items() if v is not None}
+    out = replace(s, **kw)
+    if out.starts < 1 or out.workers < 1 or out.hops < 0 or out.seed < 0:
+        raise SpecError(
+            "global search: starts and workers must be >= 1, hops and seed >= 0 "
+            f"(got starts={out.starts}, workers={out.workers}, hops={out.hops}, seed={out.seed})"
+        )
+    if out.time_budget_s is not None and not out.time_budget_s > 0:
+        raise SpecError(f"global search: time budget must be positive, got {out.time_budget_s}")
+    return out
+
+
+def global_optimize(
+    lens: Lens,
+    spec: DesignSpec,
+    *,
+    seed: int | None = None,
+    starts: int | None = None,
+    time_budget_s: float | None = None,
+    workers: int | None = None,
+    progress: Callable[[SearchProgress], None] | None = None,
+    hops: int | None = None,
+) -> GlobalResult:
+    """Global search for the spec's best design (module docstring).
+
+    Parameters
+    ----------
+    lens : Lens
+        The start lens (usually :func:`~raytrace.optimize.start_lens` of the spec).
+    spec : DesignSpec
+        Variables (continuous and ``glass``), pick-ups, operands; ``spec.search`` gives the
+        defaults of the keywords below and ``spec.glass`` the glass pool.
+    seed, starts, time_budget_s, workers, hops
+        Override ``spec.search``: root seed (int >= 0), number of starts, wall-clock budget in
+        seconds (None: none), worker processes (1: this process), basin hops per start.
+    progress : callable, optional
+        Called with a :class:`SearchProgress` after every local run and start (in this
+        process); raising KeyboardInterrupt from it stops the search like Ctrl-C.
+
+    Returns
+    -------
+    GlobalResult
+        The best design found, per-start merits, the seed; ``stopped`` tells whether a time
+        budget or an interruption cut the search short (the result is then the best so far and
+        depends on timing).
+    """
+    s = _settings(
+        spec, seed=seed, starts=starts, time_budget_s=time_budget_s, workers=workers, hops=hops
+    )
+    spec = replace(spec, search=s)
+    check_spec(lens, spec, need_continuous=False)
+    pools = _pools(spec)  # raises SpecError for an unknown glass / empty pool, before any work
+    t0 = time.perf_counter()
+    deadline = time.time() + s.time_budget_s if s.time_budget_s is not None else math.inf
+    merit_start = _merit_of(apply(lens, spec, start_values(lens, spec)), spec)
+    outcomes: dict[int, StartOutcome] = {}
+    best = [math.inf]
+    stopped = ""
+
+    def emit(kind: str, k: int, hop: int, m: float) -> None:
+        if m < best[0]:
+            best[0] = m
+        if progress is not None:
+            progress(
+                SearchProgress(
+                    kind, k, hop, m, best[0], len(outcomes), s.starts, time.perf_counter() - t0
+                )
+            )
+
+    def finished(o: StartOutcome) -> None:
+        outcomes[o.index] = o
+        emit("start", o.index, o.hops - 1, o.merit)
+
+    try:
+        if s.workers == 1:
+            for k in range(s.starts):
+                if time.time() > deadline:
+                    stopped = "time"
+                    break
+
+                def should_stop() -> str | None:
+                    return "time" if time.time() > deadline else None
+
+                o = run_start(lens, spec, k, s.seed, should_stop, emit)
+                finished(o)
+                if o.stopped:
+                    stopped = o.stopped
+                    break
+        else:
+            stopped = _run_pool(lens, spec, s, deadline, emit, finished)
+    except KeyboardInterrupt:
+        stopped = "interrupted"
+
+    done = [o for o in outcomes.values() if math.isfinite(o.merit)]
+    start_merits = np.full(s.starts, math.nan)
+    for o in done:
+        start_merits[o.index] = o.merit
+    evaluations = sum(o.evaluations for o in outcomes.values())
+    if not done:  # nothing finished: the start lens is the best design known
+        final = apply(lens, spec, start_values(lens, spec))
+        g = ()
+        best_k = -1
+    else:
+        bo = min(done, key=lambda o: (o.merit, o.index))
+        best_k, g = bo.index, bo.glasses
+        final = design(lens, spec, bo.x, g, pools)
+        if not stopped and continuous(spec):
+            try:
+                pol = optimize(_base(lens, spec, bo.x, g, pools), spec)
+                evaluations += pol.evaluations
+                if pol.merit < _merit_of(final, spec):
+                    final = pol.lens
+            except KeyboardInterrupt:
+                stopped = "interrupted"
+            except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
+                pass
+    vals = evaluate(final, spec.operands)
+    m = merit(vals)
+    emit("polish", best_k, -1, m)
+    choices = tuple(
+        GlassChoice(
+            v.surface,
+            pools[j].glasses[g[j]].name,
+            pools[j].glasses[g[j]].catalog,
+            pools[j].glasses[g[j]].nd,
+            pools[j].glasses[g[j]].vd,
+            availability(pools[j].glasses[g[j]]),
+        )
+        for j, v in enumerate(_glass_vars(spec))
+        if g
+    )
+    converged = spec.merit_goal is None or m <= spec.merit_goal
+    n_done = len(done)
+    msg = f"best merit {m:.6g} from start {best_k} of {n_done}/{s.starts} starts (seed {s.seed})"
+    if stopped:
+        msg += f"; stopped: {'time budget spent' if stopped == 'time' else 'interrupted'}"
+    if not converged:
+        msg += f"; above the merit goal {spec.merit_goal:.6g}"
+    return GlobalResult(
+        lens=final,
+        merit=m,
+        merit_start=merit_start,
+        start_merits=start_merits,
+        best_start=best_k,
+        seed=s.seed,
+        glasses=choices,
+        operands=vals,
+        evaluations=evaluations,
+        seconds=time.perf_counter() - t0,
+        workers=s.workers,
+        stopped=stopped,
+        converged=converged,
+        message=msg,
+    )
+
+
+def _run_pool(lens, spec, s: SearchSettings, deadline: float, emit, finished) -> str:
+    """Run the starts in ``s.workers`` spawned processes; returns why it stopped early."""
+    ctx = mp.get_context("spawn")
+    event = ctx.Event()
+    q = ctx.Queue()
+    stopped = ""
+
+    def drain() -> None:
+        while True:
+            try:
+                item = q.get_nowait()
+            except queue_mod.Empty:
+                return
+            emit(*item)
+
+    ex = ProcessPoolExecutor(
+        max_workers=s.workers, mp_context=ctx, initializer=_init_worker, initargs=(event, q)
+    )
+    try:
+        futures = {
+            ex.submit(_worker_start, lens, spec, k, s.seed, deadline): k for k in range(s.starts)
+        }
+        pending = set(futures)
+        try:
+            while pending:
+                done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+                drain()
+                for f in sorted(done, key=lambda f: futures[f]):
+                    if f.cancelled():
+                        continue
+                    o = f.result()
+                    finished(o)
+                    if o.stopped and not stopped:
+                        stopped = o.stopped
+                if time.time() > deadline and not stopped:
+                    stopped = "time"
+                if stopped:
+                    event.set()
+                    for f in pending:
+                        f.cancel()
+        except KeyboardInterrupt:
+            stopped = "interrupted"
+            event.set()
+            for f in pending:
+                f.cancel()
+            # the running starts end at their next merit evaluation with their best so far
+            for f in sorted(pending, key=lambda f: futures[f]):
+                if not f.cancelled():
+                    o = f.result()
+                    finished(o)
+        drain()
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+    return stopped

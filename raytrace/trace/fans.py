@@ -1,0 +1,292 @@
+"""Ray fans (transverse ray aberrations) and spot diagrams of one field in one image plane.
+
+Rays fill the paraxial entrance pupil centred on the real chief ray (:mod:`.pupil`). In the image
+plane every ray's intercept is taken relative to the real chief ray's: the transverse ray
+aberration ``ε = (x, y)_ray − (x, y)_chief`` (mm). A tangential fan varies py (the meridional
+y direction) and plots ε_y; a sagittal fan varies px and plots ε_x. A spot diagram's RMS radius
+is taken about the spot's centroid; its geometric radius is the largest distance from the
+centroid. Units: mm, degrees, nm.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import TraceError
+from ..kernels.codes import STATUS_OK
+from ..lens import Lens
+from ..paraxial import ImagePlane, image_planes, paraxial, plane_z, resolve_object_distance
+from .chief import aim
+from .pupil import aimed_bundle, pupil_points
+from .rays import trace_rays
+
+
+def _field(lens: Lens, field_deg, object_height_mm, finite: bool) -> tuple[float, str]:
+    if field_deg is not None and object_height_mm is not None:
+        raise TraceError("give field_deg or object_height_mm, not both")
+    if object_height_mm is not None:
+        if not finite:
+            raise TraceError("object heights need a finite object distance")
+        return float(object_height_mm), "height"
+    if field_deg is None:
+        return 0.0, "angle"
+    return float(field_deg), "angle"
+
+
+def _trace_field(
+    lens,
+    field_deg,
+    object_height_mm,
+    px,
+    py,
+    *,
+    plane,
+    s_prime,
+    from_last_vertex,
+    defocus,
+    object_distance,
+    object_s,
+    object_scale,
+    wavelength,
+    clip,
+):
+    od = resolve_object_distance(
+        lens,
+        object_distance=object_distance,
+        object_s=object_s,
+        object_scale=object_scale,
+        wavelength=wavelength,
+    )
+    par = paraxial(lens, od, wavelength)
+    f, kind = _field(lens, field_deg, object_height_mm, not par.infinite)
+    planes = image_planes(plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus)
+    if len(planes) != 1:
+        raise TraceError("ray fans and spot diagrams take one image plane")
+    z = float(plane_z(par, planes)[0])
+    cr = aim(lens, np.array([f]), kind, od, wavelength, clip=False)
+    if cr.status[0] != STATUS_OK:
+        raise TraceError(
+            f"{lens.name}: the chief ray of field {f:g} {'deg' if kind == 'angle' else 'mm'} "
+            f"fails ({cr.status_names[0]}); no fan or spot about it"
+        )
+    b = aimed_bundle(lens, par, (cr.y_start[0], cr.z_start[0], cr.M_start[0], cr.N_start[0]), px, py)
+    rb = trace_rays(lens, b.origins, b.directions, wavelength=wavelength, clip=clip)
+    x, y = rb.at_plane(z)
+    yc = float(cr.heights_at(z)[0])
+    return f, kind, od, z, par, x, y - yc, rb.status, yc
+
+
+@dataclass(frozen=True, eq=False)
+class RayFan:
+    """Transverse ray aberrations of one field along one pupil axis.
+
+    pupil: normalised pupil coordinate (−1..1) along ``axis`` ("y": tangential, "x": sagittal);
+    ex, ey: ε_x and ε_y (mm) in the image plane relative to the real chief ray (NaN where a ray
+    failed); status: per ray; field, field_kind; z_plane: image plane (absolute z, mm);
+    chief_height: the real chief ray's height there (mm); wavelength (nm).
+    """
+
+    pupil: np.ndarray
+    ex: np.ndarray
+    ey: np.ndarray
+    status: np.ndarray
+    axis: str
+    field: float
+    field_kind: str
+    object_distance: float
+    z_plane: float
+    chief_height: float
+    wavelength: float
+
+    @property
+    def aberration(self) -> np.ndarray:
+        """ε along the fan's own axis: ε_y for a tangential fan, ε_x for a sagittal one (mm)."""
+        return self.ey if self.axis == "y" else self.ex
+
+    def __repr__(self) -> str:
+        unit = "deg" if self.field_kind == "angle" else "mm"
+        e = self.aberration
+        m = float(np.nanmax(np.abs(e))) if np.isfinite(e).any() else math.nan
+        return (
+            f"RayFan({'tangential' if self.axis == 'y' else 'sagittal'}, field {self.field:g} "
+            f"{unit}, {self.pupil.size} rays, max |eps| = {m:.6g} mm, {self.wavelength:g} nm)"
+        )
+
+
+def ray_fan(
+    lens: Lens,
+    field_deg: float | None = None,
+    *,
+    object_height_mm: float | None = None,
+    n: int = 21,
+    axis: str = "y",
+    plane: ImagePlane | str | None = None,
+    s_prime: float | None = None,
+    from_last_vertex: float | None = None,
+    defocus: float | None = None,
+    object_distance: float | str | None = None,
+    object_s: float | None = None,
+    object_scale: float | None = None,
+    wavelength: float | None = None,
+    clip: bool = True,
+) -> RayFan:
+    """A fan of real rays aimed about the real chief ray of one field.
+
+    Parameters
+    ----------
+    lens : Lens
+    field_deg, object_height_mm : float
+        The field: an angle in degrees (default 0) or an object height in mm (finite objects).
+    n : int
+        Rays across the pupil, from −1 to 1.
+    axis : {"y", "x"}
+        "y": tangential fan (pupil coordinate py, aberration ε_y); "x": sagittal (px, ε_x).
+    plane, s_prime, from_last_vertex, defocus
+        The image plane (docs/design.md, "Vocabulary"); default the Gaussian plane.
+    object_distance, object_s, object_scale
+        The object plane; default the lens's.
+    wavelength : float, optional
+        nm; default the lens's.
+    clip : bool
+        Apply semi-diameters (vignetted rays get a status and NaN).
+
+    Returns
+    -------
+    RayFan
+        Pupil coordinates and transverse aberrations ε (mm) relative to the real chief ray.
+    """
+    if axis not in ("x", "y"):
+        raise TraceError(f"axis must be 'y' (tangential) or 'x' (sagittal), got {axis!r}")
+    px, py = pupil_points("fan_y" if axis == "y" else "fan_x", int(n))
+    f, kind, od, z, par, x, dy, st, yc = _trace_field(
+        lens, field_deg, object_height_mm, px, py, plane=plane, s_prime=s_prime,
+        from_last_vertex=from_last_vertex, defocus=defocus, object_distance=object_distance,
+        object_s=object_s, object_scale=object_scale, wavelength=wavelength, clip=clip,
+    )  # fmt: skip
+    return RayFan(
+        pupil=py if axis == "y" else px,
+        ex=x,
+        ey=dy,
+        status=st,
+        axis=axis,
+        field=f,
+        field_kind=kind,
+        object_distance=od,
+        z_plane=z,
+        chief_height=yc,
+        wavelength=par.wavelength,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class SpotDiagram:
+    """The spot of one field: ray intercepts relative to the real chief ray (mm).
+
+    x, y: intercepts minus the chief ray's (mm; NaN where a ray failed); px, py: their pupil
+    coordinates; status: per ray; centroid_x, centroid_y (mm, relative to the chief ray);
+    rms_radius: RMS distance from the centroid (mm); geometric_radius: largest distance from the
+    centroid (mm); field, field_kind, object_distance, z_plane, chief_height, wavelength.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    px: np.ndarray
+    py: np.ndarray
+    status: np.ndarray
+    centroid_x: float
+    centroid_y: float
+    rms_radius: float
+    geometric_radius: float
+    field: float
+    field_kind: str
+    object_distance: float
+    z_plane: float
+    chief_height: float
+    wavelength: float
+
+    @property
+    def n_ok(self) -> int:
+        return int(np.count_nonzero(self.status == STATUS_OK))
+
+    def __repr__(self) -> str:
+        unit = "deg" if self.field_kind == "angle" else "mm"
+        return (
+            f"SpotDiagram(field {self.field:g} {unit}, {self.n_ok}/{self.x.size} rays, "
+            f"RMS radius {self.rms_radius * 1000:.4g} um, geometric radius "
+            f"{self.geometric_radius * 1000:.4g} um, {self.wavelength:g} nm)"
+        )
+
+
+def spot_diagram(
+    lens: Lens,
+    field_deg: float | None = None,
+    *,
+    object_height_mm: float | None = None,
+    pattern: str = "hexapolar",
+    n: int = 8,
+    plane: ImagePlane | str | None = None,
+    s_prime: float | None = None,
+    from_last_vertex: float | None = None,
+    defocus: float | None = None,
+    object_distance: float | str | None = None,
+    object_s: float | None = None,
+    object_scale: float | None = None,
+    wavelength: float | None = None,
+    clip: bool = True,
+) -> SpotDiagram:
+    """The spot diagram of one field: real rays over the pupil, aimed about the real chief ray.
+
+    Parameters
+    ----------
+    lens : Lens
+    field_deg, object_height_mm : float
+        The field: an angle in degrees (default 0) or an object height in mm (finite objects).
+    pattern : {"hexapolar", "rings", "square"}
+        Pupil sampling (:mod:`raytrace.trace.pupil`); ``n`` rings (or points across).
+    plane, s_prime, from_last_vertex, defocus
+        The image plane; default the Gaussian plane.
+    object_distance, object_s, object_scale
+        The object plane; default the lens's.
+    wavelength : float, optional
+        nm; default the lens's.
+    clip : bool
+        Apply semi-diameters.
+
+    Returns
+    -------
+    SpotDiagram
+        Intercepts relative to the chief ray (mm), centroid, RMS and geometric radius (mm).
+    """
+    if pattern not in ("hexapolar", "rings", "square"):
+        raise TraceError(f"pattern must be hexapolar, rings or square, got {pattern!r}")
+    px, py = pupil_points(pattern, int(n))
+    f, kind, od, z, par, x, dy, st, yc = _trace_field(
+        lens, field_deg, object_height_mm, px, py, plane=plane, s_prime=s_prime,
+        from_last_vertex=from_last_vertex, defocus=defocus, object_distance=object_distance,
+        object_s=object_s, object_scale=object_scale, wavelength=wavelength, clip=clip,
+    )  # fmt: skip
+    ok = st == STATUS_OK
+    if not ok.any():
+        raise TraceError(f"{lens.name}: no ray of field {f:g} reaches the image plane")
+    cx, cy = float(np.mean(x[ok])), float(np.mean(dy[ok]))
+    r2 = (x[ok] - cx) ** 2 + (dy[ok] - cy) ** 2
+    return SpotDiagram(
+        x=x,
+        y=dy,
+        px=px,
+        py=py,
+        status=st,
+        centroid_x=cx,
+        centroid_y=cy,
+        rms_radius=float(np.sqrt(np.mean(r2))),
+        geometric_radius=float(np.sqrt(np.max(r2))),
+        field=f,
+        field_kind=kind,
+        object_distance=od,
+        z_plane=z,
+        chief_height=yc,
+        wavelength=par.wavelength,
+    )

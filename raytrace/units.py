@@ -1,0 +1,129 @@
+"""Values with units, validated where they enter (CLI and API alike): lengths, wavelengths, image
+scales. One parser, one set of messages (docs/design.md, "Vocabulary" and "Errors and files").
+
+A number may carry a unit suffix wherever a unit could be doubted: ``"1.5m"``, ``"250mm"``,
+``"25cm"``, ``"2in"`` for lengths; ``"587.6nm"``, ``"0.5876um"`` (or ``µm``) for wavelengths;
+``"12x"`` for an image scale. A bare number means the documented default unit of the place it is
+given (mm for lengths, nm for wavelengths) — except where the default is ambiguous, where the
+caller asks for a suffix (``require_unit=True``) and a bare number is refused with a message that
+shows how to write it. A value that looks like the other unit (a wavelength of 0.5876 "nm") is
+refused with a message saying so.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from .errors import OrthoscopeError
+
+
+class UnitError(OrthoscopeError, ValueError):
+    """A value with a unit is malformed, out of range, or looks like the wrong unit."""
+
+
+#: mm per unit
+LENGTH_UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "um": 1e-3, "µm": 1e-3, "in": 25.4}
+#: nm per unit
+WAVELENGTH_UNITS = {"nm": 1.0, "um": 1000.0, "µm": 1000.0, "mm": 1e6}
+
+#: the range of wavelengths the project accepts (nm): deep UV to far IR
+WAVELENGTH_RANGE_NM = (100.0, 30000.0)
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_RE = re.compile(rf"^\s*({_NUM}|[-+]?inf(?:inity)?)\s*([a-zA-Zµ×]*)\s*$")
+
+
+def split_unit(text: str) -> tuple[float, str]:
+    """``"1.5m"`` → (1.5, "m"); ``"12x"`` → (12.0, "x"); ``"inf"`` → (inf, ""). UnitError when the
+    text is not a number with an optional unit word."""
+    m = _RE.match(str(text))
+    if not m:
+        raise UnitError(f"{text!r} is not a number (with an optional unit such as mm, m, nm, um)")
+    v = float(m.group(1))
+    if math.isnan(v):
+        raise UnitError(f"{text!r} is not a number")
+    unit = m.group(2).replace("×", "x").replace("X", "x")
+    return v, unit.lower() if unit not in ("µm",) else unit
+
+
+def length_mm(
+    value: float | str,
+    what: str,
+    *,
+    require_unit: bool = False,
+    allow_inf: bool = False,
+    positive: bool = False,
+) -> float:
+    """A length in mm from a number (mm) or a string with a unit suffix (mm, cm, m, um, in).
+
+    ``require_unit``: a bare number is refused (used where the default unit was once metres).
+    ``allow_inf``: ``inf`` is accepted. ``positive``: the value must be > 0.
+    """
+    if isinstance(value, str):
+        v, unit = split_unit(value)
+        if not unit:
+            if require_unit:
+                raise UnitError(
+                    f"{what}: {value!r} needs a unit — write e.g. {value}m or {value}mm "
+                    "(a bare number is ambiguous here)"
+                )
+            unit = "mm"
+        if unit not in LENGTH_UNITS:
+            raise UnitError(
+                f"{what}: unknown length unit {unit!r} in {value!r}; use mm, cm, m, um or in"
+            )
+        v *= LENGTH_UNITS[unit]
+    else:
+        v = float(value)
+    if math.isnan(v) or (math.isinf(v) and not allow_inf):
+        raise UnitError(f"{what}: expected a finite length, got {value!r}")
+    if positive and not v > 0:
+        raise UnitError(f"{what}: expected a positive length, got {value!r}")
+    return v
+
+
+def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
+    """A wavelength in nm from a number (nm) or a string with a unit (nm, um, µm).
+
+    Refuses NaN, inf, zero and negative values, and values outside
+    :data:`WAVELENGTH_RANGE_NM`; a bare number below 100 looks like µm and the message says so
+    (``0.5876`` → "write 0.5876um or 587.6nm")."""
+    unit = "nm"
+    if isinstance(value, str):
+        v, unit = split_unit(value)
+        unit = unit or "nm"
+        if unit not in WAVELENGTH_UNITS:
+            raise UnitError(f"{what}: unknown wavelength unit {unit!r} in {value!r}; use nm or um")
+        v *= WAVELENGTH_UNITS[unit]
+    else:
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise UnitError(f"{what}: expected a number of nm, got {value!r}") from None
+    if not math.isfinite(v):
+        raise UnitError(f"{what}: expected a finite wavelength in nm, got {value!r}")
+    if v <= 0:
+        raise UnitError(f"{what}: a wavelength must be positive, got {value!r}")
+    lo, hi = WAVELENGTH_RANGE_NM
+    if v < lo and unit == "nm":
+        raise UnitError(
+            f"{what} {value!r} nm looks like micrometres: write {value}um or "
+            f"{v * 1000:g}nm (wavelengths are in nm)"
+        )
+    if not lo <= v <= hi:
+        raise UnitError(f"{what}: {v:g} nm is outside {lo:g}-{hi:g} nm")
+    return v
+
+
+def image_scale(value: float | str, what: str = "image scale") -> float:
+    """An image scale N ("N×", Gaussian magnification −1/N) from ``12``, ``"12"`` or ``"12x"``."""
+    if isinstance(value, str):
+        v, unit = split_unit(value)
+        if unit not in ("", "x"):
+            raise UnitError(f"{what}: {value!r} is not an image scale such as 12x")
+    else:
+        v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise UnitError(f"{what}: N must be a positive finite number (12x: m0 = -1/12), got {value!r}")
+    return v

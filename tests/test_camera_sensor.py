@@ -1,0 +1,75 @@
+"""The sensor spec and the pixel conventions (docs/design.md, "Camera models").
+
+Sources: the conventions of each target — OpenCV pixel centres at integers (a centred cx is
+(W − 1)/2), COLMAP and Metashape at +0.5 (cx = W/2; Metashape's cx is an offset from the image
+centre: Agisoft Metashape User Manual, Appendix C), photogrammetric mm with y up — and plain
+arithmetic of a 36 × 24 mm, 6000 × 4000 px sensor (6 µm pitch).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from distortion.camera import Sensor
+from distortion.camera.conventions import image_centre, pixel_centre_offset
+from distortion.errors import DataError
+
+
+def test_from_strings_two_of_three():
+    a = Sensor.from_spec("36x24", "6000x4000")
+    b = Sensor.from_spec("36 x 24 mm", pitch_um=6)
+    c = Sensor.from_spec(pixels=(6000, 4000), pitch_um="0.006mm")
+    d = Sensor.from_spec("36x24mm", "6000x4000px", pitch_um="6x6")
+    for s in (a, b, c, d):
+        assert (s.width_px, s.height_px) == (6000, 4000)
+        assert s.width_mm == pytest.approx(36.0) and s.height_mm == pytest.approx(24.0)
+        assert s.pixel_pitch_um == pytest.approx((6.0, 6.0))
+    assert "36x24 mm" in repr(a) and "6 µm" in repr(a)
+
+
+def test_pitch_that_looks_like_mm_is_refused_with_the_fix():
+    with pytest.raises(DataError, match="looks like millimetres.*give the pitch in micrometres"):
+        Sensor.from_spec("36x24", pitch_um=0.006)
+    with pytest.raises(DataError, match="above 100 µm"):
+        Sensor.from_spec(pixels="6000x4000", pitch_um=6000)
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"size": "36x24"}, "give two of"),
+        ({"size": "36", "pixels": "6000x4000"}, "width and height"),
+        ({"size": "36x24", "pixels": "6000.5x4000"}, "whole numbers"),
+        ({"size": "36x24", "pixels": "6000x4000", "pitch_um": 5}, "disagrees"),
+        ({"size": "36000x24000", "pixels": "6000x4000"}, "outside"),
+        ({"size": "36x24furlong", "pixels": "6000x4000"}, "unknown unit"),
+    ],
+)
+def test_bad_specs_raise_clear_errors(kw, match):
+    with pytest.raises(DataError, match=match):
+        Sensor.from_spec(**kw)
+
+
+def test_principal_point_in_each_convention():
+    # odd, non-square: 3001 x 1999 px of 5 µm, principal point 0.1 mm right and 0.05 mm up
+    s = Sensor.from_spec(pixels="3001x1999", pitch_um=5, principal_point_offset_mm=(0.1, 0.05))
+    assert s.centre("opencv") == (1500.0, 999.0)  # (W-1)/2, (H-1)/2
+    assert s.centre("colmap") == (1500.5, 999.5)  # W/2, H/2
+    assert s.principal_point("opencv") == pytest.approx((1520.0, 989.0))  # y up -> v smaller
+    assert s.principal_point("colmap") == pytest.approx((1520.5, 989.5))
+    assert s.principal_point("metashape") == pytest.approx((20.0, -10.0))  # offset from centre
+    assert pixel_centre_offset("colmap") == 0.5 and pixel_centre_offset("metashape") == 0.5
+    assert image_centre(3001, 1999, "metashape") == (1500.5, 999.5)
+
+
+def test_mm_and_pixels_round_trip_with_y_up():
+    s = Sensor.from_spec("36x24", "6000x4000")
+    mm = np.array([[0.0, 0.0], [18.0, 12.0], [-3.0, 1.5]])
+    px = s.mm_to_pixels(mm)
+    # the sensor centre is the centre of the pixel array; +y mm is up = smaller v
+    np.testing.assert_allclose(px[0], [2999.5, 1999.5])
+    np.testing.assert_allclose(px[1], [2999.5 + 3000, 1999.5 - 2000])
+    np.testing.assert_allclose(s.pixels_to_mm(px), mm, atol=1e-12)
+    np.testing.assert_allclose(s.mm_to_pixels(mm, "colmap"), px + 0.5)
+    np.testing.assert_allclose(s.pixels_to_mm(px + 0.5, "colmap"), mm, atol=1e-12)

@@ -1,0 +1,93 @@
+"""Docs that cannot rot: every ``orthoscope ...`` example in the README and in each command's
+``--help`` epilog runs (in a scratch folder holding copies of the files the examples name) and
+exits with status 0; every Python block of the README runs."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import re
+import shlex
+import shutil
+from pathlib import Path
+
+import pytest
+
+from orthoscope.cli import build_parser, main
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+
+
+def _readme_blocks(lang: str) -> list[str]:
+    text = README.read_text(encoding="utf-8")
+    return re.findall(rf"```{lang}\n(.*?)```", text, flags=re.S)
+
+
+def _commands(text: str) -> list[str]:
+    """``orthoscope ...`` command lines of a shell text (continuation lines joined, comments and
+    the install line of the quick start dropped)."""
+    joined = re.sub(r"\\\n\s*", " ", text)
+    out = []
+    for line in re.split(r"\n|;\s+", joined):
+        line = line.split(" #")[0].strip()
+        m = re.search(r"(?:^|&& |: )(orthoscope (?:[^&]|&(?!&))*)", line)
+        if m:
+            out.append(m.group(1).strip())
+    return out
+
+
+def readme_examples() -> list[str]:
+    return [c for block in _readme_blocks("sh") for c in _commands(block)]
+
+
+def help_examples() -> list[str]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.choices and isinstance(a.choices, dict))
+    out = []
+    for p in sub.choices.values():
+        out += _commands(p.epilog or "")
+    return out
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory):
+    d = tmp_path_factory.mktemp("docs")
+    shutil.copytree(ROOT / "tests" / "data", d / "tests" / "data")
+    shutil.copytree(ROOT / "lenses", d / "lenses")
+    return d
+
+
+def _run(cmd: str, cwd: Path, monkeypatch) -> tuple[int, str]:
+    argv = shlex.split(cmd)[1:]
+    monkeypatch.chdir(cwd)
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main(argv)
+        except SystemExit as e:  # --help / --version
+            rc = int(e.code or 0)
+    return rc, err.getvalue()
+
+
+def test_examples_were_found():
+    assert len(readme_examples()) >= 10
+    assert len(help_examples()) >= len(build_parser()._subparsers._group_actions[0].choices) - 1
+
+
+@pytest.mark.parametrize("cmd", sorted(set(readme_examples() + help_examples())))
+def test_example_runs(cmd, scratch, monkeypatch, tmp_path):
+    # each example in its own copy of the scratch folder: outputs never exist beforehand
+    work = tmp_path / "w"
+    shutil.copytree(scratch, work)
+    rc, err = _run(cmd, work, monkeypatch)
+    assert rc == 0, f"{cmd}\n{err}"
+
+
+def test_readme_python_blocks_run(monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    for block in _readme_blocks("python"):
+        exec(compile(block, "README.md", "exec"), {})

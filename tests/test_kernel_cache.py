@@ -1,0 +1,60 @@
+"""The numba kernel cache (docs/design.md, "Performance"): a cache that cannot be written falls
+back to the user cache folder or to uncached compilation with one warning, never an error; the
+cache stamp covers every kernel module, so inlined code is never stale."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CHILD = """
+import warnings, math
+warnings.simplefilter("always")
+import numpy as np
+from raytrace.files.library import load_lens
+from raytrace.trace import chief_rays
+cr = chief_rays(load_lens("topogon-us2031792-fig1"), [0.0, 7.0])
+print("HEIGHT", repr(float(cr.heights_at(cr.z_last[0] + 51.9415)[1])))
+"""
+
+
+def test_unwritable_cache_falls_back_to_uncached_with_one_warning(tmp_path):
+    # a private copy of the packages whose __pycache__ folders cannot be created (a file of that
+    # name blocks the directory even for root), and a home / XDG cache inside /proc, where no
+    # one can create folders: no cache location is writable.
+    for pkg in ("raytrace", "distortion", "orthoscope"):
+        shutil.copytree(ROOT / pkg, tmp_path / pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "lenses", tmp_path / "orthoscope_lenses")
+    for d in (tmp_path / "raytrace").rglob("*"):
+        if d.is_dir():
+            (d / "__pycache__").write_text("not a folder")
+    (tmp_path / "raytrace" / "__pycache__").write_text("not a folder")
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if not k.startswith("NUMBA_CACHE") and k not in ("HOME", "XDG_CACHE_HOME")
+    }
+    env.update(HOME="/proc/no-home", XDG_CACHE_HOME="/proc/no-cache", PYTHONPATH=str(tmp_path))
+    r = subprocess.run(
+        [sys.executable, "-c", CHILD], cwd=tmp_path, env=env, capture_output=True, text=True
+    )
+    assert r.returncode == 0, r.stderr
+    warned = [ln for ln in r.stderr.splitlines() if "KernelCacheWarning" in ln]
+    assert len(warned) == 1, r.stderr
+    assert "NUMBA_CACHE_DIR" in warned[0]
+    # the uncached kernels give the published chief-ray height (US 2,031,792: 8.1121 mm at 7 deg,
+    # see tests/test_trace.py)
+    h = float(r.stdout.split("HEIGHT")[1])
+    assert abs(h - 8.1121) < 6e-4
+
+
+def test_cache_stamp_covers_every_kernel_module():
+    from raytrace.kernels.jit import KERNEL_STAMP
+
+    names = {n for n, *_ in KERNEL_STAMP}
+    assert names == {p.name for p in (ROOT / "raytrace" / "kernels").glob("*.py")}

@@ -1,0 +1,121 @@
+"""The shape of the code base (docs/design.md, "Layout"): imports run orthoscope → distortion →
+raytrace and never back; the science packages neither print nor parse arguments; no module
+imports another module's private names; every package is installed; the public API answers
+the README's quick start."""
+
+from __future__ import annotations
+
+import ast
+import re
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+LAYERS = {"raytrace": 0, "distortion": 1, "orthoscope": 2}
+
+
+def _modules(pkg: str):
+    for p in sorted((ROOT / pkg).rglob("*.py")):
+        yield p, ast.parse(p.read_text(encoding="utf-8"), filename=str(p))
+
+
+def _imported(tree: ast.AST, path: Path, pkg: str):
+    """(module name, imported names, line) of every import, relative ones resolved."""
+    rel = path.relative_to(ROOT).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                yield a.name, [], node.lineno
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = parts[: len(parts) - node.level + (1 if path.name == "__init__.py" else 0)]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module or ""
+            yield mod, [a.name for a in node.names], node.lineno
+
+
+@pytest.mark.parametrize("pkg", sorted(LAYERS))
+def test_imports_run_one_way(pkg):
+    bad = []
+    for path, tree in _modules(pkg):
+        for mod, _, line in _imported(tree, path, pkg):
+            top = mod.split(".")[0]
+            if top in LAYERS and LAYERS[top] > LAYERS[pkg]:
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports {mod}")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("pkg", ["raytrace", "distortion"])
+def test_science_packages_do_not_print_or_parse_arguments(pkg):
+    bad = []
+    for path, tree in _modules(pkg):
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "print":
+                bad.append(f"{path.relative_to(ROOT)}:{node.lineno} print()")
+        for mod, _, line in _imported(tree, path, pkg):
+            if mod == "argparse":
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports argparse")
+    assert not bad, "\n".join(bad)
+
+
+def test_no_private_names_imported_across_modules():
+    bad = []
+    for pkg in LAYERS:
+        for path, tree in _modules(pkg):
+            for mod, names, line in _imported(tree, path, pkg):
+                if mod.split(".")[0] not in LAYERS:
+                    continue
+                for n in names:
+                    if n.startswith("_") and not n.startswith("__"):
+                        bad.append(f"{path.relative_to(ROOT)}:{line} imports {mod}.{n}")
+    assert not bad, "\n".join(bad)
+
+
+def test_kernels_import_nothing_of_the_python_layer():
+    bad = []
+    for path, tree in _modules("raytrace/kernels"):
+        for mod, _, line in _imported(tree, path, "raytrace"):
+            if mod.startswith("raytrace.") and not mod.startswith("raytrace.kernels"):
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports {mod}")
+    assert not bad, "\n".join(bad)
+
+
+def test_every_package_is_installed():
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    listed = set(cfg["tool"]["setuptools"]["packages"])
+    found = {
+        ".".join(p.parent.relative_to(ROOT).parts)
+        for pkg in LAYERS
+        for p in (ROOT / pkg).rglob("__init__.py")
+    }
+    assert found - listed == set(), f"packages missing from pyproject.toml: {found - listed}"
+
+
+def test_quick_start_api_runs_and_documents_units():
+    import numpy as np
+
+    import orthoscope as osc
+
+    assert re.fullmatch(r"\d+\.\d+(\.\d+)?.*", osc.__version__)
+    assert set(osc.__all__) <= set(dir(osc))
+    lens = osc.load_lens("topogon-us2031792-fig1")
+    p = osc.paraxial(lens)
+    # US 2,031,792 (Topogon, Fig. 1) EFL 66.04 mm; see lenses/README.md
+    assert p.efl == pytest.approx(66.04, abs=0.005)
+    rays = osc.chief_rays(lens, fields_deg=[0, 10, 20])
+    assert rays.ok.all() and rays.y_last.shape == (3,)
+    out = osc.trace_rays(lens, np.array([[0.0, 1.0, -10.0]]), np.array([[0.0, 0.0, 1.0]]))
+    assert out.ok.all()
+    d = osc.characteristic_distortion(lens, fields_deg=[0, 10, 20, 30], s_prime=p.s_prime_gauss)
+    cal = osc.calibrate(d, method="minimax")
+    assert cal.Dc_max_abs <= np.max(np.abs(d.D0))
+    doc = osc.characteristic_distortion.__doc__
+    assert "Parameters" in doc and "Returns" in doc and "mm" in doc
+    for r in (lens, p, rays, d, cal):
+        assert len(repr(r)) < 400 and "np.float64" not in repr(r), type(r)

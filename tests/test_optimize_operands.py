@@ -1,0 +1,158 @@
+"""Operands in several planes at once and the new operand types (raytrace.optimize.operands):
+distortion_slope against a finite difference of two planes traced by the distortion package,
+landing_angle against the image heights in two planes, axial colour and per-operand wavelengths
+against the closed-form thick lens, and one chief-ray trace per object however many planes.
+
+Sources: Pestrecov 1958, Section V (Table V's planes s' = 425 / 525 / 625 mm for the object at
+s = -55.0009 mm; Eq. 8 M0 = p0'/(m_e p0)); the thick-lens power and back focal distance
+(e.g. Hecht, Optics, §6.2: 1/f = (n-1)(c1 - c2) + (n-1)² t c1 c2 / n, BFD = f (1 - (n-1) t c1 / n));
+orthoscope's documented cauchy2 model glass n = A + B/λ² with n(d) = nd and n(F) - n(C) =
+(nd - 1)/vd (raytrace/materials.py docstring), rebuilt here from that definition.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import raytrace.trace
+from distortion.characteristic import characteristic_distortion
+from raytrace import AIR, Aperture, Field, Lens, Surface
+from raytrace.files.library import load_lens
+from raytrace.materials import model_glass
+from raytrace.optimize import Operand, evaluate
+from raytrace.paraxial import paraxial
+
+S_PROJ = -55.0009  # Pestrecov 1958 Table IV: object of the projection planes, mm from H
+PLANES = (425.0, 525.0, 625.0)  # Table V image planes, s' in mm
+ANGLES = (10.0, 25.0, 45.0)
+LF, LD, LC = 486.1327, 587.5618, 656.2725
+
+
+@pytest.fixture(scope="module")
+def twinplex():
+    return load_lens("twinplex-like-55-525")
+
+
+def test_distortion_slope_is_the_difference_of_two_planes(twinplex):
+    ops = tuple(
+        Operand("distortion_slope", 0.0, 1.0, {"field": a, "object_s": S_PROJ}) for a in ANGLES
+    )
+    slope = np.array([v.value for v in evaluate(twinplex, ops)])
+    # independent: the distortion package traces the planes 425 and 625 mm (Pestrecov Eqs. 8-9)
+    res = characteristic_distortion(twinplex, list(ANGLES), object_s=S_PROJ, s_prime=[425, 625])
+    fd = (res.D0[1] - res.D0[0]) / 200.0
+    np.testing.assert_allclose(slope, fd, rtol=1e-9, atol=1e-13)
+    # D0 is affine in s': the slope carries a plane's D0 to any other plane
+    d425 = [
+        v.value
+        for v in evaluate(
+            twinplex,
+            tuple(
+                Operand(
+                    "distortion", 0.0, 1.0, {"field": a, "object_s": S_PROJ, "plane": {"s_prime": p}}
+                )
+                for p in PLANES
+                for a in ANGLES
+            ),
+        )
+    ]
+    d = np.array(d425).reshape(len(PLANES), len(ANGLES))
+    for i, p in enumerate(PLANES):
+        np.testing.assert_allclose(d[i], d[0] + (p - 425.0) * slope, atol=1e-10)
+    # and the one plane operand equals the distortion package in each plane
+    np.testing.assert_allclose(d[[0, 2]], res.D0, atol=1e-12)
+
+
+def test_landing_angle_is_the_slope_of_the_final_segment(twinplex):
+    ops = tuple(
+        Operand("landing_angle", 0.0, 1.0, {"field": a, "object_s": S_PROJ}) for a in ANGLES
+    )
+    ang = np.array([v.value for v in evaluate(twinplex, ops)])
+    res = characteristic_distortion(twinplex, list(ANGLES), object_s=S_PROJ, s_prime=[425, 625])
+    ref = np.degrees(np.arctan((res.yp[1] - res.yp[0]) / 200.0))
+    np.testing.assert_allclose(ang, ref, atol=1e-9)
+    assert np.all(ang > 0) and ang[-1] > ang[0]
+
+
+def test_chief_rays_traced_once_per_object_whatever_the_planes(twinplex, monkeypatch):
+    calls = []
+    real = raytrace.trace.aim
+
+    def counting(lens, fields, kind, od, wavelength=None, clip=True):
+        calls.append((od, kind, tuple(fields)))
+        return real(lens, fields, kind, od, wavelength, clip)
+
+    monkeypatch.setattr(raytrace.trace, "aim", counting)
+    ops = [
+        Operand("distortion", 0.0, 1.0, {"field": a, "object_s": S_PROJ, "plane": {"s_prime": p}})
+        for p in PLANES
+        for a in (10.0, 20.0, 30.0, 40.0, 45.0)
+    ]
+    ops += [Operand("distortion_slope", 0.0, 1.0, {"field": 45.0, "object_s": S_PROJ})]
+    ops += [Operand("landing_angle", 0.0, 1.0, {"field": 35.0, "object_s": S_PROJ})]
+    ops += [Operand("distortion", 0.0, 1.0, {"field": a}) for a in (25.0, 45.0)]  # Gaussian
+    evaluate(twinplex, tuple(ops))
+    assert len(calls) == 2  # the projection object and the lens file's (Gaussian) object
+    assert sorted(len(c[2]) for c in calls) == [2, 6]
+
+
+def _thick_singlet(nd=1.6, vd=40.0, c1=0.02, c2=-0.004, t=5.0, fnumber=8.0):
+    return Lens(
+        "thick singlet",
+        (Surface(c1, t, model_glass(nd, vd), stop=True), Surface(c2, 80.0, AIR)),
+        Aperture("fnumber", fnumber),
+        Field("angle", 5.0),
+    )
+
+
+def _closed_form(nd, vd, c1, c2, t, lam):
+    b = ((nd - 1) / vd) / (1 / LF**2 - 1 / LC**2)
+    n = nd - b / LD**2 + b / lam**2
+    phi = (n - 1) * (c1 - c2) + (n - 1) ** 2 * t * c1 * c2 / n
+    f = 1.0 / phi
+    return f, t + f * (1 - (n - 1) * t * c1 / n)  # EFL, image z (object at infinity)
+
+
+def test_axial_color_and_wavelength_against_the_thick_lens():
+    lens = _thick_singlet()
+    ops = (
+        Operand("axial_color", 0.0, 1.0),
+        Operand("axial_color", 0.0, 1.0, {"wavelengths": [LC, LD]}),
+        Operand("efl", 0.0, 1.0, {"wavelength": LF}),
+        Operand("efl", 0.0, 1.0),
+    )
+    v = [o.value for o in evaluate(lens, ops)]
+    fF, zF = _closed_form(1.6, 40.0, 0.02, -0.004, 5.0, LF)
+    fC, zC = _closed_form(1.6, 40.0, 0.02, -0.004, 5.0, LC)
+    fd, zd = _closed_form(1.6, 40.0, 0.02, -0.004, 5.0, LD)
+    assert v[0] == pytest.approx(zF - zC, rel=1e-9)
+    assert v[0] < 0  # a positive singlet brings blue to focus first
+    assert v[1] == pytest.approx(zC - zd, rel=1e-9)
+    assert v[2] == pytest.approx(fF, rel=1e-12)
+    assert v[3] == pytest.approx(fd, rel=1e-12)
+    assert paraxial(lens).efl == pytest.approx(fd, rel=1e-12)
+
+
+def test_rms_spot_wavelength_changes_the_spot():
+    # ``wavelength`` analyses the lens at that wavelength (as distortion's wavelength= does): its
+    # "gaussian" plane is that wavelength's; a common physical plane is given from the vertex
+    lens = _thick_singlet(fnumber=30.0)  # slow: the spherical aberration is negligible
+    _, zF = _closed_form(1.6, 40.0, 0.02, -0.004, 5.0, LF)
+    fd, zd = _closed_form(1.6, 40.0, 0.02, -0.004, 5.0, LD)
+    t = 5.0
+    ops = (
+        Operand("rms_spot", 0.0, 1.0, {"plane": {"from_last_vertex": zd - t}, "wavelength": LF}),
+        Operand("rms_spot", 0.0, 1.0, {"plane": {"from_last_vertex": zd - t}}),
+        Operand("rms_spot", 0.0, 1.0, {"plane": "gaussian", "wavelength": LF}),
+        Operand("rms_spot", 0.0, 1.0, {"plane": {"from_last_vertex": zF - t}, "wavelength": LF}),
+    )
+    f_at_d, d_at_d, f_own, f_at_f = (o.value for o in evaluate(lens, ops))
+    assert f_own == pytest.approx(f_at_f, rel=1e-9)
+    assert f_at_d > 2 * d_at_d
+    # the F bundle in the d plane: a defocused disc of radius r = (EPD/2)|zF - zd|/f has RMS
+    # radius r/sqrt 2 (the real rays and the F-line focal length change it by about 1 %)
+    r = 0.5 * paraxial(lens).epd * abs(zF - zd) / fd
+    assert f_at_d == pytest.approx(r / math.sqrt(2), rel=0.03)
