@@ -289,7 +289,7 @@ def calibrate(
     CalibrationResult
         K_c, D_c (mm), D_rc (fraction), ρ, ρ_k and spreads (one row of Table II per field).
     """
-    curve = _as_curve(distortion, plane)
+    curve = _as_curve(distortion, plane, at)
     what = f"calibration ({method})"
     if method not in METHODS:
         raise CalibrationError(
@@ -325,7 +325,7 @@ def calibrate(
     return CalibrationResult(curve, method, at_t, float(Kc), float(k), ycp, Dc, Drc)
 
 
-def _as_curve(d, plane: int) -> DistortionCurve:
+def _as_curve(d, plane: int, at=None) -> DistortionCurve:
     if isinstance(d, DistortionCurve):
         return d
     if hasattr(d, "curve") and hasattr(d, "n_planes"):
@@ -333,6 +333,16 @@ def _as_curve(d, plane: int) -> DistortionCurve:
             raise CalibrationError(
                 f"plane={plane}: the result has {d.n_planes} image plane(s) (0-based index)"
             )
+        from raytrace.kernels.codes import STATUS_NAMES
+
+        for a in np.atleast_1d(np.asarray(at if at is not None else [], dtype=float)):
+            hit = np.nonzero(np.isclose(d.fields, a, rtol=0, atol=1e-9 * max(1.0, abs(a))))[0]
+            if hit.size and d.status[hit[0]] != 0:
+                name = STATUS_NAMES.get(int(d.status[hit[0]]), str(int(d.status[hit[0]])))
+                raise CalibrationError(
+                    f"field {a:g} could not be traced (status {name}): calibrate at fields "
+                    "the lens passes"
+                )
         return d.curve(int(plane))
     raise CalibrationError(
         f"expected a DistortionCurve or a CharacteristicDistortion, got {type(d).__name__}"

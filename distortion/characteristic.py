@@ -258,8 +258,7 @@ def characteristic_distortion(
         For impossible requests (a plane before the last vertex, heights with an object at
         infinity, an unknown reference, ...).
     """
-    from raytrace.paraxial import image_planes, paraxial, plane_z
-    from raytrace.paraxial import resolve_object_distance
+    from raytrace.paraxial import image_planes, paraxial, plane_z, resolve_object_distance
     from raytrace.trace import aim
 
     if reference not in REFERENCES:
@@ -482,6 +481,14 @@ class ChromaticDistortion:
     Dr = property(lambda self: self._stack("Dr"))
     constant = property(lambda self: self._stack("constant"))
     status = property(lambda self: self._stack("status"))
+
+    def plane_label(self, i: int) -> str:
+        """Plane ``i`` described with the reference wavelength's H' and Gaussian plane."""
+        par = self.reference_paraxial
+        z = float(self.z_planes[i])
+        sp, d = z - par.z_Hp, z - par.z_gauss
+        g = "Gaussian plane" if abs(d) <= 1e-9 * max(1.0, abs(sp)) else f"defocus {d:+.4f} mm"
+        return f"s' = {sp:.4f} mm ({g} at {self.reference_wavelength:g} nm)"
 
     @property
     def scale_description(self) -> str:

@@ -2,10 +2,12 @@
 
 Conventions
 -----------
-δr is distortion, ``δr = r_actual − r_ideal`` (positive outward = pincushion), the sign of the
-Fraser & Shortis profiles and of the photogrammetric (Brown–Conrady / Australis) terms
-``Δx = x̄ (K1 r² + K2 r⁴ + K3 r⁶)``. r and δr are in mm inside this module (profiles in µm
-are converted at the interface: ``dr_um``).
+δr is distortion, ``δr = r_actual − r_ideal`` (positive outward = pincushion): the sign of the
+Fraser & Shortis profiles and of Brown's distortion polynomial ``δr = K1 r³ + K2 r⁵ + ...``.
+The Australis / Fraser (1997) model writes instead the CORRECTION ``Δx = x̄ (K1 r² + ...)``
+added to a measured coordinate to get the ideal one, so its K are the negatives of these (to
+first order; :mod:`distortion.camera` converts exactly). r and δr are in mm inside this module
+(profiles in µm are converted at the interface: ``dr_um``).
 
 * Gaussian form (Brown–Conrady odd polynomial, no linear term), referred to the Gaussian
   principal distance c_g:  ``δr = K1 r³ + K2 r⁵ + K3 r⁷``  (K1 in mm⁻², K2 mm⁻⁴, K3 mm⁻⁶).

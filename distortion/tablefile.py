@@ -34,7 +34,6 @@ import numpy as np
 from .curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 from .errors import DataError
 
-
 _ALIASES = {
     "alpha": "angle",
     "angle": "angle",

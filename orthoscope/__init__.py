@@ -71,9 +71,20 @@ _API: dict[str, str] = {
     "Conjugate": "distortion.variation",
     "fit_radial": "distortion.coefficients",
     "opencv_model": "distortion.coefficients",
+    # camera models (OpenCV, COLMAP, Metashape, Australis) and sensors
+    "Sensor": "distortion.camera",
+    "CameraModel": "distortion.camera",
+    "CameraFit": "distortion.camera",
+    "camera_from_sensor": "distortion.camera",
+    "fit_camera_model": "distortion.camera",
+    "select_camera_model": "distortion.camera",
+    "convert_camera_model": "distortion.camera",
+    "read_calibration": "distortion.camera",
+    "write_calibration": "distortion.camera",
     # design
     "read_spec": "raytrace.optimize",
     "optimize": "raytrace.optimize",
+    "global_optimize": "raytrace.optimize",
     # plots (matplotlib loads with the first of these)
     "plot_distortion": "orthoscope.plots.distortion",
     "plot_characteristic": "orthoscope.plots.distortion",
@@ -81,7 +92,12 @@ _API: dict[str, str] = {
     "plot_planes": "orthoscope.plots.distortion",
     "plot_rotation": "orthoscope.plots.distortion",
     "plot_layout": "orthoscope.plots.layout",
+    "plot_profiles": "orthoscope.plots.variation",
+    "plot_g": "orthoscope.plots.variation",
+    "plot_ray_fan": "orthoscope.plots.rays",
+    "plot_spot": "orthoscope.plots.rays",
     "save_figure": "orthoscope.plots.save",
+    "plot_glass_map": "orthoscope.plots.glassmap",
     # errors
     "OrthoscopeError": "raytrace.errors",
     "PrescriptionError": "raytrace.errors",
@@ -126,6 +142,17 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from distortion.calibration import CalibrationResult, calibrate
+    from distortion.camera import (
+        CameraFit,
+        CameraModel,
+        Sensor,
+        camera_from_sensor,
+        convert_camera_model,
+        fit_camera_model,
+        read_calibration,
+        select_camera_model,
+        write_calibration,
+    )
     from distortion.characteristic import CharacteristicDistortion, characteristic_distortion
     from distortion.coefficients import fit_radial, opencv_model
     from distortion.compensation import CompensationResult, compensate
@@ -144,7 +171,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from raytrace.files.library import list_lenses, load_lens
     from raytrace.lens import Aperture, Field, Lens, Surface
     from raytrace.materials import Material, fixed_index, model_glass
-    from raytrace.optimize import optimize, read_spec
+    from raytrace.optimize import global_optimize, optimize, read_spec
     from raytrace.paraxial import ImagePlane, ParaxialResult, paraxial, pestrecov_constants
     from raytrace.trace import (
         ChiefRays,
@@ -164,5 +191,8 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         plot_planes,
         plot_rotation,
     )
+    from .plots.glassmap import plot_glass_map
     from .plots.layout import plot_layout
+    from .plots.rays import plot_ray_fan, plot_spot
+    from .plots.variation import plot_g, plot_profiles
     from .plots.save import save_figure

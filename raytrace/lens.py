@@ -240,6 +240,27 @@ class Lens:
         w = () if weights is None else tuple(float(x) for x in weights)
         return replace(self, wavelengths=wl, weights=w, wavelength=float(ref))
 
+    def _out_of_range(self, m: Material, wl: np.ndarray, j: int, env) -> np.ndarray:
+        """The index of a catalog glass evaluated outside its data range, with the material's
+        warning (or strict error) repeated with the lens file and surface in front."""
+        import warnings
+
+        from .materials import OutOfRangeError, OutOfRangeWarning
+
+        where = f"{self.path or self.name}: " + ("object space" if j == 0 else f"surface {j}")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", OutOfRangeWarning)
+            try:
+                n = _index(m, wl, env)
+            except OutOfRangeError as e:
+                raise OutOfRangeError(f"{where}: {e}") from None
+        for w in caught:
+            if issubclass(w.category, OutOfRangeWarning):
+                warnings.warn(f"{where}: {w.message}", OutOfRangeWarning, stacklevel=4)
+            else:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return n
+
     def indices(self, wavelengths=None) -> np.ndarray:
         """Refractive indices at ``wavelengths`` (nm; a number or a sequence; default the
         reference wavelength): array (n_wavelengths, n_surfaces + 1) — column 0 the object space,
@@ -259,12 +280,10 @@ class Lens:
         for j, m in enumerate(mats):
             n = done.get(m)
             if n is None:
-                if env is not None and m.kind == "catalog":
-                    from .glass.thermal import index_at
-
-                    n = np.asarray(index_at(m, wl, env[0], env[1]), dtype=float)
+                if m.kind == "catalog" and not m.in_range(wl):
+                    n = self._out_of_range(m, wl, j, env)
                 else:
-                    n = np.asarray(m.index(wl), dtype=float)
+                    n = _index(m, wl, env)
                 done[m] = n
             out[:, j] = n
         return out
@@ -307,6 +326,15 @@ class Lens:
             field=fld,
             object_distance=self.object_distance * factor,
         )
+
+
+def _index(m: Material, wl: np.ndarray, env: tuple[float, float] | None) -> np.ndarray:
+    """Index of ``m`` at ``wl`` (nm), relative to the air of ``env`` (°C, atm) when given."""
+    if env is not None and m.kind == "catalog":
+        from .glass.thermal import index_at
+
+        return np.asarray(index_at(m, wl, env[0], env[1]), dtype=float)
+    return np.asarray(m.index(wl), dtype=float)
 
 
 def _normalize_wavelengths(lens: Lens) -> None:

@@ -127,3 +127,46 @@ def image_scale(value: float | str, what: str = "image scale") -> float:
     if not (math.isfinite(v) and v > 0):
         raise UnitError(f"{what}: N must be a positive finite number (12x: m0 = -1/12), got {value!r}")
     return v
+
+
+#: Fraunhofer / spectral-line letters as glass catalogs print them (Schott optical glass data
+#: sheets, e.g. the N-BK7 sheet: nm, in air). Case matters: ``d`` (helium) is not ``D``
+#: (sodium).
+SPECTRAL_LINES = {
+    "i": 365.0146,
+    "h": 404.6561,
+    "g": 435.8343,
+    "F'": 479.9914,
+    "F": 486.1327,
+    "e": 546.074,
+    "d": 587.5618,
+    "D": 589.2938,
+    "C'": 643.8469,
+    "C": 656.2725,
+    "r": 706.5188,
+    "s": 852.11,
+    "t": 1013.98,
+}
+
+
+def wavelengths_nm(values, what: str = "wavelengths") -> tuple[float, ...]:
+    """Several wavelengths in nm: a comma-separated string (``"486.1327,587.5618,656.2725"``,
+    ``"F,d,C"``, ``"0.55um,650nm"``) or a sequence of numbers / strings. Each value goes through
+    :func:`wavelength_nm`; a spectral-line letter (:data:`SPECTRAL_LINES`) stands for its
+    wavelength. An empty list is refused."""
+    if isinstance(values, str):
+        items = [v.strip() for v in values.split(",") if v.strip()]
+    else:
+        try:
+            items = list(values)
+        except TypeError:
+            items = [values]
+    if not items:
+        raise UnitError(f"{what}: give at least one wavelength (nm)")
+    out = []
+    for v in items:
+        if isinstance(v, str) and v.strip() in SPECTRAL_LINES:
+            out.append(SPECTRAL_LINES[v.strip()])
+        else:
+            out.append(wavelength_nm(v, what))
+    return tuple(out)

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from distortion.camera import (
-    CameraModel,
     OPENCV_ORDERS,
+    CameraModel,
     convert_camera_model,
     convert_exact,
     fit_camera_model,
@@ -43,40 +43,117 @@ def _correspondences(cam, grid=(25, 17)):
 
 TRUTHS = [
     _cv(k1=-0.08, k2=0.02, p1=4e-4, p2=-6e-4, k3=-0.003),
-    _cv(k1=-0.08, k2=0.02, p1=4e-4, p2=-6e-4, k3=-0.003, k4=0.004, k5=-0.002, k6=0.001,
-        s1=3e-4, s2=-2e-4, s3=-4e-4, s4=1e-4, tau_x=0.012, tau_y=-0.008),
-    CameraModel.create("opencv_fisheye", W, H, fx=1400.0, fy=1410.0, cx=1523.4, cy=987.6,
-                       alpha=0.002, k1=0.03, k2=-0.006, k3=0.001, k4=-1e-4),
-    CameraModel.create("colmap:OPENCV", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1,
-                       k1=-0.08, k2=0.02, p1=4e-4, p2=-6e-4),
-    CameraModel.create("colmap:FOV", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1,
-                       omega=0.6),
-    CameraModel.create("colmap:DIVISION", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1,
-                       k=-0.05),
-    CameraModel.create("colmap:EUCM", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1,
-                       alpha=0.5, beta=1.1),
-    CameraModel.create("metashape", W, H, f=3200.0, cx=23.4, cy=-11.7, b1=12.0, b2=1.5,
-                       k1=-0.08, k2=0.02, k3=-0.003, k4=2e-4, p1=-6e-4, p2=4e-4, p3=0.1, p4=-0.1),
-    CameraModel.create("australis", W, H, pixel_size_mm=(0.0078, 0.0079), c=25.0, xp=0.05,
-                       yp=-0.04, K1=8e-5, K2=-6e-8, K3=7e-11, P1=1e-5, P2=-2e-5, b1=1e-4,
-                       b2=-5e-5),
+    _cv(
+        k1=-0.08,
+        k2=0.02,
+        p1=4e-4,
+        p2=-6e-4,
+        k3=-0.003,
+        k4=0.004,
+        k5=-0.002,
+        k6=0.001,
+        s1=3e-4,
+        s2=-2e-4,
+        s3=-4e-4,
+        s4=1e-4,
+        tau_x=0.012,
+        tau_y=-0.008,
+    ),
+    CameraModel.create(
+        "opencv_fisheye",
+        W,
+        H,
+        fx=1400.0,
+        fy=1410.0,
+        cx=1523.4,
+        cy=987.6,
+        alpha=0.002,
+        k1=0.03,
+        k2=-0.006,
+        k3=0.001,
+        k4=-1e-4,
+    ),
+    CameraModel.create(
+        "colmap:OPENCV",
+        W,
+        H,
+        fx=3210.0,
+        fy=3190.0,
+        cx=1523.9,
+        cy=988.1,
+        k1=-0.08,
+        k2=0.02,
+        p1=4e-4,
+        p2=-6e-4,
+    ),
+    CameraModel.create("colmap:FOV", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, omega=0.6),
+    CameraModel.create("colmap:DIVISION", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, k=-0.05),
+    CameraModel.create(
+        "colmap:EUCM", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, alpha=0.5, beta=1.1
+    ),
+    CameraModel.create(
+        "metashape",
+        W,
+        H,
+        f=3200.0,
+        cx=23.4,
+        cy=-11.7,
+        b1=12.0,
+        b2=1.5,
+        k1=-0.08,
+        k2=0.02,
+        k3=-0.003,
+        k4=2e-4,
+        p1=-6e-4,
+        p2=4e-4,
+        p3=0.1,
+        p4=-0.1,
+    ),
+    CameraModel.create(
+        "australis",
+        W,
+        H,
+        pixel_size_mm=(0.0078, 0.0079),
+        c=25.0,
+        xp=0.05,
+        yp=-0.04,
+        K1=8e-5,
+        K2=-6e-8,
+        K3=7e-11,
+        P1=1e-5,
+        P2=-2e-5,
+        b1=1e-4,
+        b2=-5e-5,
+    ),
 ]
 
 
 @pytest.mark.parametrize("truth", TRUTHS, ids=lambda c: c.model + str(len(c.params)))
 def test_fit_recovers_the_generating_camera(truth):
     xy, uv = _correspondences(truth)
-    fit = fit_camera_model(xy, uv, truth.model, width=W, height=H,
-                           pixel_size_mm=truth.pixel_size_mm,
-                           free=[n for n in truth.spec.params if truth[n] != 0 or n in ("cx",)])
+    fit = fit_camera_model(
+        xy,
+        uv,
+        truth.model,
+        width=W,
+        height=H,
+        pixel_size_mm=truth.pixel_size_mm,
+        free=[n for n in truth.spec.params if truth[n] != 0 or n in ("cx",)],
+    )
     assert fit.rms_px < 1e-8, fit
     assert fit.n_failed == 0
-    # parameters: to 1e-6, except in the 14-coefficient OpenCV model, whose rational terms and
-    # tilt are nearly interchangeable over a sensor (condition number ~1e6): there the image
-    # residual above is the meaningful check and the parameters agree to 1e-4
-    rel = 1e-4 if fit.condition > 1e5 else 1e-6
-    for n in fit.free:
-        assert fit.camera[n] == pytest.approx(truth[n], rel=rel, abs=1e-12), (n, fit.condition)
+    # parameters to 1e-6 where they are identifiable. In the 14-coefficient OpenCV model the
+    # rational terms and the tilt are nearly interchangeable over a sensor (condition number of
+    # the scaled Jacobian ~1e9, reported by the fit): its parameters then move with round-off,
+    # and the meaningful check is the image map itself, between and beyond the fitted points.
+    if fit.condition < 1e6:
+        for n in fit.free:
+            assert fit.camera[n] == pytest.approx(truth[n], rel=1e-6, abs=1e-12), n
+    else:
+        assert truth.model == "opencv" and len(fit.free) == 18, fit.condition
+        dense = unproject(truth, sensor_grid(W, H, (61, 43)), pixels="opencv").points
+        d = project(fit.camera, dense).points - project(truth, dense).points
+        assert np.abs(d).max() < 1e-8
     assert len(fit.std_errors) == len(fit.free)
     assert fit.correlation.shape == (len(fit.free),) * 2
 
@@ -138,7 +215,9 @@ def test_exact_conversions_preserve_the_projection(target):
     xy = unproject(src, sensor_grid(W, H, (9, 7)), pixels="opencv").points
     np.testing.assert_allclose(
         project(conv.camera, xy, pixels="opencv").points,
-        project(src, xy, pixels="opencv").points, rtol=0, atol=1e-9,
+        project(src, xy, pixels="opencv").points,
+        rtol=0,
+        atol=1e-9,
     )
 
 
@@ -154,8 +233,7 @@ def test_refit_states_its_residual_and_lost_terms():
     src = _cv(k1=-0.08, k2=0.02, p1=4e-4, p2=-6e-4, k3=-0.003, s1=3e-4, tau_x=0.01)
     conv = convert_camera_model(src, "metashape")
     assert conv.method == "refit"
-    assert any("prism" in t for t in conv.lost_terms) and any("tilt" in t for t in
-                                                             conv.lost_terms)
+    assert any("prism" in t for t in conv.lost_terms) and any("tilt" in t for t in conv.lost_terms)
     # the stated residual is what one measures independently over the same grid
     grid = sensor_grid(W, H)
     ideal = unproject(src, grid, pixels="opencv").points

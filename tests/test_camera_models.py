@@ -42,16 +42,39 @@ TOL = 1e-9  # px, issue 17 done-when
 # magnitude ranges of random coefficients (random sign unless noted); small enough that every
 # map is one-to-one over the test field
 PERSPECTIVE = {
-    "k1": (0.05, 0.1), "k2": (0.01, 0.03), "k3": (1e-3, 5e-3), "k4": (1e-3, 5e-3),
-    "k5": (1e-3, 3e-3), "k6": (1e-4, 1e-3), "p1": (2e-4, 8e-4), "p2": (2e-4, 8e-4),
-    "s1": (1e-4, 5e-4), "s2": (1e-4, 5e-4), "s3": (1e-4, 5e-4), "s4": (1e-4, 5e-4),
-    "tau_x": (5e-3, 2e-2), "tau_y": (5e-3, 2e-2), "k": (0.03, 0.08),
+    "k1": (0.05, 0.1),
+    "k2": (0.01, 0.03),
+    "k3": (1e-3, 5e-3),
+    "k4": (1e-3, 5e-3),
+    "k5": (1e-3, 3e-3),
+    "k6": (1e-4, 1e-3),
+    "p1": (2e-4, 8e-4),
+    "p2": (2e-4, 8e-4),
+    "s1": (1e-4, 5e-4),
+    "s2": (1e-4, 5e-4),
+    "s3": (1e-4, 5e-4),
+    "s4": (1e-4, 5e-4),
+    "tau_x": (5e-3, 2e-2),
+    "tau_y": (5e-3, 2e-2),
+    "k": (0.03, 0.08),
 }
 FISHEYE = {
-    "k0": (0.01, 0.04), "k1": (0.01, 0.04), "k2": (2e-3, 6e-3), "k3": (2e-4, 8e-4),
-    "k4": (2e-5, 8e-5), "k5": (2e-6, 8e-6), "p0": (2e-4, 8e-4), "p1": (2e-4, 8e-4),
-    "p2": (2e-4, 8e-4), "sx1": (1e-4, 5e-4), "sy1": (1e-4, 5e-4), "s0": (1e-4, 5e-4),
-    "s1": (1e-4, 5e-4), "s2": (1e-4, 5e-4), "s3": (1e-4, 5e-4), "alpha": (1e-3, 3e-3),
+    "k0": (0.01, 0.04),
+    "k1": (0.01, 0.04),
+    "k2": (2e-3, 6e-3),
+    "k3": (2e-4, 8e-4),
+    "k4": (2e-5, 8e-5),
+    "k5": (2e-6, 8e-6),
+    "p0": (2e-4, 8e-4),
+    "p1": (2e-4, 8e-4),
+    "p2": (2e-4, 8e-4),
+    "sx1": (1e-4, 5e-4),
+    "sy1": (1e-4, 5e-4),
+    "s0": (1e-4, 5e-4),
+    "s1": (1e-4, 5e-4),
+    "s2": (1e-4, 5e-4),
+    "s3": (1e-4, 5e-4),
+    "alpha": (1e-3, 3e-3),
     "k": (0.01, 0.04),
 }
 POSITIVE = {"omega": (0.3, 0.9), "alpha": (0.3, 0.7), "beta": (0.8, 1.2)}  # FOV, EUCM
@@ -72,8 +95,10 @@ def random_camera(name: str, seed_extra: int = 0) -> CameraModel:
             p[n] = f * rng.uniform(1.03, 1.05)
         elif n in ("cx", "cy"):
             p[n] = rng.uniform(15.0, 40.0) * rng.choice([-1, 1])
-        elif spec.name.startswith("colmap:") and n in ("omega", "alpha", "beta") and (
-            spec.name in ("colmap:FOV", "colmap:EUCM")
+        elif (
+            spec.name.startswith("colmap:")
+            and n in ("omega", "alpha", "beta")
+            and (spec.name in ("colmap:FOV", "colmap:EUCM"))
         ):
             p[n] = rng.uniform(*POSITIVE[n])
         else:
@@ -216,8 +241,10 @@ def test_colmap_models_equal_pycolmap(name, tmp_path):
     assert ref_cam.model.name == cam.spec.colmap_name
     np.testing.assert_array_equal(np.asarray(ref_cam.params), cam.params)
     fisheye = cam.spec.projection == "equidistant"
-    dirs = fisheye_directions() if fisheye else np.column_stack(
-        [perspective_points(), np.ones(len(perspective_points()))]
+    dirs = (
+        fisheye_directions()
+        if fisheye
+        else np.column_stack([perspective_points(), np.ones(len(perspective_points()))])
     )
     ref = np.asarray(ref_cam.img_from_cam(dirs))
     ours = project(cam, dirs)
@@ -243,8 +270,9 @@ def test_colmap_fov_series_branches_equal_pycolmap(tmp_path):
     pycolmap = pytest.importorskip("pycolmap")
     pts = np.array([[0.0, 0.0, 1.0], [1e-3, -2e-3, 1.0], [5e-3, 4e-3, 1.0], [0.3, -0.2, 1.0]])
     for omega in (0.005, 0.7):
-        cam = CameraModel.create("colmap:FOV", W, H, fx=3200.0, fy=3300.0, cx=1523.0,
-                                 cy=987.0, omega=omega)
+        cam = CameraModel.create(
+            "colmap:FOV", W, H, fx=3200.0, fy=3300.0, cx=1523.0, cy=987.0, omega=omega
+        )
         sub = tmp_path / f"w{omega}"
         sub.mkdir()
         ref = np.asarray(_pycolmap_camera(pycolmap, cam, sub).img_from_cam(pts))
@@ -271,9 +299,22 @@ def random_metashape(seed=0):
     rng = np.random.default_rng(77 + seed)
     s = lambda lo, hi: rng.uniform(lo, hi) * rng.choice([-1, 1])  # noqa: E731
     return CameraModel.create(
-        "metashape", W, H, f=3200.0, cx=s(15, 40), cy=s(15, 40), b1=s(5, 20), b2=s(0.5, 2),
-        k1=s(0.05, 0.1), k2=s(0.01, 0.03), k3=s(1e-3, 5e-3), k4=s(1e-4, 5e-4),
-        p1=s(2e-4, 8e-4), p2=s(2e-4, 8e-4), p3=s(0.05, 0.2), p4=s(0.05, 0.2),
+        "metashape",
+        W,
+        H,
+        f=3200.0,
+        cx=s(15, 40),
+        cy=s(15, 40),
+        b1=s(5, 20),
+        b2=s(0.5, 2),
+        k1=s(0.05, 0.1),
+        k2=s(0.01, 0.03),
+        k3=s(1e-3, 5e-3),
+        k4=s(1e-4, 5e-4),
+        p1=s(2e-4, 8e-4),
+        p2=s(2e-4, 8e-4),
+        p3=s(0.05, 0.2),
+        p4=s(0.05, 0.2),
     )
 
 
@@ -298,11 +339,13 @@ def test_metashape_common_terms_equal_cv2_through_exact_conversion():
     assert d["fx"] == cam["f"] + cam["b1"] and d["cx"] == (W - 1) / 2 + cam["cx"]
     xy = perspective_points()
     k, dist = _opencv_arrays(cv, 5)
-    ref = cv2.projectPoints(np.column_stack([xy, np.ones(len(xy))]), np.zeros(3), np.zeros(3),
-                            k, dist)[0][:, 0, :]
+    ref = cv2.projectPoints(
+        np.column_stack([xy, np.ones(len(xy))]), np.zeros(3), np.zeros(3), k, dist
+    )[0][:, 0, :]
     assert np.abs(project(cam, xy, pixels="opencv").points - ref).max() <= TOL
-    assert np.abs(_metashape_manual(cam.as_dict(), W, H, xy[:, 0], xy[:, 1]) - 0.5 - ref).max() \
-        <= TOL
+    assert (
+        np.abs(_metashape_manual(cam.as_dict(), W, H, xy[:, 0], xy[:, 1]) - 0.5 - ref).max() <= TOL
+    )
 
 
 def test_round_trip_opencv_metashape_colmap_opencv_through_files(tmp_path):
@@ -344,9 +387,20 @@ def random_australis():
     rng = np.random.default_rng(1997)
     s = lambda lo, hi: rng.uniform(lo, hi) * rng.choice([-1, 1])  # noqa: E731
     return CameraModel.create(
-        "australis", W, H, pixel_size_mm=(0.0078, 0.0079), c=25.0, xp=s(0.02, 0.1),
-        yp=s(0.02, 0.1), K1=s(5e-5, 1e-4), K2=s(5e-8, 1e-7), K3=s(5e-11, 1e-10),
-        P1=s(5e-6, 2e-5), P2=s(5e-6, 2e-5), b1=s(5e-5, 2e-4), b2=s(2e-5, 1e-4),
+        "australis",
+        W,
+        H,
+        pixel_size_mm=(0.0078, 0.0079),
+        c=25.0,
+        xp=s(0.02, 0.1),
+        yp=s(0.02, 0.1),
+        K1=s(5e-5, 1e-4),
+        K2=s(5e-8, 1e-7),
+        K3=s(5e-11, 1e-10),
+        P1=s(5e-6, 2e-5),
+        P2=s(5e-6, 2e-5),
+        b1=s(5e-5, 2e-4),
+        b2=s(2e-5, 1e-4),
     )
 
 
@@ -383,8 +437,9 @@ def test_australis_decentering_and_radial_signs_against_opencv():
         ({"P2": 4e-7}, {"p1": c * 4e-7}),
         ({"P1": 4e-7}, {"p2": -c * 4e-7}),
     ):
-        cam = CameraModel.create("australis", W, H, pixel_size_mm=(0.0078, 0.0078), c=c,
-                                 xp=0.05, yp=-0.04, **terms)
+        cam = CameraModel.create(
+            "australis", W, H, pixel_size_mm=(0.0078, 0.0078), c=c, xp=0.05, yp=-0.04, **terms
+        )
         cv = convert_camera_model(cam, "opencv", free=5).camera
         for name, value in expect.items():
             assert cv[name] == pytest.approx(value, rel=2e-3), (terms, cv)
@@ -395,8 +450,12 @@ def test_australis_decentering_and_radial_signs_against_opencv():
 
 # ---- every model: Jacobian, inverse, status ------------------------------------------------------
 def _all_cameras():
-    out = [random_camera("opencv"), random_camera("opencv_fisheye"), random_metashape(),
-           random_australis()]
+    out = [
+        random_camera("opencv"),
+        random_camera("opencv_fisheye"),
+        random_metashape(),
+        random_australis(),
+    ]
     out += [random_camera(m) for m in COLMAP_MODELS]
     return out
 
@@ -405,8 +464,11 @@ def _all_cameras():
 def test_jacobian_matches_central_differences(cam):
     # An independent numerical check of every analytic Jacobian.
     fisheye = cam.spec.projection == "equidistant"
-    pts = (fisheye_directions(40)[:, :2] / fisheye_directions(40)[:, 2:]) if fisheye else \
-        perspective_points(40)[:40]
+    pts = (
+        (fisheye_directions(40)[:, :2] / fisheye_directions(40)[:, 2:])
+        if fisheye
+        else perspective_points(40)[:40]
+    )
     j = project_jacobian(cam, pts)
     h = 1e-6
     for axis in (0, 1):
@@ -419,8 +481,11 @@ def test_jacobian_matches_central_differences(cam):
 @pytest.mark.parametrize("cam", _all_cameras(), ids=lambda c: c.model)
 def test_inverse_round_trip(cam):
     fisheye = cam.spec.projection == "equidistant"
-    ideal = (fisheye_directions()[:, :2] / fisheye_directions()[:, 2:]) if fisheye else \
-        perspective_points()
+    ideal = (
+        (fisheye_directions()[:, :2] / fisheye_directions()[:, 2:])
+        if fisheye
+        else perspective_points()
+    )
     img = project(cam, ideal)
     assert img.ok.all()
     back = unproject(cam, img.points)

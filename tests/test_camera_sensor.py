@@ -73,3 +73,25 @@ def test_mm_and_pixels_round_trip_with_y_up():
     np.testing.assert_allclose(s.pixels_to_mm(px), mm, atol=1e-12)
     np.testing.assert_allclose(s.mm_to_pixels(mm, "colmap"), px + 0.5)
     np.testing.assert_allclose(s.pixels_to_mm(px + 0.5, "colmap"), mm, atol=1e-12)
+
+
+def test_camera_from_sensor_places_the_principal_point_in_each_convention():
+    from distortion.camera import camera_from_sensor, project
+
+    s = Sensor.from_spec(pixels="3001x1999", pitch_um=5, principal_point_offset_mm=(0.1, 0.05))
+    c = 25.0  # mm -> f = 5000 px
+    cv = camera_from_sensor("opencv", s, c)
+    assert (cv["fx"], cv["cx"], cv["cy"]) == pytest.approx((5000.0, 1520.0, 989.0))
+    col = camera_from_sensor("colmap:SIMPLE_PINHOLE", s, c)
+    assert (col["f"], col["cx"], col["cy"]) == pytest.approx((5000.0, 1520.5, 989.5))
+    ms = camera_from_sensor("metashape", s, c)
+    assert (ms["f"], ms["b1"], ms["cx"], ms["cy"]) == pytest.approx((5000.0, 0.0, 20.0, -10.0))
+    au = camera_from_sensor("australis", s, c)
+    assert (au["c"], au["xp"], au["yp"]) == pytest.approx((25.0, 0.1, 0.05))
+    # the axis images at the principal point in every model (OpenCV pixels)
+    for cam in (cv, col, ms, au):
+        np.testing.assert_allclose(
+            project(cam, [[0.0, 0.0]], pixels="opencv").points[0], (1520.0, 989.0), atol=1e-9
+        )
+    centred = camera_from_sensor("colmap:PINHOLE", Sensor.from_spec("36x24", "6000x4000"), 50.0)
+    assert (centred["cx"], centred["cy"]) == (3000.0, 2000.0)  # COLMAP: centred cx = W/2

@@ -63,10 +63,7 @@ def _run(cmd: str, cwd: Path, monkeypatch) -> tuple[int, str]:
     monkeypatch.chdir(cwd)
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            rc = main(argv)
-        except SystemExit as e:  # --help / --version
-            rc = int(e.code or 0)
+        rc = main(argv)
     return rc, err.getvalue()
 
 

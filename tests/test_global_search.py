@@ -45,7 +45,6 @@ from raytrace.optimize import (
     optimize,
 )
 from raytrace.optimize.global_search import perturb
-from raytrace.optimize.solver import set_materials
 from raytrace.packing import pack
 from raytrace.paraxial import paraxial
 from raytrace.trace import trace_rays

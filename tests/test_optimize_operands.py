@@ -52,7 +52,10 @@ def test_distortion_slope_is_the_difference_of_two_planes(twinplex):
             twinplex,
             tuple(
                 Operand(
-                    "distortion", 0.0, 1.0, {"field": a, "object_s": S_PROJ, "plane": {"s_prime": p}}
+                    "distortion",
+                    0.0,
+                    1.0,
+                    {"field": a, "object_s": S_PROJ, "plane": {"s_prime": p}},
                 )
                 for p in PLANES
                 for a in ANGLES

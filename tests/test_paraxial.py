@@ -126,3 +126,30 @@ def test_afocal_lens_is_an_error():
     )
     with pytest.raises(LensError, match="afocal"):
         paraxial(lens)
+
+
+def test_object_space_na_follows_optiland():
+    """Object-space NA → entrance-pupil diameter: the project's convention is optiland's
+    (ObjectNAAperture.compute_epd, optiland 0.6.3): EPD = 2 |z_E0 − z_obj| tan(asin(NA/n)).
+    Checked against optiland's own paraxial EPD for the same lens and object."""
+    pytest.importorskip("optiland")
+    import sys
+    from dataclasses import replace
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import optiland_adapter as ola
+
+    from raytrace.files.library import load_lens
+    from raytrace.lens import Aperture
+
+    lens = replace(load_lens("cooke-triplet-f4"), object_distance=200.0)
+    lens = replace(lens, aperture=Aperture("na", 0.2))
+    ours = paraxial(lens)
+    op = ola.build_optic(lens)
+    op.set_aperture(aperture_type="objectNA", value=0.2)
+    theirs = float(op.paraxial.EPD())
+    assert ours.epd == pytest.approx(theirs, rel=1e-12)
+    assert ours.epd == pytest.approx(
+        2 * abs(ours.z_E0 - ours.z_object) * math.tan(math.asin(0.2)), rel=1e-14
+    )

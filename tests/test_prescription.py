@@ -357,7 +357,7 @@ def test_lens_error_is_converted_with_line() -> None:
     text = COOKE.replace("wavelength = 587.5618", "wavelength = 0.5876")
     err = _fails(text)
     assert err.line == _line_of(text, "wavelength =")
-    assert "wavelength must be in nm" in str(err)
+    assert "looks like micrometres" in str(err)  # raytrace.units.wavelength_nm
 
 
 def test_virtual_gaussian_image() -> None:

@@ -12,7 +12,8 @@ that does not converge gets a status code instead of a silent number (:data:`STA
 ``NOT_CONVERGED``, ``SINGULAR`` (zero Jacobian), ``FOLDED`` (the solution lies on a branch
 where the map has folded back — past the radius where the distortion turns round, so it is not
 the inverse a camera means: relative to the Jacobian at the centre, its Jacobian has an
-eigenvalue in the left half plane) or ``INVALID`` (non-finite input, Z ≤ 0, outside the model's domain).
+eigenvalue in the left half plane) or ``INVALID`` (non-finite input, Z ≤ 0, outside the
+model's domain).
 
 The models and their formulas (each written once, in the functions below):
 
@@ -1242,7 +1243,9 @@ def _native_px_scale(cam: CameraModel) -> tuple[float, float]:
 
 def _solve(cam, fn, target_a, target_b, p_a, p_b, image_side: str, tol_px: float, max_iter: int):
     """Newton: find p with fn(p) = target. ``image_side`` "residual" when the residual is in
-    native image units (unknown = ideal), "step" when the unknown is the image point."""
+    native image units (unknown = ideal), "step" when the unknown is the image point. The value
+    and Jacobian of an accepted trial step are kept for the next iteration (one evaluation of
+    the model per iteration when no backtracking is needed)."""
     n = target_a.size
     sx, sy = _native_px_scale(cam)
     status = np.full(n, NOT_CONVERGED, dtype=np.int8)
@@ -1256,14 +1259,28 @@ def _solve(cam, fn, target_a, target_b, p_a, p_b, image_side: str, tol_px: float
     else:
         mag = np.full(n, float(max(cam.width, cam.height)))
     floor = np.maximum(tol_px, ROUNDING_ULPS * _EPS * np.maximum(mag, 1.0))
+    val = np.full((2, n), np.nan)  # model value at p
+    jac = np.full((4, n), np.nan)  # its Jacobian
+    fresh = np.zeros(n, bool)  # val/jac belong to the current p
+
+    def evaluate(sel):
+        a, b, j = fn(pa[sel], pb[sel])
+        val[0, sel], val[1, sel] = a, b
+        for c in range(4):
+            jac[c, sel] = np.broadcast_to(j[c], np.shape(a))
+        fresh[sel] = True
+
     used = 0
     for it in range(max_iter + 1):
         idx = np.nonzero(active)[0]
         if idx.size == 0:
             break
         used = it
-        ca, cb, j = fn(pa[idx], pb[idx])
-        ra, rb = ca - target_a[idx], cb - target_b[idx]
+        stale = idx[~fresh[idx]]
+        if stale.size:
+            evaluate(stale)
+        ra, rb = val[0, idx] - target_a[idx], val[1, idx] - target_b[idx]
+        j = jac[:, idx]
         det = j[0] * j[3] - j[1] * j[2]
         bad = ~(np.isfinite(ra) & np.isfinite(rb) & np.isfinite(det))
         sing = ~bad & (np.abs(det) <= 1e-300)
@@ -1293,12 +1310,16 @@ def _solve(cam, fn, target_a, target_b, p_a, p_b, image_side: str, tol_px: float
         for _ in range(30):
             k = np.nonzero(pending)[0]
             ta, tb = pa[gi[k]] - lam[k] * step_a[k], pb[gi[k]] - lam[k] * step_b[k]
-            na, nb, _j = fn(ta, tb)
+            na, nb, nj = fn(ta, tb)
             nm = (na - target_a[gi[k]]) ** 2 + (nb - target_b[gi[k]]) ** 2
             accept = np.isfinite(nm) & (nm < merit[k])
-            acc = k[accept]
-            pa[gi[acc]], pb[gi[acc]] = ta[accept], tb[accept]
-            pending[acc] = False
+            acc = gi[k[accept]]
+            pa[acc], pb[acc] = ta[accept], tb[accept]
+            val[0, acc], val[1, acc] = na[accept], nb[accept]
+            for c in range(4):
+                jac[c, acc] = np.broadcast_to(nj[c], na.shape)[accept]
+            fresh[acc] = True
+            pending[k[accept]] = False
             lam[k[~accept]] *= 0.5
             if not np.any(pending):
                 break
@@ -1306,6 +1327,7 @@ def _solve(cam, fn, target_a, target_b, p_a, p_b, image_side: str, tol_px: float
         k = np.nonzero(pending)[0]
         pa[gi[k]] -= step_a[k]
         pb[gi[k]] -= step_b[k]
+        fresh[gi[k]] = False
     # a solution on a branch where the map has folded back is not the inverse: relative to the
     # Jacobian at the centre, M = J_centre⁻¹ J must keep both eigenvalues in the right half
     # plane (det M > 0 and trace M > 0); a mirrored far branch fails the trace
@@ -1314,8 +1336,7 @@ def _solve(cam, fn, target_a, target_b, p_a, p_b, image_side: str, tol_px: float
         r = [float(np.real(np.ravel(v)[0])) for v in fn(*_centre_point(cam, fn))[2]]
         rdet = r[0] * r[3] - r[1] * r[2]
         inv = (r[3] / rdet, -r[1] / rdet, -r[2] / rdet, r[0] / rdet)
-        j = fn(pa[ok], pb[ok])[2]
-        m = _mul(inv, j)
+        m = _mul(inv, tuple(jac[:, ok]))
         mdet = m[0] * m[3] - m[1] * m[2]
         folded = ~((mdet > 0) & (m[0] + m[3] > 0))
         status[ok[folded]] = FOLDED

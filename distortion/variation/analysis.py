@@ -66,6 +66,7 @@ from .models import (
     fs_predict,
 )
 
+
 @dataclass(frozen=True)
 class GEstimate:
     """g_ss' from one object plane (Eq. 6 rearranged: δr_ss' − δr_s = g (δr_s' − δr_s)).

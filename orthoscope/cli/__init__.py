@@ -175,6 +175,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         _silence_stdout()
         return 0
+    except OSError as e:  # the output itself cannot be written (full disk, /dev/full, EIO)
+        if debug:
+            raise
+        _silence_stdout()
+        print(f"{command}: error: cannot write the output: {e.strerror or e}", file=sys.stderr)
+        return 1
     except Exception as e:  # never a traceback for a person
         if debug:
             raise

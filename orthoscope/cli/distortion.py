@@ -179,7 +179,12 @@ def cmd_distortion(args) -> int:
 
 
 def _plots(res, cals, args, lens) -> None:
+    import numpy as np
+
     from .common import CliError
+
+    if (args.plot or args.plot_rotation or args.layout) and not np.isfinite(res.yp).any():
+        raise CliError("no field could be traced (see the table): there is nothing to plot")
 
     if args.plot_rotation and not cals:
         raise CliError("--plot-rotation (Fig. 4) needs --calibrate")

@@ -164,14 +164,14 @@ def _print_table(table: list[dict]) -> None:
 
 
 def _search_overrides(args) -> dict:
-    from raytrace.optimize import parse_duration
+    from raytrace.optimize import SpecError, parse_duration
 
     over = {}
     if args.time is not None:
         try:
             over["time_budget_s"] = parse_duration(args.time)
-        except Exception as e:  # SpecError: say it with the flag's name
-            raise CliError(f"--time {args.time}: {str(e).split(': ', 1)[-1]}") from None
+        except SpecError as e:  # say it with the flag's name
+            raise CliError(f"--time: {e}") from None
     for name, lo in (("seed", 0), ("starts", 1), ("workers", 1), ("hops", 0)):
         v = getattr(args, name)
         if v is not None:
@@ -280,10 +280,10 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
     from raytrace.files.native import write_lens
     from raytrace.optimize import global_optimize
 
-    starts = over.get("starts", spec.search.starts)
-    prog = GlobalProgress(starts, args.quiet or args.json)
+    spec = replace(spec, search=replace(spec.search, **over))  # the notes tell the settings
+    prog = GlobalProgress(spec.search.starts, args.quiet or args.json)
     try:
-        res = global_optimize(lens, spec, progress=prog, **over)
+        res = global_optimize(lens, spec, progress=prog)
     finally:
         prog.close()
     table = _operand_table(res.operands)
@@ -402,8 +402,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "written (--write-anyway writes it, marked)."
         ),
         epilog="Examples: orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
-        "-o my-twinplex.toml;  orthoscope optimize SPEC.toml --global --time 10m --seed 1 "
-        "-o my.toml",
+        "-o my-twinplex.toml;  orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
+        "--global --starts 2 --time 5s --seed 1 -o my-global.toml",
     )
     q.add_argument("spec", metavar="SPEC.toml", help="Design spec file (docs/spec.md).")
     q.add_argument(

@@ -18,7 +18,7 @@ def fmt(v: float | None, width: int = 12, prec: int = 4) -> str:
 
 def _cell(v: float, dec: int, signed: bool) -> str:
     if not math.isfinite(v):
-        return "nan"
+        return "-"
     s = f"{v:+.{dec}f}" if signed else f"{v:.{dec}f}"
     if signed and float(s) == 0.0:
         s = f"{0.0:.{dec}f}"

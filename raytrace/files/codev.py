@@ -40,9 +40,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
-from ..glass import lookup_glass, parse_glass_code
+from ..glass import lookup_glass, normalize_name, parse_glass_code, private_material
 from ..lens import Aperture, Field, Lens, Surface
-from ..materials import AIR, LAMBDA_D, Material, model_glass
+from ..materials import AIR, LAMBDA_D, Material
 from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
 
 #: CODE V treats an object distance of 1e10 or more as infinite.
@@ -51,7 +51,7 @@ CODEV_INFINITY = 1.0e10
 _DIM = {"M": 1.0, "MM": 1.0, "C": 10.0, "CM": 10.0, "I": 25.4, "IN": 25.4}
 _ASPH_LETTERS = "ABCDEFGHJ"  # r^4 ... r^20
 _IGNORED = set(
-    """LEN WTW WTF VUY VLY VUX VLX INI TEM PRE DER CCY THC GLC CUF KC AC BC CC DC EC FC GC HC
+    """LEN WTF VUY VLY VUX VLX INI DER CCY THC GLC CUF KC AC BC CC DC EC FC GC HC
     JC POL CLS TOL TOLE AUT SAV DES""".split()
 )
 _DECENTER = {"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE", "DAR", "BEN", "REV", "RET", "DEC", "TILT"}
@@ -178,18 +178,23 @@ class _SeqParser:
         h: dict[str, tuple] = {}
         xan = yan = xob = yob = None
         in_prv = False
+        prv_wl: tuple[list[float], int] | None = None
+        self.private: dict[str, Material] = {}
         rdm_seen = False
         for line, toks in _logical_lines(self.text):
             cmd, args = toks[0].upper(), toks[1:]
             if in_prv:
                 if cmd == "END":
                     in_prv = False
+                elif cmd == "PWL":
+                    prv_wl = (self.nums(args, "PWL", line), line)
+                else:
+                    self.private_glass(toks, prv_wl, line)
                 continue
             if cmd == "GO":
                 break
             if cmd == "PRV":
                 in_prv = True
-                self.warn(f"line {line}: PRV private glass definitions skipped")
                 continue
             if cmd == "RDM":
                 v = args[0].upper() if args else "Y"
@@ -215,6 +220,18 @@ class _SeqParser:
                 h["WL"] = (self.nums(args, "WL", line), line)
             elif cmd == "REF":
                 h["REF"] = (int(self.num(args, 0, "REF", line)), line)
+            elif cmd == "WTW":
+                h["WTW"] = (self.nums(args, "WTW", line), line)
+            elif cmd == "TEM":
+                h["TEM"] = (self.num(args, 0, "TEM", line), line)
+            elif cmd == "PRE":
+                v = self.num(args, 0, "PRE", line)
+                if v not in (1.0, 760.0):
+                    raise self.err(
+                        f"PRE {args[0][:20]}: a system pressure other than 1 atm is not "
+                        "supported; remove PRE (or set it to 1 atm) and save again",
+                        line,
+                    )
             elif cmd in ("YAN", "XAN", "YOB", "XOB"):
                 vals = (self.nums(args, cmd, line), line)
                 if cmd == "YAN":
@@ -331,12 +348,52 @@ class _SeqParser:
         else:
             cur.asph[_ASPH_LETTERS.index(cmd)] = self.num(args, 0, cmd, line)
 
+    def private_glass(self, toks: list[str], prv_wl, line: int) -> None:
+        """One private glass of a PRV block: ``'NAME' n1 n2 ...`` (indices at the PWL
+        wavelengths, nm) or ``'NAME' LAU A0 A1 A2 A3 A4 A5`` (Laurent:
+        n² = A0 + A1 λ² + A2 λ⁻² + A3 λ⁻⁴ + A4 λ⁻⁶ + A5 λ⁻⁸, λ in µm — AGF formula 1)."""
+        name = _unquote(toks[0])
+        args = toks[1:]
+        if not args:
+            raise self.err(f"PRV glass {name}: no data after the name", line)
+        key = args[0].upper()
+        if key == "LAU":
+            coef = tuple(self.nums(args[1:], f"PRV {name} LAU", line))
+            formula, rng = 1, (0.0, math.inf)
+        elif key[:1].isalpha():
+            raise self.err(
+                f"PRV glass {name}: the dispersion form {args[0]} is not supported (orthoscope "
+                "reads indices at the PWL wavelengths and LAU); give the glass as nd:vd or a "
+                "catalog name instead",
+                line,
+            )
+        else:
+            vals = self.nums(args, f"PRV {name}", line)
+            if prv_wl is None or len(prv_wl[0]) != len(vals):
+                raise self.err(
+                    f"PRV glass {name}: {len(vals)} indices need a PWL line with as many "
+                    f"wavelengths (got {0 if prv_wl is None else len(prv_wl[0])})",
+                    line,
+                )
+            pairs = sorted(zip(prv_wl[0], vals, strict=True))
+            lam = [p[0] / 1000.0 for p in pairs]
+            if len(set(lam)) != len(lam) or not all(v > 0.0 for v in vals):
+                raise self.err(f"PRV glass {name}: repeated wavelengths or indices <= 0", line)
+            coef = tuple(lam) + tuple(p[1] for p in pairs)
+            formula, rng = "spline", (pairs[0][0], pairs[-1][0])
+        try:
+            self.private[normalize_name(name)] = private_material(name, formula, coef, rng)
+        except ValueError as e:
+            raise self.err(f"PRV {e}", line) from None
+
     def material(self, g: tuple[str, int] | None, no: int) -> Material:
         if g is None:
             return AIR
         name, line = g
         if name.upper() == "AIR":
             return AIR
+        if normalize_name(name) in self.private:
+            return self.private[normalize_name(name)]
         code = parse_glass_code(name)
         if code is not None:
             return code
@@ -399,7 +456,7 @@ class _SeqParser:
         pims = [s for s in body if s.pim is not None]
         if pims and pims[-1] is not body[-1]:
             raise self.err("PIM (paraxial image solve) only on the last surface", pims[-1].pim)
-        # wavelength
+        # wavelengths (nm), weights, reference
         if "WL" in h:
             wls, wl_line = h["WL"]
             if "REF" in h:
@@ -410,12 +467,31 @@ class _SeqParser:
                 ref = (len(wls) + 1) // 2
                 if len(wls) > 1:
                     self.warn(f"no REF: the middle wavelength {wls[ref - 1]:g} nm is used")
-            wl = wls[ref - 1]
+            wts = [1.0] * len(wls)
+            if "WTW" in h:
+                given, wt_line = h["WTW"]
+                if len(given) != len(wls) or not all(w >= 0.0 for w in given):
+                    raise self.err(
+                        f"WTW: give one weight >= 0 per WL wavelength ({len(wls)})", wt_line
+                    )
+                wts = list(given)
         else:
-            wl, wl_line = LAMBDA_D, last_line
+            wls, wl_line, ref, wts = [LAMBDA_D], last_line, 1, [1.0]
             self.warn("no WL: the d line 587.5618 nm is used")
-        if not 200.0 <= wl <= 20000.0:
-            raise self.err(f"WL {wl:g}: wavelengths are in nm (200-20000)", wl_line)
+        from ..units import UnitError, wavelength_nm
+
+        for w in wls:
+            try:
+                wavelength_nm(w)
+            except UnitError as e:
+                raise self.err(f"WL {w:g}: {e} (CODE V wavelengths are in nm)", wl_line) from None
+        wl = wls[ref - 1]
+        temperature = None
+        if "TEM" in h:
+            t, t_line = h["TEM"]
+            if not -273.15 < t < 1000.0:
+                raise self.err(f"TEM {t!r}: temperature out of range (°C)", t_line)
+            temperature = t if t != 20.0 else None
         # aperture
         if "APER" not in h:
             raise self.err("no aperture: the file needs EPD, FNO or NAO", last_line)
@@ -464,6 +540,9 @@ class _SeqParser:
             field=fld,
             object_distance=od,
             wavelength=wl,
+            wavelengths=tuple(wls),
+            weights=tuple(wts),
+            temperature_c=temperature,
             source=f"imported from the CODE V file {Path(self.path).name}" if self.path else "",
             notes="",
             units="mm",

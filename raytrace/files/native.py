@@ -8,6 +8,12 @@ The format (documented for users in ``lenses/README.md``)::
     notes      = "free text"         # optional
     units      = "mm"                # only "mm"
     wavelength = 587.5618            # nm, optional (default: the helium d line)
+    # several wavelengths instead (nm), optional weights, and the reference (primary) one:
+    # wavelengths = [486.1327, 587.5618, 656.2725]
+    # weights = [1.0, 2.0, 1.0]
+    # reference_wavelength = 587.5618
+    # temperature_c = 25.0           # optional system environment (°C, atm): catalog glasses
+    # pressure_atm = 1.0             #   follow it by Schott's dn/dT model
     # scale_to_efl = 100.0           # optional: scale the whole lens to this paraxial EFL (mm)
     object   = { distance = "inf" }  # mm from the object plane to the first vertex (> 0), or "inf"
     aperture = { fnumber = 4.0 }     # exactly one of fnumber / epd (mm) / na
@@ -23,7 +29,9 @@ Per surface: ``r`` (radius, mm, ``"inf"`` = plane; positive when the centre of c
 after the vertex) or ``c`` (curvature, 1/mm); ``t`` (mm to the next vertex; for the last surface
 to the image plane, or ``"gaussian"`` to solve it to the paraxial image of the file's object);
 the medium after the surface: ``glass = "nd/vd"`` (model glass), ``n = 1.5`` (fixed index) or
-nothing / ``glass = "air"``; ``sd`` (semi-diameter, mm); ``stop = true``; ``k`` (conic);
+nothing / ``glass = "air"``; a glass defined here: ``glass = "NAME", catalog = "private",
+formula = 2, coefficients = [...]`` (a formula id of :mod:`raytrace.glass.formulas`, λ in µm;
+optional ``range_nm = [min, max]``); ``sd`` (semi-diameter, mm); ``stop = true``; ``k`` (conic);
 ``asph = [A4, A6, ...]``; ``label``. ``[object]`` may also carry ``glass`` / ``n`` for an
 immersed object space.
 
@@ -65,6 +73,9 @@ _SURFACE_KEYS: dict[str, tuple[str, ...]] = {
     "glass": ("glass", "material"),
     "catalog": ("catalog",),
     "model": ("model",),
+    "formula": ("formula",),
+    "coefficients": ("coefficients",),
+    "range_nm": ("range_nm",),
     "n": ("n", "index"),
     "sd": ("sd", "semi_diameter"),
     "k": ("k", "conic"),
@@ -79,13 +90,18 @@ _TOP_KEYS = (
     "notes",
     "units",
     "wavelength",
+    "wavelengths",
+    "weights",
+    "reference_wavelength",
+    "temperature_c",
+    "pressure_atm",
     "scale_to_efl",
     "object",
     "aperture",
     "field",
     "surfaces",
 )
-_OBJECT_KEYS = ("distance", "glass", "catalog", "model", "n")
+_OBJECT_KEYS = ("distance", "glass", "catalog", "model", "n", "formula", "coefficients", "range_nm")
 _APERTURE_KEYS = ("fnumber", "epd", "na")
 _FIELD_KEYS = ("angle", "height")
 
@@ -279,6 +295,7 @@ def _material(
     surface: int | None = None,
     catalog: Any = None,
     model: Any = None,
+    private: dict[str, Any] | None = None,
 ) -> Material:
     if glass is not None and n is not None:
         raise src.error('give either glass = "..." or n = <index>, not both', line, surface)
@@ -323,6 +340,9 @@ def _material(
                 raise src.error(f"glass {glass!r}: {e}", line, surface) from None
     if model is not None:
         raise src.error(f"model = {model!r} applies to an nd/vd model glass only", line, surface)
+    given = {k: v for k, v in (private or {}).items() if v is not None}
+    if given or (catalog or "").strip().lower() == "private":
+        return _private(src, text, catalog, given, line, surface)
     from ..glass import lookup_glass
 
     try:
@@ -334,6 +354,109 @@ def _material(
             f"glass {text!r} is not in the {catalog} catalog (found in {g.catalog})", line, surface
         )
     return g.material
+
+
+def _private(
+    src: _Source, name: str, catalog: Any, given: dict[str, Any], line, surface
+) -> Material:
+    """A glass defined in the file: catalog = "private", formula, coefficients, range_nm."""
+    from ..glass import PRIVATE, private_material
+
+    if (catalog or "").strip().lower() != PRIVATE or "formula" not in given or (
+        "coefficients" not in given
+    ):
+        raise src.error(
+            f'glass {name!r}: a glass defined in the file needs catalog = "{PRIVATE}", formula '
+            "and coefficients together (formula ids: raytrace.glass.FORMULAS)",
+            line,
+            surface,
+        )
+    formula = given["formula"]
+    if isinstance(formula, bool) or not isinstance(formula, int | str):
+        raise src.error(f"glass {name!r}: formula must be an id, got {formula!r}", line, surface)
+    coef = given["coefficients"]
+    if not isinstance(coef, list):
+        raise src.error(f"glass {name!r}: coefficients must be a list of numbers", line, surface)
+    coef = [_number(src, c, f"glass {name!r} coefficient", line, surface) for c in coef]
+    rng = given.get("range_nm", [0.0, "inf"])
+    if not isinstance(rng, list) or len(rng) != 2:
+        raise src.error(f"glass {name!r}: range_nm must be [min, max] in nm", line, surface)
+    lo, hi = (_number(src, v, "range_nm", line, surface, allow_inf=True) for v in rng)
+    try:
+        return private_material(name, formula, coef, (lo, hi))
+    except ValueError as e:
+        raise src.error(str(e), line, surface) from None
+
+
+def _wavelengths(src: _Source, data: dict[str, Any]) -> dict[str, Any]:
+    """The Lens keywords wavelength, wavelengths, weights from ``wavelength`` (one, the
+    reference) or ``wavelengths`` + optional ``weights`` + ``reference_wavelength``."""
+    from ..units import UnitError, wavelength_nm
+
+    def nm(value, key):
+        line = src.key_line("", key)
+        v = _number(src, value, f"{key} (nm)", line)
+        try:
+            return wavelength_nm(v, key)
+        except UnitError as e:
+            raise src.error(str(e), line) from None
+
+    one = nm(data["wavelength"], "wavelength") if "wavelength" in data else None
+    ref = (
+        nm(data["reference_wavelength"], "reference_wavelength")
+        if "reference_wavelength" in data
+        else None
+    )
+    if one is not None and ref is not None and one != ref:
+        raise src.error(
+            f"wavelength = {one!r} and reference_wavelength = {ref!r} disagree: give one",
+            src.key_line("", "reference_wavelength"),
+        )
+    ref = ref if ref is not None else one
+    if "wavelengths" not in data:
+        if "weights" in data:
+            raise src.error("weights need wavelengths = [...]", src.key_line("", "weights"))
+        return {"wavelength": LAMBDA_D if ref is None else ref}
+    wl_line = src.key_line("", "wavelengths")
+    raw = data["wavelengths"]
+    if not isinstance(raw, list) or not raw:
+        raise src.error("wavelengths must be a non-empty list of nm", wl_line)
+    wls = tuple(nm(v, "wavelengths") for v in raw)
+    if ref is None:
+        if len(wls) > 1:
+            raise src.error(
+                "several wavelengths need reference_wavelength = one of them (the primary "
+                "wavelength for paraxial data and solves)",
+                wl_line,
+            )
+        ref = wls[0]
+    if ref not in wls:
+        raise src.error(
+            f"the reference wavelength {ref!r} nm is not in wavelengths = {list(wls)}",
+            src.key_line("", "reference_wavelength") or wl_line,
+        )
+    weights: tuple[float, ...] = ()
+    if "weights" in data:
+        w_line = src.key_line("", "weights")
+        raw_w = data["weights"]
+        if not isinstance(raw_w, list) or len(raw_w) != len(wls):
+            raise src.error(f"weights must list one number per wavelength ({len(wls)})", w_line)
+        weights = tuple(_number(src, v, "weights", w_line) for v in raw_w)
+        if any(v < 0.0 for v in weights):
+            raise src.error("weights must not be negative", w_line)
+    return {"wavelength": ref, "wavelengths": wls, "weights": weights}
+
+
+def _environment(src: _Source, data: dict[str, Any]) -> dict[str, Any]:
+    out = {}
+    for key, lo, hi in (("temperature_c", -273.15, 1000.0), ("pressure_atm", 0.0, 100.0)):
+        if key in data:
+            line = src.key_line("", key)
+            v = _number(src, data[key], key, line)
+            if not lo <= v <= hi:
+                raise src.error(f"{key} = {v!r} is out of range ({lo:g} to {hi:g})", line)
+            out[key] = v
+    return out
 
 
 def _string(src: _Source, data: dict[str, Any], key: str, default: str | None) -> str | None:
@@ -407,11 +530,8 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
             f'units must be "mm" (the only unit supported), got {units!r}',
             src.key_line("", "units"),
         )
-    wavelength = LAMBDA_D
-    if "wavelength" in data:
-        wavelength = _number(
-            src, data["wavelength"], "wavelength (nm)", src.key_line("", "wavelength")
-        )
+    wl_kw = _wavelengths(src, data)
+    env_kw = _environment(src, data)
     scale_to = None
     if "scale_to_efl" in data:
         line = src.key_line("", "scale_to_efl")
@@ -456,6 +576,7 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
             src.key_line("object", "glass"),
             catalog=obj.get("catalog"),
             model=obj.get("model"),
+            private={k: obj.get(k) for k in ("formula", "coefficients", "range_nm")},
         )
 
     aperture = _choice(src, data, "aperture", _APERTURE_KEYS, Aperture)
@@ -479,7 +600,8 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
         aperture=aperture,
         field=fld,
         object_distance=object_distance,
-        wavelength=wavelength,
+        **wl_kw,
+        **env_kw,
         source=source,
         notes=lens_notes,
         units="mm",
@@ -580,6 +702,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
         no,
         catalog=_one_of(src, e, "catalog", K, line, no),
         model=_one_of(src, e, "model", K, line, no),
+        private={k: _one_of(src, e, k, K, line, no) for k in ("formula", "coefficients", "range_nm")},
     )
 
     t = _one_of(src, e, "t", K, line, no)
@@ -598,12 +721,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
     else:
         thickness = _number(src, t, "t (thickness, mm)", line, no)
         if last:
-            if thickness < 0.0:
-                raise src.error(
-                    f"the image distance (t of the last surface) must be >= 0, got {thickness!r}",
-                    line,
-                    no,
-                )
+            pass  # the image distance may be negative (a virtual image plane the file defines)
         elif not material.is_air and thickness <= 0.0:
             raise src.error(f"glass thickness must be positive, got t = {thickness!r}", line, no)
         elif thickness < 0.0:
@@ -837,7 +955,19 @@ def _material_cells(m: Material) -> list[tuple[str, str] | None]:
     if m.kind == "index":
         return [("n", repr(float(m.nd))), None]
     if m.kind == "catalog":
-        return [("glass", _toml_str(m.name)), ("catalog", _toml_str(m.catalog))]
+        cells = [("glass", _toml_str(m.name)), ("catalog", _toml_str(m.catalog))]
+        from ..glass import PRIVATE
+
+        if m.catalog == PRIVATE:
+            f = repr(m.formula) if isinstance(m.formula, int) else _toml_str(str(m.formula))
+            coef = "[" + ", ".join(repr(float(c)) for c in m.coefficients) + "]"
+            lo, hi = m.wavelength_range_nm
+            cells[1] = (
+                "catalog",
+                f'"{PRIVATE}", formula = {f}, coefficients = {coef}, '
+                f"range_nm = [{_fnum(lo)}, {_fnum(hi)}]",
+            )
+        return cells
     glass = ("glass", '"' + f"{float(m.nd)!r}/{float(m.vd)!r}" + '"')
     return [glass, ("model", _toml_str(m.model)) if m.model != "cauchy2" else None]
 
@@ -877,7 +1007,20 @@ def dumps(lens: Lens) -> str:
     if notes is not None:
         out.append(f"notes      = {_toml_str(notes)}\n")
     out.append('units      = "mm"\n')
-    out.append(f"wavelength = {_fnum(lens.wavelength)}   # nm\n\n")
+    if len(lens.wavelengths) == 1:
+        out.append(f"wavelength = {_fnum(lens.wavelength)}   # nm\n")
+    else:
+        out.append(
+            "wavelengths = [" + ", ".join(_fnum(w) for w in lens.wavelengths) + "]   # nm\n"
+        )
+        out.append(f"reference_wavelength = {_fnum(lens.wavelength)}   # nm\n")
+    if any(w != 1.0 for w in lens.weights):
+        out.append("weights = [" + ", ".join(_fnum(w) for w in lens.weights) + "]\n")
+    if lens.temperature_c is not None:
+        out.append(f"temperature_c = {_fnum(lens.temperature_c)}   # °C\n")
+    if lens.pressure_atm is not None:
+        out.append(f"pressure_atm = {_fnum(lens.pressure_atm)}   # atm\n")
+    out.append("\n")
 
     obj = [f"distance = {_fnum(lens.object_distance)}"]
     obj += [f"{c[0]} = {c[1]}" for c in _material_cells(lens.object_material) if c]

@@ -19,6 +19,7 @@ from .air import absolute_to_relative, air_index, relative_to_absolute
 from .catalog import (
     CATALOGS,
     DATA_FILE,
+    PRIVATE,
     CatalogGlass,
     GlassMatch,
     catalog_available,
@@ -28,6 +29,7 @@ from .catalog import (
     lookup_glass,
     normalize_name,
     parse_glass_code,
+    private_material,
     search_glass,
 )
 from .formulas import FORMULAS, evaluate
@@ -41,6 +43,7 @@ __all__ = [
     "GlassMatch",
     "OutOfRangeError",
     "OutOfRangeWarning",
+    "PRIVATE",
     "absolute_to_relative",
     "air_index",
     "catalog_available",
@@ -54,6 +57,7 @@ __all__ = [
     "lookup_glass",
     "normalize_name",
     "parse_glass_code",
+    "private_material",
     "relative_to_absolute",
     "search_glass",
 ]

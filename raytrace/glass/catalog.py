@@ -26,6 +26,8 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import PrescriptionError
 from ..materials import Material, model_glass
 
@@ -323,6 +325,53 @@ def lookup_glass(
             "with its nd and vd"
         )
     return cand[0]
+
+
+#: the ``catalog`` of a glass defined inside a lens file (CODE V ``PRV``, a TOML ``formula``)
+PRIVATE = "private"
+
+
+def private_material(
+    name: str,
+    formula_id: int | str,
+    coefficients,
+    wavelength_range_nm: tuple[float, float] = (0.0, math.inf),
+) -> Material:
+    """A glass defined in a lens file by a dispersion formula (:mod:`.formulas`) and its
+    coefficients (λ in µm): a ``kind="catalog"`` material of catalog :data:`PRIVATE`, relative
+    to air at 20 °C / 1 atm, with nd and vd computed from the formula. ``ValueError`` (naming
+    the glass) for an unknown formula, no coefficients, or data giving no real index at the d,
+    F and C lines."""
+    from ..materials import LAMBDA_C, LAMBDA_D, LAMBDA_F
+    from .formulas import FORMULAS, evaluate
+
+    if formula_id not in FORMULAS:
+        raise ValueError(
+            f"glass {name}: unknown dispersion formula {formula_id!r}; known: "
+            f"{', '.join(map(str, FORMULAS))}"
+        )
+    coef = tuple(float(c) for c in coefficients)
+    if not coef or not all(math.isfinite(c) for c in coef):
+        raise ValueError(f"glass {name}: the formula needs finite coefficients")
+    with np.errstate(all="ignore"):
+        nd, nf, nc = (
+            float(evaluate(formula_id, coef, w / 1000.0)) for w in (LAMBDA_D, LAMBDA_F, LAMBDA_C)
+        )
+    if not all(math.isfinite(v) and v > 0.0 for v in (nd, nf, nc)):
+        raise ValueError(f"glass {name}: the formula gives no real index at 486-656 nm")
+    lo, hi = (float(v) for v in wavelength_range_nm)
+    if not lo < hi:
+        raise ValueError(f"glass {name}: the wavelength range must be (min, max), got {lo}, {hi}")
+    return Material(
+        "catalog",
+        nd,
+        (nd - 1.0) / (nf - nc) if nf != nc else math.inf,
+        name=name,
+        catalog=PRIVATE,
+        formula=formula_id,
+        coefficients=coef,
+        wavelength_range_nm=(lo, hi),
+    )
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,10 @@ id            equation (λ in µm; coefficients in the order listed)
 "cauchy"      Cauchy power series (refractiveindex.info formula 5): n = C1 + Σ C(2i) λ^C(2i+1)
 "tabulated"   a table n(λ): coefficients λ1..λN, n1..nN (λ ascending); piecewise-linear
               interpolation in λ (numpy.interp), held constant beyond the table's ends
+"spline"      a table n(λ) (same coefficients) through a cubic spline in λ with not-a-knot
+              ends, extrapolated with the end cubics — the interpolation ray-optics applies to
+              CODE V private glasses (scipy ``interp1d(kind="cubic")``); 3 points: the
+              parabola, 2: the line, 1: a constant
 ============  ==========================================================================
 
 refractiveindex.info formula 7 is the Herzberger formula (AGF 3, same coefficient order) and is
@@ -163,6 +167,35 @@ def _tabulated(lam, c):
     return np.interp(lam, np.asarray(c[:m]), np.asarray(c[m:]))
 
 
+def _spline(lam, c):
+    m = len(c) // 2
+    x = np.asarray(c[:m], dtype=float)
+    y = np.asarray(c[m:], dtype=float)
+    if m <= 3:
+        poly = np.polyfit(x, y, m - 1) if m > 1 else np.array([y[0]])
+        return np.polyval(poly, lam)
+    h = np.diff(x)
+    a = np.zeros((m, m))
+    r = np.zeros(m)
+    for i in range(1, m - 1):  # continuity of the first derivative (second derivatives M)
+        a[i, i - 1 : i + 2] = h[i - 1], 2.0 * (h[i - 1] + h[i]), h[i]
+        r[i] = 6.0 * ((y[i + 1] - y[i]) / h[i] - (y[i] - y[i - 1]) / h[i - 1])
+    # not-a-knot: the third derivative is continuous at the second and the last-but-one point
+    a[0, :3] = h[1], -(h[0] + h[1]), h[0]
+    a[-1, -3:] = h[-1], -(h[-2] + h[-1]), h[-2]
+    mm = np.linalg.solve(a, r)
+    j = np.clip(np.searchsorted(x, lam, side="right") - 1, 0, m - 2)
+    hj = h[j]
+    t1 = x[j + 1] - lam
+    t0 = lam - x[j]
+    return (
+        mm[j] * t1**3 / (6.0 * hj)
+        + mm[j + 1] * t0**3 / (6.0 * hj)
+        + (y[j] / hj - mm[j] * hj / 6.0) * t1
+        + (y[j + 1] / hj - mm[j + 1] * hj / 6.0) * t0
+    )
+
+
 @dataclass(frozen=True)
 class Formula:
     """One dispersion formula: ``id``, its ``name``, the ``equation`` as text and the
@@ -231,6 +264,12 @@ FORMULAS: dict[int | str, Formula] = {
             "tabulated n(λ)",
             "piecewise-linear interpolation in λ of the table (λ1..λN, n1..nN)",
             _tabulated,
+        ),
+        Formula(
+            "spline",
+            "tabulated n(λ), cubic spline",
+            "not-a-knot cubic spline in λ through the table (λ1..λN, n1..nN)",
+            _spline,
         ),
     )
 }

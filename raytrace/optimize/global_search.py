@@ -276,10 +276,16 @@ class _Start:
         if self.k == 0:
             return x0, g0
         efl = paraxial(self.lens).efl
-        sigma = self.spec.search.perturbation
-        x = perturb(x0, self.cont, efl, self.rng, sigma, self.lo, self.hi)
         g = [int(self.rng.integers(len(pool))) for pool in self.pools]
-        return x, g
+        # a perturbed start that cannot be traced (a chief ray fails, an impossible lens) is
+        # drawn again with half the perturbation, up to 8 times, then the lens's own values
+        sigma = self.spec.search.perturbation
+        for _ in range(8):
+            x = perturb(x0, self.cont, efl, self.rng, sigma, self.lo, self.hi)
+            if math.isfinite(_merit_of(design(self.lens, self.spec, x, g, self.pools), self.spec)):
+                return x, g
+            sigma *= 0.5
+        return x0, g
 
     def fit_glasses(self, x: np.ndarray, g: list[int]) -> tuple[np.ndarray, list[int]]:
         """Glass fitting: nd / vd model glasses optimized, then snapped to real glasses."""
@@ -522,8 +528,13 @@ def global_optimize(
         final = design(lens, spec, bo.x, g, pools)
         if not stopped and continuous(spec):
             try:
-                pol = optimize(_base(lens, spec, bo.x, g, pools), spec)
+                pol = optimize(
+                    _base(lens, spec, bo.x, g, pools),
+                    spec,
+                    stop=lambda: "time" if time.time() > deadline else None,
+                )
                 evaluations += pol.evaluations
+                stopped = pol.stopped
                 if pol.merit < _merit_of(final, spec):
                     final = pol.lens
             except KeyboardInterrupt:

@@ -165,6 +165,12 @@ def object_distance_for_scale(lens: Lens, n: float, wavelength: float | None = N
     if not (math.isfinite(n) and n > 0):
         raise TraceError(f"image scale {n!r}x: N must be a positive number (12x: m0 = -1/12)")
     par = paraxial(lens, math.inf, wavelength)
+    if not par.efl > 0:
+        raise TraceError(
+            f"{lens.name}: an image scale {n:g}x (real object, magnification -1/{n:g}) needs a "
+            f"positive focal length; this lens has EFL {par.efl:.6g} mm — give the object as "
+            "object_distance (mm) instead"
+        )
     s = object_distance_for_magnification(par.efl, -1.0 / n)
     return object_distance_for_s(lens, s, wavelength, _par=par)
 

@@ -341,16 +341,19 @@ def _wl(value, what: str = "wavelength") -> float | None:
 
 
 def resolve_wavelengths(lens: Lens, wavelengths) -> tuple[float, ...]:
-    """``wavelengths`` (nm; a sequence, a number, or ``"lens"`` for the lens's own) as a tuple
-    of checked floats."""
-    if isinstance(wavelengths, str):
-        if wavelengths.strip().lower() != "lens":
-            return (_wl(wavelengths, "wavelengths"),)
+    """``wavelengths`` (nm; a sequence, a number, a string such as ``"F,d,C"`` or
+    ``"486.1,656.3"``, or ``"lens"`` for the lens's own) as a tuple of checked floats
+    (:func:`raytrace.units.wavelengths_nm`)."""
+    from ..units import UnitError, wavelengths_nm
+
+    if isinstance(wavelengths, str) and wavelengths.strip().lower() == "lens":
         return tuple(lens.wavelengths)
-    vals = np.atleast_1d(np.asarray(wavelengths, dtype=object)).ravel()
-    if vals.size == 0:
-        raise TraceError("wavelengths: give at least one wavelength (nm)")
-    return tuple(_wl(v, "wavelengths") for v in vals)
+    if not isinstance(wavelengths, str):
+        wavelengths = np.atleast_1d(np.asarray(wavelengths, dtype=object)).ravel().tolist()
+    try:
+        return wavelengths_nm(wavelengths)
+    except UnitError as e:
+        raise TraceError(str(e)) from None
 
 
 def aim(

@@ -1,0 +1,277 @@
+"""Calibration files: OpenCV YAML/JSON (``cv2.FileStorage`` is the referee of the layout),
+COLMAP ``cameras.txt`` (pycolmap reads and writes it), Metashape and PhotoScan XML, and the
+Australis-style text defined in distortion/camera/files.py.
+
+Sources: the files OpenCV and pycolmap write themselves; the Metashape calibration XML layout
+(<calibration> with projection, width, height, f, cx, cy, b1, b2, k1..k4, p1..p4) as in
+Agisoft's exports and the chunk/sensor layout quoted in easyidp 2.0.4 ``metashape.py``
+(``_decode_sensor_tag`` docstring); the older PhotoScan layout with fx, fy and an absolute cx.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from distortion.camera import (
+    OPENCV_ORDERS,
+    CameraModel,
+    colmap_line,
+    format_calibration,
+    read_calibration,
+    read_colmap_cameras,
+    write_calibration,
+)
+from distortion.errors import DataError
+from raytrace.errors import OutputError
+
+W, H = 3001, 1999
+
+
+def _opencv(n=14):
+    vals = dict(
+        k1=-0.08,
+        k2=0.02,
+        p1=4e-4,
+        p2=-6e-4,
+        k3=-0.003,
+        k4=0.004,
+        k5=-0.002,
+        k6=0.001,
+        s1=3e-4,
+        s2=-2e-4,
+        s3=-4e-4,
+        s4=1e-4,
+        tau_x=0.012,
+        tau_y=-0.008,
+    )
+    return CameraModel.create(
+        "opencv",
+        W,
+        H,
+        fx=3210.25,
+        fy=3190.5,
+        cx=1523.4,
+        cy=987.6,
+        **{k: vals[k] for k in OPENCV_ORDERS[n]},
+    )
+
+
+FISHEYE = CameraModel.create(
+    "opencv_fisheye",
+    W,
+    H,
+    fx=900.0,
+    fy=905.0,
+    cx=1523.4,
+    cy=987.6,
+    alpha=0.002,
+    k1=0.03,
+    k2=-0.006,
+    k3=0.001,
+    k4=-1e-4,
+)
+
+
+@pytest.mark.parametrize("ext", ["yml", "json"])
+@pytest.mark.parametrize(
+    "cam",
+    [_opencv(n) for n in OPENCV_ORDERS] + [FISHEYE],
+    ids=lambda c: f"{c.model}{len(c.params)}-{sum(v != 0 for v in c.params)}",
+)
+def test_opencv_files_round_trip_and_cv2_reads_them(tmp_path, ext, cam):
+    path = tmp_path / f"cal.{ext}"
+    write_calibration(cam, path)
+    back = read_calibration(path)
+    assert back == cam
+    cv2 = pytest.importorskip("cv2")
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
+    k = fs.getNode("camera_matrix").mat()
+    d = fs.getNode("distortion_coefficients").mat().ravel()
+    assert int(fs.getNode("image_width").real()) == W
+    fs.release()
+    p = cam.as_dict()
+    assert k[0, 0] == p["fx"] and k[1, 1] == p["fy"] and k[0, 2] == p["cx"]
+    if cam.model == "opencv":
+        assert d.size == cam.n_opencv_coefficients
+        np.testing.assert_array_equal(d, [p[n] for n in OPENCV_ORDERS[d.size]])
+    else:
+        assert k[0, 1] == p["alpha"] * p["fx"]  # cv2.fisheye keeps the skew as alpha * fx
+
+
+@pytest.mark.parametrize("ext", ["yml", "json"])
+def test_we_read_what_cv2_filestorage_writes(tmp_path, ext):
+    cv2 = pytest.importorskip("cv2")
+    path = tmp_path / f"cv.{ext}"
+    k = np.array([[3210.25, 0.0, 1523.4], [0.0, 3190.5, 987.6], [0.0, 0.0, 1.0]])
+    d = np.array([[-0.08, 0.02, 4e-4, -6e-4, -0.003, 0.004, -0.002, 0.001]])
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    fs.write("image_width", W)
+    fs.write("image_height", H)
+    fs.write("camera_matrix", k)
+    fs.write("distortion_coefficients", d)
+    fs.release()
+    cam = read_calibration(path)
+    assert cam.model == "opencv" and (cam.width, cam.height) == (W, H)
+    assert cam["fx"] == 3210.25 and cam["cy"] == 987.6 and cam["k6"] == 0.001
+    assert cam.n_opencv_coefficients == 8
+
+
+def test_colmap_cameras_txt(tmp_path):
+    text = (
+        "# Camera list with one line of data per camera:\n"
+        "1 SIMPLE_RADIAL 3001 1999 3200 1500.5 999.5 -0.05\n"
+        "\n"
+        "7 OPENCV_FISHEYE 3001 1999 900 905 1500.5 999.5 0.03 -0.006 0.001 -0.0001\n"
+    )
+    (tmp_path / "cameras.txt").write_text(text)
+    cams = read_colmap_cameras(tmp_path / "cameras.txt")
+    assert sorted(cams) == [1, 7]
+    assert cams[1].model == "colmap:SIMPLE_RADIAL" and cams[1]["k"] == -0.05
+    with pytest.raises(DataError, match="holds 2 cameras"):
+        read_calibration(tmp_path / "cameras.txt")
+    assert read_calibration(tmp_path / "cameras.txt", camera_id=7)["k4"] == -0.0001
+    (tmp_path / "bad.txt").write_text("1 OPENCV 3001 1999 1 2 3\n")
+    with pytest.raises(DataError, match=r"bad.txt:1: COLMAP OPENCV takes 8 parameters"):
+        read_calibration(tmp_path / "bad.txt", format="colmap")
+    (tmp_path / "bad2.txt").write_text("# x\n1 OPENCVV 3001 1999 1 2 3\n")
+    with pytest.raises(DataError, match=r"bad2.txt:2: unknown camera model.*did you mean"):
+        read_calibration(tmp_path / "bad2.txt", format="colmap")
+
+
+def test_colmap_line_is_the_smallest_exact_model():
+    cam = _opencv(5).replace(k3=0.0)
+    assert colmap_line(cam).split()[1] == "OPENCV"
+    assert colmap_line(_opencv(5)).split()[1] == "FULL_OPENCV"
+    line = colmap_line(_opencv(4).replace(p1=0.0, p2=0.0, fy=3210.25, k2=0.0))
+    assert line.split()[1] == "SIMPLE_RADIAL"
+    # COLMAP pixels: cx is OpenCV's + 0.5
+    assert float(line.split()[5]) == 1523.9
+
+
+def test_pycolmap_written_cameras_txt_reads_back(tmp_path):
+    pycolmap = pytest.importorskip("pycolmap")
+    rec = pycolmap.Reconstruction()
+    cam = pycolmap.Camera(
+        model="FULL_OPENCV",
+        width=W,
+        height=H,
+        params=[
+            3210.25,
+            3190.5,
+            1523.9,
+            988.1,
+            -0.08,
+            0.02,
+            4e-4,
+            -6e-4,
+            -0.003,
+            0.004,
+            -0.002,
+            0.001,
+        ],
+    )
+    cam.camera_id = 3
+    rec.add_camera(cam)
+    rec.write_text(str(tmp_path))
+    ours = read_calibration(tmp_path / "cameras.txt")
+    assert ours.model == "colmap:FULL_OPENCV"
+    np.testing.assert_array_equal(ours.params, cam.params)
+
+
+def test_metashape_xml_current_and_photoscan_legacy(tmp_path):
+    cam = CameraModel.create(
+        "metashape",
+        W,
+        H,
+        f=3200.0,
+        cx=23.4,
+        cy=-11.7,
+        b1=12.0,
+        b2=1.5,
+        k1=-0.08,
+        k2=0.02,
+        k3=-0.003,
+        k4=2e-4,
+        p1=-6e-4,
+        p2=4e-4,
+        p3=0.1,
+        p4=-0.1,
+    )
+    write_calibration(cam, tmp_path / "m.xml")
+    assert read_calibration(tmp_path / "m.xml") == cam
+    text = format_calibration(cam.replace(p3=0.0, p4=0.0, k4=0.0), "photoscan")
+    assert "<fx>3212.0</fx>" in text and "<fy>3200.0</fy>" in text
+    assert f"<cx>{W / 2 + 23.4!r}</cx>" in text and "<skew>1.5</skew>" in text
+    (tmp_path / "p.xml").write_text(text)
+    back = read_calibration(tmp_path / "p.xml")
+    np.testing.assert_allclose(
+        back.params, cam.replace(p3=0.0, p4=0.0, k4=0.0).params, rtol=1e-15, atol=1e-12
+    )
+
+
+def test_metashape_calibration_inside_a_chunk_xml(tmp_path):
+    # the sensor layout quoted in easyidp 2.0.4 metashape.py (_decode_sensor_tag)
+    xml = """<?xml version="1.0" encoding="UTF-8"?>
+<document><chunk><sensors>
+  <sensor id="0" label="FC6310S" type="frame">
+    <resolution width="5472" height="3648"/>
+    <property name="pixel_width" value="0.0024"/>
+    <calibration type="frame" class="initial"><resolution width="5472" height="3648"/>
+      <f>3600</f></calibration>
+    <calibration type="frame" class="adjusted">
+      <resolution width="5472" height="3648"/>
+      <f>3648.2</f><cx>12.5</cx><cy>-7.25</cy>
+      <k1>0.002</k1><k2>-0.01</k2><k3>0.012</k3>
+      <p1>-0.0011379213280524752</p1><p2>-0.0014457166089453365</p2>
+    </calibration>
+  </sensor>
+</sensors></chunk></document>
+"""
+    (tmp_path / "cameras.xml").write_text(xml)
+    cam = read_calibration(tmp_path / "cameras.xml")
+    assert (cam.width, cam.height) == (5472, 3648)
+    assert cam["f"] == 3648.2 and cam["cx"] == 12.5 and cam["p2"] == -0.0014457166089453365
+    (tmp_path / "fe.xml").write_text(
+        "<calibration><projection>fisheye</projection><width>10</width><height>10</height>"
+        "<f>5</f></calibration>"
+    )
+    with pytest.raises(DataError, match="only frame cameras"):
+        read_calibration(tmp_path / "fe.xml")
+
+
+def test_australis_text_round_trip_and_errors(tmp_path):
+    cam = CameraModel.create(
+        "australis",
+        W,
+        H,
+        pixel_size_mm=(0.0078, 0.0079),
+        c=25.0,
+        xp=0.05,
+        yp=-0.04,
+        K1=8e-5,
+        K2=-6e-8,
+        K3=7e-11,
+        P1=1e-5,
+        P2=-2e-5,
+        b1=1e-4,
+        b2=-5e-5,
+    )
+    write_calibration(cam, tmp_path / "cam.txt", format="australis")
+    assert read_calibration(tmp_path / "cam.txt") == cam  # detected by its 'format' line
+    (tmp_path / "bad.aus").write_text("format orthoscope-australis 1\nimage_width 10\nQ1 3\n")
+    with pytest.raises(DataError, match=r"bad.aus:3: unknown name 'Q1'"):
+        read_calibration(tmp_path / "bad.aus")
+
+
+def test_writers_refuse_to_overwrite_and_to_lose_terms(tmp_path):
+    cam = _opencv(5)
+    write_calibration(cam, tmp_path / "a.yml")
+    with pytest.raises(OutputError, match="exists"):
+        write_calibration(cam, tmp_path / "a.yml")
+    write_calibration(cam.replace(k1=-0.07), tmp_path / "a.yml", overwrite=True)
+    assert read_calibration(tmp_path / "a.yml")["k1"] == -0.07
+    with pytest.raises(DataError, match="convert_camera_model"):
+        write_calibration(_opencv(14), tmp_path / "m.xml")  # prism/tilt: a refit, not a rename
+    with pytest.raises(DataError, match="format"):
+        write_calibration(cam, tmp_path / "a.cal")
