@@ -98,9 +98,7 @@ class LateralColour:
 
     def __repr__(self) -> str:
         with np.errstate(invalid="ignore"):
-            worst = (
-                float(np.nanmax(np.abs(self.linear))) if np.isfinite(self.linear).any() else 0.0
-            )
+            worst = float(np.nanmax(np.abs(self.linear))) if np.isfinite(self.linear).any() else 0.0
         w1, w2 = self.wavelengths
         return (
             f"LateralColour({self.name!r}, y'({w1:g} nm) - y'({w2:g} nm), {self.fields.size} "

@@ -48,6 +48,7 @@ _API: dict[str, str] = {
     # real rays
     "chief_rays": "raytrace.trace",
     "ChiefRays": "raytrace.trace",
+    "ChromaticChiefRays": "raytrace.trace",
     "trace_rays": "raytrace.trace",
     "RayBatch": "raytrace.trace",
     "ray_fan": "raytrace.trace",
@@ -57,6 +58,14 @@ _API: dict[str, str] = {
     # distortion (Pestrecov 1958)
     "characteristic_distortion": "distortion.characteristic",
     "CharacteristicDistortion": "distortion.characteristic",
+    "ChromaticDistortion": "distortion.characteristic",
+    # colour
+    "lateral_colour": "distortion.colour",
+    "LateralColour": "distortion.colour",
+    "focal_shift": "distortion.colour",
+    "FocalShift": "distortion.colour",
+    "lookup_glass": "raytrace.glass",
+    "search_glass": "raytrace.glass",
     "calibrate": "distortion.calibration",
     "CalibrationResult": "distortion.calibration",
     "compensate": "distortion.compensation",
@@ -64,6 +73,11 @@ _API: dict[str, str] = {
     "DistortionCurve": "distortion.curve",
     "make_curve": "distortion.curve",
     "read_distortion_table": "distortion.tablefile",
+    # named definitions (F-tan(theta), F-theta, fisheye) and pupils / telecentricity
+    "projection_distortion": "distortion.definitions",
+    "ProjectionDistortion": "distortion.definitions",
+    "pupil_analysis": "distortion.telecentricity",
+    "PupilAnalysis": "distortion.telecentricity",
     # variation with object distance (Fraser & Shortis 1992) and coefficients
     "trace_variation": "distortion.variation",
     "analyze_variation": "distortion.variation",
@@ -92,12 +106,19 @@ _API: dict[str, str] = {
     "plot_planes": "orthoscope.plots.distortion",
     "plot_rotation": "orthoscope.plots.distortion",
     "plot_layout": "orthoscope.plots.layout",
+    "plot_focal_shift": "orthoscope.plots.colour",
+    "plot_lateral_colour": "orthoscope.plots.colour",
+    "plot_distortion_by_wavelength": "orthoscope.plots.colour",
     "plot_profiles": "orthoscope.plots.variation",
     "plot_g": "orthoscope.plots.variation",
     "plot_ray_fan": "orthoscope.plots.rays",
     "plot_spot": "orthoscope.plots.rays",
     "save_figure": "orthoscope.plots.save",
     "plot_glass_map": "orthoscope.plots.glassmap",
+    "plot_pupils": "orthoscope.plots.telecentricity",
+    "plot_chief_ray_angle": "orthoscope.plots.telecentricity",
+    "plot_distortion_slope": "orthoscope.plots.telecentricity",
+    "plot_entrance_pupil": "orthoscope.plots.telecentricity",
     # errors
     "OrthoscopeError": "raytrace.errors",
     "PrescriptionError": "raytrace.errors",
@@ -153,12 +174,19 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         select_camera_model,
         write_calibration,
     )
-    from distortion.characteristic import CharacteristicDistortion, characteristic_distortion
+    from distortion.characteristic import (
+        CharacteristicDistortion,
+        ChromaticDistortion,
+        characteristic_distortion,
+    )
     from distortion.coefficients import fit_radial, opencv_model
+    from distortion.colour import FocalShift, LateralColour, focal_shift, lateral_colour
     from distortion.compensation import CompensationResult, compensate
     from distortion.curve import DistortionCurve, make_curve
+    from distortion.definitions import ProjectionDistortion, projection_distortion
     from distortion.errors import CalibrationError, DataError
     from distortion.tablefile import read_distortion_table
+    from distortion.telecentricity import PupilAnalysis, pupil_analysis
     from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
     from raytrace.errors import (
         LensError,
@@ -169,12 +197,14 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     )
     from raytrace.files import convert, save_lens
     from raytrace.files.library import list_lenses, load_lens
+    from raytrace.glass import lookup_glass, search_glass
     from raytrace.lens import Aperture, Field, Lens, Surface
     from raytrace.materials import Material, fixed_index, model_glass
     from raytrace.optimize import global_optimize, optimize, read_spec
     from raytrace.paraxial import ImagePlane, ParaxialResult, paraxial, pestrecov_constants
     from raytrace.trace import (
         ChiefRays,
+        ChromaticChiefRays,
         RayBatch,
         RayFan,
         SpotDiagram,
@@ -184,6 +214,11 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         trace_rays,
     )
 
+    from .plots.colour import (
+        plot_distortion_by_wavelength,
+        plot_focal_shift,
+        plot_lateral_colour,
+    )
     from .plots.distortion import (
         plot_calibrated,
         plot_characteristic,
@@ -194,5 +229,11 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from .plots.glassmap import plot_glass_map
     from .plots.layout import plot_layout
     from .plots.rays import plot_ray_fan, plot_spot
+    from .plots.telecentricity import (
+        plot_chief_ray_angle,
+        plot_distortion_slope,
+        plot_entrance_pupil,
+        plot_pupils,
+    )
     from .plots.variation import plot_g, plot_profiles
     from .plots.save import save_figure

@@ -15,6 +15,7 @@ with ``c`` the curvature (1/mm), ``k`` the conic constant and ``aspheric = (A4, 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -267,26 +268,16 @@ class Lens:
         column j + 1 the medium after surface j. The one place indices of a lens are computed
         (packing and paraxial optics use it). Catalog glasses are relative to the air of the
         lens's environment (``temperature_c``, ``pressure_atm``; see the class docstring)."""
-        from .units import wavelength_nm
-
-        raw = self.wavelength if wavelengths is None else wavelengths
-        wl = np.array(
-            [wavelength_nm(float(w)) for w in np.atleast_1d(np.asarray(raw, dtype=float))]
-        )
-        env = self.environment
-        mats = [self.object_material, *(s.material for s in self.surfaces)]
-        out = np.empty((wl.size, len(mats)))
-        done: dict[Material, np.ndarray] = {}
-        for j, m in enumerate(mats):
-            n = done.get(m)
-            if n is None:
-                if m.kind == "catalog" and not m.in_range(wl):
-                    n = self._out_of_range(m, wl, j, env)
-                else:
-                    n = _index(m, wl, env)
-                done[m] = n
-            out[:, j] = n
-        return out
+        if wavelengths is None:
+            key: tuple[float, ...] = (self.wavelength,)
+        elif isinstance(wavelengths, float | int):
+            key = (float(wavelengths),)
+        else:
+            key = tuple(float(w) for w in np.atleast_1d(np.asarray(wavelengths, dtype=float)))
+        lo, hi = _catalog_span(self)
+        if all(lo <= w <= hi for w in key):
+            return _indices(self, key)
+        return _indices.__wrapped__(self, key)  # out of a glass's range: warn every time
 
     def with_image_distance(self, thickness: float) -> Lens:
         """A copy whose last thickness (last vertex to image plane) is ``thickness``."""
@@ -326,6 +317,39 @@ class Lens:
             field=fld,
             object_distance=self.object_distance * factor,
         )
+
+
+@functools.lru_cache(maxsize=512)
+def _catalog_span(lens: Lens) -> tuple[float, float]:
+    """The wavelength span (nm) inside every catalog glass's data range (cached per lens)."""
+    lo, hi = 0.0, math.inf
+    for m in (lens.object_material, *(s.material for s in lens.surfaces)):
+        if m.kind == "catalog":
+            lo, hi = max(lo, m.wavelength_range_nm[0]), min(hi, m.wavelength_range_nm[1])
+    return lo, hi
+
+
+@functools.lru_cache(maxsize=512)
+def _indices(lens: Lens, wavelengths: tuple[float, ...]) -> np.ndarray:
+    """:meth:`Lens.indices` for a tuple of wavelengths (nm), cached per lens (read-only)."""
+    from .units import wavelength_nm
+
+    wl = np.array([wavelength_nm(w) for w in wavelengths])
+    env = lens.environment
+    mats = [lens.object_material, *(s.material for s in lens.surfaces)]
+    out = np.empty((wl.size, len(mats)))
+    done: dict[Material, np.ndarray] = {}
+    for j, m in enumerate(mats):
+        n = done.get(m)
+        if n is None:
+            if m.kind == "catalog" and not m.in_range(wl):
+                n = lens._out_of_range(m, wl, j, env)
+            else:
+                n = _index(m, wl, env)
+            done[m] = n
+        out[:, j] = n
+    out.flags.writeable = False
+    return out
 
 
 def _index(m: Material, wl: np.ndarray, env: tuple[float, float] | None) -> np.ndarray:
@@ -412,11 +436,24 @@ def validate(lens: Lens) -> None:
     check_physical(lens)
 
 
+def check_file_lens(lens: Lens) -> None:
+    """What a lens FILE may not hold, whatever its format (every reader calls this after building
+    the lens; a lens built in Python may be an idealisation, such as a thin lens of zero
+    thickness): glass of zero or negative centre thickness. Raises :class:`LensError` naming the
+    surface."""
+    for i, s in enumerate(lens.surfaces[:-1], start=1):
+        if s.thickness <= 0.0 and not s.material.is_air:
+            raise LensError(
+                f"{lens.name}: surface {i}: the glass after it has thickness {s.thickness:g} mm; "
+                "give its centre thickness (a positive number of mm)"
+            )
+
+
 def check_physical(lens: Lens) -> None:
-    """What every reader must refuse, whatever the file format (one validation for all): glass
-    of zero thickness, a refractive index below 1, a semi-diameter beyond the surface's sag
-    (|sd| ≥ |R| for a sphere), and consecutive surfaces that cross inside their semi-diameters.
-    Raises :class:`LensError` naming the surface (1-based) and the fix."""
+    """What no lens may be, however it was made (checked on construction): a refractive index
+    below 1, a semi-diameter beyond the surface's sag (|sd| ≥ |R| for a sphere), and consecutive
+    surfaces that cross inside their semi-diameters. Raises :class:`LensError` naming the surface
+    (1-based) and the fix."""
     n = len(lens.surfaces)
     for i, s in enumerate(lens.surfaces, start=1):
         m = s.material
@@ -424,11 +461,6 @@ def check_physical(lens: Lens) -> None:
             raise LensError(
                 f"{lens.name}: surface {i}: refractive index {m.nd:g} is below 1; give the index "
                 "of the medium after the surface (air is 1)"
-            )
-        if i < n and s.thickness == 0.0 and not m.is_air:
-            raise LensError(
-                f"{lens.name}: surface {i}: the glass after it has zero thickness; give its "
-                "centre thickness (mm)"
             )
         if math.isfinite(s.semi_diameter) and s.curvature != 0.0:
             if 1.0 - (1.0 + s.conic) * (s.curvature * s.semi_diameter) ** 2 <= 0.0:

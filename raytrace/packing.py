@@ -98,16 +98,16 @@ def pack(lens: Lens, wavelength: float | None = None, *, wavelengths=None) -> Pa
     for i, s in enumerate(ss):
         asph[i, : len(s.aspheric)] = s.aspheric
     idx = lens.indices(wl)  # (w, n + 1): object space, then after each surface
-    n_in_w = np.ascontiguousarray(idx[:, :-1])
-    n_out_w = np.ascontiguousarray(idx[:, 1:])
+    n_in_w = np.array(idx[:, :-1], order="C")  # writeable copies (idx is a cached read-only
+    n_out_w = np.array(idx[:, 1:], order="C")  # array): one kernel specialisation only
     return PackedLens(
         kind=np.array([s.kind for s in ss], dtype=np.int64),
         c=np.array([s.curvature for s in ss], dtype=np.float64),
         k=np.array([s.conic for s in ss], dtype=np.float64),
         asph=np.ascontiguousarray(asph),
         zv=np.ascontiguousarray(lens.vertex_z, dtype=np.float64),
-        n_in=np.ascontiguousarray(n_in_w[0]),
-        n_out=np.ascontiguousarray(n_out_w[0]),
+        n_in=n_in_w[0].copy(),
+        n_out=n_out_w[0].copy(),
         sd=np.array([s.semi_diameter for s in ss], dtype=np.float64),
         stop=lens.stop_index,
         z_image=float(lens.image_z),

@@ -125,7 +125,9 @@ def image_scale(value: float | str, what: str = "image scale") -> float:
     else:
         v = float(value)
     if not (math.isfinite(v) and v > 0):
-        raise UnitError(f"{what}: N must be a positive finite number (12x: m0 = -1/12), got {value!r}")
+        raise UnitError(
+            f"{what}: N must be a positive finite number (12x: m0 = -1/12), got {value!r}"
+        )
     return v
 
 

@@ -42,8 +42,8 @@ def asphere_lens() -> Lens:
     c = model_glass(1.62041, 60.32)
     f = model_glass(1.61659, 36.63)
     s = (
-        Surface(1 / 21.25, 2.0, c, semi_diameter=9.5, conic=-0.3, aspheric=(-2.5e-6, 3.1e-9)),
-        Surface(1 / -158.65, 6.0, semi_diameter=9.0, label="rear of crown"),
+        Surface(1 / 21.25, 2.0, c, semi_diameter=8.0, conic=-0.3, aspheric=(-2.5e-6, 3.1e-9)),
+        Surface(1 / -158.65, 6.0, semi_diameter=7.8, label="rear of crown"),
         Surface(1 / -20.25, 1.0, f, semi_diameter=6.0),
         Surface(1 / 19.3, 6.0, stop=True, semi_diameter=5.5),
         Surface(1 / 141.25, 2.0, fixed_index(1.62), aspheric=(0.0, 0.0, 1.7e-11)),
@@ -261,3 +261,19 @@ def test_field_is_largest_radial_field_of_ftyp_count():
     assert lens.field.value == pytest.approx(math.hypot(15.0, 20.0), rel=1e-15)
     # fields beyond the FTYP count are not used
     assert loads_zmx(text.replace("FTYP 0 0 3", "FTYP 0 0 2")).field.value == 14.0
+
+
+@pytest.mark.parametrize(
+    "old,new,words",
+    [
+        ("DISZ 2", "DISZ 0", "thickness 0 mm"),
+        ("GLAS ___BLANK 1 0 1.61659 3.663E+1", "GLAS ___BLANK 1 0 0.5 0", "below 1"),
+    ],
+)
+def test_impossible_lenses_are_refused_as_the_native_format_refuses_them(old, new, words):
+    # one validation for every reader (docs/design.md, "Errors and files"): a .zmx file may not
+    # hold what a .toml file may not hold
+    text = (DATA / "cooke-triplet-f4.zmx").read_text(encoding="utf-8")
+    assert old in text
+    with pytest.raises(PrescriptionError, match=words):
+        loads_zmx(text.replace(old, new, 1))

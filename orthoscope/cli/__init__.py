@@ -33,12 +33,15 @@ COMMANDS: tuple[str, ...] = (
     "trace",
     "fan",
     "distortion",
+    "pupils",
+    "colour",
     "calibrate",
     "compensate",
     "variation",
     "coefficients",
     "optimize",
     "convert",
+    "glass",
 )
 
 

@@ -35,7 +35,10 @@ TABLE_LAYOUT_HELP = (
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
-SAMPLES = [["distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--calibrate", "minimax"]]
+SAMPLES = [
+    ["distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--calibrate", "minimax"],
+    ["distortion", "cooke-triplet-f4", "--grid", "5x5"],
+]
 #: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
 OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png"), ("--layout", ".png")]
 
@@ -127,6 +130,8 @@ def cmd_distortion(args) -> int:
 
     lens = load(args.lens)
     args._inputs = [lens.path] if lens.path else []
+    if _grid_mode(args):  # 2-D distortion: --grid / --plot-grid / --plot-vectors (below)
+        return _grid(args, lens)
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
     at = at_fields(args.at)
@@ -137,6 +142,14 @@ def cmd_distortion(args) -> int:
     planes = resolve_planes(lens, args)
     if kind == "height" and od == float("inf"):
         raise CliError("object-height fields need a finite object (--object-distance)")
+    if args.definition is not None:  # named definitions: orthoscope/cli/definitions.py
+        from .definitions import run_definition
+
+        return run_definition(lens, fields, kind, od, planes, args)
+    if args.focal is not None:
+        raise CliError("--focal needs --definition NAME")
+    if args.wavelengths is not None:
+        return _by_wavelength(lens, fields, kind, od, planes, args)
     res = characteristic_distortion(
         lens,
         **field_keyword(fields, kind),
@@ -175,6 +188,55 @@ def cmd_distortion(args) -> int:
     bad = int(np.count_nonzero(res.status != 0))
     if bad and args.strict:
         raise CliError(f"{bad} field(s) could not be traced (see the table); --strict fails")
+    return 0
+
+
+def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
+    """--wavelengths: distortion per wavelength (one trace), against --scale."""
+    import numpy as np
+
+    from distortion.characteristic import characteristic_distortion
+
+    from ..report.colour import chromatic_distortion_to_dict, format_chromatic_distortion
+    from .common import CliError, field_keyword, print_json
+
+    bad = [
+        flag
+        for flag, on in (
+            ("--wavelength", args.wavelength is not None),
+            ("--calibrate", args.calibrate is not None),
+            ("--csv", args.csv),
+            ("--plot-rotation", args.plot_rotation),
+            ("--layout", args.layout),
+        )
+        if on
+    ]
+    if bad:
+        raise CliError(f"--wavelengths does not combine with {', '.join(bad)}")
+    cd = characteristic_distortion(
+        lens,
+        **field_keyword(fields, kind),
+        object_distance=od,
+        plane=planes,
+        reference=args.reference,
+        wavelengths=args.wavelengths,
+        scale=args.scale,
+    )
+    if args.json:
+        print_json({"distortion_by_wavelength": chromatic_distortion_to_dict(cd)})
+    else:
+        print(format_chromatic_distortion(cd))
+    if args.plot:
+        from ..plots.colour import plot_distortion_by_wavelength
+        from ..plots.common import offscreen_figures
+        from ..plots.save import save_figure
+
+        with offscreen_figures():
+            fig = plot_distortion_by_wavelength(cd)
+        save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
+    n_bad = int(np.count_nonzero(cd.status != 0))
+    if n_bad and args.strict:
+        raise CliError(f"{n_bad} ray(s) could not be traced (see the table); --strict fails")
     return 0
 
 
@@ -228,7 +290,9 @@ def add_force_arg(q: argparse.ArgumentParser) -> None:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from .colour import add_scale_arg, add_wavelengths_arg
     from .common import REFERENCES
+    from .definitions import add_definition_args
 
     q = sub.add_parser(
         "distortion",
@@ -256,6 +320,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--reference", default="characteristic", choices=REFERENCES, help=REFERENCE_HELP)
     add_calibration_args(q, required=False)
     add_wavelength_arg(q)
+    add_wavelengths_arg(
+        q,
+        help="Distortion per wavelength from one trace (nm, 0.5876um, line letters F,d,C, or "
+        "'lens'), in the planes of the reference wavelength; see --scale.",
+    )
+    add_scale_arg(q)
+    add_definition_args(q)
     add_table_layout_arg(q)
     q.add_argument(
         "--strict", action="store_true", help="Exit with status 2 when a field cannot be traced."
@@ -278,6 +349,150 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="FILE",
         help="Save a lens layout drawing with the chief rays to the image plane(s).",
     )
+    _add_grid_args(q)
     add_force_arg(q)
     add_output_args(q)
     q.set_defaults(func=cmd_distortion)
+
+
+# ------------------------------------------------------------------ 2-D distortion (--grid)
+GRID_HELP = (
+    "2-D distortion on an NXxNY grid of fields (e.g. 21x21) whose corners lie at the lens's field "
+    "(or --max-field): distortion vectors about a named reference point, their decomposition "
+    "(radial, decentering, thin prism) and the Brown-Conrady (Fraser 1997) fit per plane."
+)
+REFERENCE_POINT_HELP = (
+    "Reference point of the 2-D ideal image: 'axial' (image of the axial object point; "
+    "default), 'ppa' (principal point of autocollimation), 'ppbs' (point of best symmetry)."
+)
+
+
+def _add_grid_args(q: argparse.ArgumentParser) -> None:
+    g = q.add_argument_group("2-D distortion")
+    g.add_argument("--grid", metavar="NXxNY", help=GRID_HELP)
+    g.add_argument(
+        "--sensor", metavar="WxH", help="Fill a sensor of W x H mm with the grid (ideal image)."
+    )
+    g.add_argument(
+        "--reference-point", choices=["axial", "ppa", "ppbs"], default="axial",
+        help=REFERENCE_POINT_HELP,
+    )  # fmt: skip
+    g.add_argument(
+        "--plot-grid", metavar="FILE",
+        help="Save the grid-distortion picture (ideal and exaggerated real grid).",
+    )  # fmt: skip
+    g.add_argument(
+        "--plot-vectors", metavar="FILE", help="Save the vector plot of the distortion field."
+    )
+
+
+def _grid_mode(args) -> bool:
+    return any(getattr(args, k, None) for k in ("grid", "sensor", "plot_grid", "plot_vectors"))
+
+
+def _grid_size(text: str | None) -> tuple[int, int]:
+    from .common import CliError
+
+    if text is None:
+        return (21, 21)
+    parts = text.lower().replace("×", "x").split("x")
+    try:
+        vals = tuple(int(p) for p in parts)
+    except ValueError:
+        vals = ()
+    if len(vals) == 1:
+        vals = (vals[0], vals[0])
+    if len(vals) != 2 or min(vals) < 2:
+        raise CliError(f"--grid {text}: write NXxNY with at least 2 points each, e.g. 21x21")
+    return vals
+
+
+def _grid(args, lens) -> int:
+    """``--grid``: the 2-D distortion field, its decomposition and Brown-Conrady fit per plane."""
+    import numpy as np
+
+    from distortion.grid import decompose_distortion, distortion_grid, fit_brown_conrady
+
+    from ..report.grid import format_grid, grid_to_dict
+    from .common import MAX_FIELDS, CliError, check_size, print_json, resolve_object, resolve_planes
+
+    bad = [
+        flag
+        for flag, on in (
+            ("--fields", args.fields is not None),
+            ("--steps", args.steps is not None),
+            ("--calibrate", args.calibrate is not None),
+            ("--csv", args.csv),
+            ("--plot", args.plot),
+            ("--plot-rotation", args.plot_rotation),
+            ("--layout", args.layout),
+            ("--wavelengths", getattr(args, "wavelengths", None) is not None),
+        )
+        if on
+    ]
+    if bad:
+        raise CliError(f"--grid (2-D distortion) does not combine with {', '.join(bad)}")
+    nx, ny = _grid_size(args.grid)
+    check_size(nx * ny, MAX_FIELDS, "--grid (fields)", args, per_item_bytes=400)
+    for flag in ("plot_grid", "plot_vectors"):
+        check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
+    od = resolve_object(lens, args)
+    planes = resolve_planes(lens, args)
+    kw = {}
+    if args.sensor is not None:
+        if args.max_field is not None:
+            raise CliError("give --sensor or --max-field, not both")
+        kw["sensor"] = args.sensor
+    elif args.max_field is not None:
+        import math
+
+        kind = args.field_kind or lens.field.kind
+        m = float(args.max_field)
+        if kind == "angle":
+            if not 0 < m < 90:
+                raise CliError("--max-field must lie between 0 and 90 degrees")
+            a = np.degrees(np.arctan(np.linspace(-1, 1, nx) * math.tan(math.radians(m)) / 2**0.5))
+            b = np.degrees(np.arctan(np.linspace(-1, 1, ny) * math.tan(math.radians(m)) / 2**0.5))
+            kw.update(fields_x_deg=a, fields_y_deg=b)
+        else:
+            kw.update(
+                object_x_mm=np.linspace(-m, m, nx) / 2**0.5,
+                object_y_mm=np.linspace(-m, m, ny) / 2**0.5,
+            )
+    g = distortion_grid(
+        lens,
+        grid=(nx, ny),
+        object_distance=od,
+        plane=planes,
+        reference_point=args.reference_point,
+        wavelength=args.wavelength,
+        **kw,
+    )
+    decs, fits = [], []
+    for p in range(g.n_planes):
+        if np.count_nonzero(g.ok) >= 8:
+            decs.append(decompose_distortion(g, p))
+            fits.append(fit_brown_conrady(g, p))
+    if args.json:
+        print_json({"distortion_grid": grid_to_dict(g, decs, fits)})
+    else:
+        print(format_grid(g, decs, fits))
+    if (args.plot_grid or args.plot_vectors) and not np.isfinite(g.actual).any():
+        raise CliError("no field could be traced: there is nothing to plot")
+    if args.plot_grid or args.plot_vectors:
+        from ..plots.common import offscreen_figures
+        from ..plots.grid import plot_distortion_vectors, plot_grid_distortion
+        from ..plots.save import save_figure
+
+        if args.plot_grid:
+            with offscreen_figures():
+                fig = plot_grid_distortion(g)
+            save_figure(fig, args.plot_grid, overwrite=args.force, inputs=args._inputs)
+        if args.plot_vectors:
+            with offscreen_figures():
+                fig = plot_distortion_vectors(g)
+            save_figure(fig, args.plot_vectors, overwrite=args.force, inputs=args._inputs)
+    n_bad = int(np.count_nonzero(~g.ok))
+    if n_bad and args.strict:
+        raise CliError(f"{n_bad} field(s) could not be traced; --strict fails")
+    return 0

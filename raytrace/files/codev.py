@@ -41,7 +41,7 @@ from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
 from ..glass import lookup_glass, normalize_name, parse_glass_code, private_material
-from ..lens import Aperture, Field, Lens, Surface
+from ..lens import Aperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material
 from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
 
@@ -552,6 +552,7 @@ class _SeqParser:
         lines = [s.line for s in body]
         try:
             lens = Lens(**kw)
+            check_file_lens(lens)
         except (LensError, ValueError) as e:
             raise lens_error(self.err, e, lines, obj.line) from None
         if pims:

@@ -362,8 +362,10 @@ def _private(
     """A glass defined in the file: catalog = "private", formula, coefficients, range_nm."""
     from ..glass import PRIVATE, private_material
 
-    if (catalog or "").strip().lower() != PRIVATE or "formula" not in given or (
-        "coefficients" not in given
+    if (
+        (catalog or "").strip().lower() != PRIVATE
+        or "formula" not in given
+        or ("coefficients" not in given)
     ):
         raise src.error(
             f'glass {name!r}: a glass defined in the file needs catalog = "{PRIVATE}", formula '
@@ -702,7 +704,9 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
         no,
         catalog=_one_of(src, e, "catalog", K, line, no),
         model=_one_of(src, e, "model", K, line, no),
-        private={k: _one_of(src, e, k, K, line, no) for k in ("formula", "coefficients", "range_nm")},
+        private={
+            k: _one_of(src, e, k, K, line, no) for k in ("formula", "coefficients", "range_nm")
+        },
     )
 
     t = _one_of(src, e, "t", K, line, no)
@@ -1010,9 +1014,7 @@ def dumps(lens: Lens) -> str:
     if len(lens.wavelengths) == 1:
         out.append(f"wavelength = {_fnum(lens.wavelength)}   # nm\n")
     else:
-        out.append(
-            "wavelengths = [" + ", ".join(_fnum(w) for w in lens.wavelengths) + "]   # nm\n"
-        )
+        out.append("wavelengths = [" + ", ".join(_fnum(w) for w in lens.wavelengths) + "]   # nm\n")
         out.append(f"reference_wavelength = {_fnum(lens.wavelength)}   # nm\n")
     if any(w != 1.0 for w in lens.weights):
         out.append("weights = [" + ", ".join(_fnum(w) for w in lens.weights) + "]\n")

@@ -51,7 +51,7 @@ from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
 from ..glass import lookup_glass, parse_glass_code
-from ..lens import Aperture, Field, Lens, Surface
+from ..lens import Aperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from .output import write_atomic
 from .text import (
@@ -688,6 +688,7 @@ class _ZmxParser:
                 image_solve=solve,
                 path=self.path,
             )
+            check_file_lens(lens)
         except (LensError, ValueError) as e:
             raise lens_error(self.err, e, [z.line for z in body], surfaces[0].line) from None
         return ImportResult(lens, tuple(self.warnings))

@@ -23,8 +23,8 @@ met, one more Newton step with the last Jacobian is taken when it lowers |r| (a 
 round-off, so that independently aimed rays agree far below the tolerance).
 
 Continuation over the grid (:func:`_aim_fields_2d`): fields are solved in order of their distance
-from the origin (|f|). Each starts from its nearest already-solved field j (brute force over the
-solved ones: O(n²) distance tests, ~0.1 s for 10⁴ fields), predicted as
+from the origin (|f|). Each starts from its nearest already-solved field j (found in a uniform
+bucket grid of the fields, searched ring by ring), predicted as
 ``u = u_j + slope0·(f − f_j)`` (slope0 = the paraxial du/df); the first field starts from the
 solved origin field (0, 0) (aimed first). When Newton fails from that guess, the field is
 approached along the straight path from f_j in steps that halve on failure and double on success
@@ -235,10 +235,18 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
     n = f1.shape[0]
     ns = c.shape[0]
     order = np.argsort(f1 * f1 + f2 * f2)
-    solved = np.empty(n, dtype=np.int64)  # indices of solved fields, in solve order
-    nsolved = 0
     U1 = np.zeros(n)
     U2 = np.zeros(n)
+    # solved fields in a uniform bucket grid (nearest-neighbour queries in ~O(1))
+    nb = max(1, int(math.sqrt(n)))
+    lo1 = min(0.0, np.min(f1)) if n else 0.0
+    lo2 = min(0.0, np.min(f2)) if n else 0.0
+    h1 = (max(0.0, np.max(f1)) - lo1) / nb if n else 1.0
+    h2 = (max(0.0, np.max(f2)) - lo2) / nb if n else 1.0
+    h1 = h1 if h1 > 0.0 else 1.0
+    h2 = h2 if h2 > 0.0 else 1.0
+    head = np.full(nb * nb, -1, dtype=np.int64)
+    nxt = np.full(n, -1, dtype=np.int64)
     # the origin field (0, 0) anchors the continuation
     ok0, o1, o2, _r1, _r2, _ne = _newton2(
         kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, 0.0, 0.0, 0.0, 0.0, tol,
@@ -249,12 +257,27 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
         # nearest solved field (the origin when none is nearer or none is solved)
         best = -1
         dbest = f1[i] * f1[i] + f2[i] * f2[i] if ok0 else np.inf
-        for jj in range(nsolved):
-            j = solved[jj]
-            d = (f1[i] - f1[j]) ** 2 + (f2[i] - f2[j]) ** 2
-            if d < dbest:
-                dbest = d
-                best = j
+        c1 = min(nb - 1, int((f1[i] - lo1) / h1))
+        c2 = min(nb - 1, int((f2[i] - lo2) / h2))
+        for ring in range(nb):
+            reach = (ring - 1) * min(h1, h2)
+            if ring > 0 and reach > 0.0 and reach * reach >= dbest:
+                break
+            for a in range(c1 - ring, c1 + ring + 1):
+                if a < 0 or a >= nb:
+                    continue
+                for b in range(c2 - ring, c2 + ring + 1):
+                    if b < 0 or b >= nb:
+                        continue
+                    if max(abs(a - c1), abs(b - c2)) != ring:
+                        continue
+                    j = head[a * nb + b]
+                    while j >= 0:
+                        d = (f1[i] - f1[j]) ** 2 + (f2[i] - f2[j]) ** 2
+                        if d < dbest:
+                            dbest = d
+                            best = j
+                        j = nxt[j]
         if best >= 0:
             g1, g2, b1, b2 = f1[best], f2[best], U1[best], U2[best]
         elif ok0:
@@ -283,8 +306,9 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
             continue
         U1[i] = u1
         U2[i] = u2
-        solved[nsolved] = i
-        nsolved += 1
+        cell = c1 * nb + c2
+        nxt[i] = head[cell]
+        head[cell] = i
         start[0, i] = x0
         start[1, i] = y0
         start[2, i] = z0

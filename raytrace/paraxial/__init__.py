@@ -13,8 +13,10 @@ from .conjugates import (
 from .firstorder import ParaxialResult, paraxial
 from .orthoscopy import (
     PestrecovConstants,
+    distortion_slope,
     ideal_heights,
     orthoscopy_abscissa,
+    orthoscopy_constant_slope,
     paraxial_chief_heights,
     pestrecov_constants,
 )
@@ -23,11 +25,13 @@ __all__ = [
     "ImagePlane",
     "ParaxialResult",
     "PestrecovConstants",
+    "distortion_slope",
     "ideal_heights",
     "image_planes",
     "object_distance_for_s",
     "object_distance_for_scale",
     "orthoscopy_abscissa",
+    "orthoscopy_constant_slope",
     "paraxial",
     "paraxial_chief_heights",
     "pestrecov_constants",

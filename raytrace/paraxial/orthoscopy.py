@@ -252,3 +252,39 @@ def paraxial_chief_heights(
     else:
         raise ValueError(f"unknown field kind {field_kind!r}")
     return (z_image - par.z_E0p) * tan_a / par.m_e
+
+
+# --------------------------------------------------------------------------------------------
+# How the distortion changes from plane to plane (Section V): the one implementation
+# --------------------------------------------------------------------------------------------
+
+
+def orthoscopy_constant_slope(m_e: float, p0: float | None = None) -> float:
+    """Derivative of the constant of orthoscopy (Eq. 8) with respect to the image plane s':
+    ``dM0/ds' = 1/(m_e p0)`` (finite conjugates, give ``p0``) or ``dF0/ds' = 1/m_e`` (object at
+    infinity, ``p0=None`` or ``-inf``). Eq. (8) is affine in s' (``p0' = s' − H'E0'``), so this
+    is exact. An image-side telecentric lens (``m_e = inf``) gives 0: its scale is the same in
+    every plane. Units: 1/mm (finite) or dimensionless (infinity)."""
+    if m_e == 0.0:
+        raise ValueError("m_e must be nonzero")
+    if p0 is None or math.isinf(p0):
+        return 1.0 / m_e
+    if p0 == 0.0:
+        raise ValueError("p0 must be nonzero (object plane in the entrance pupil?)")
+    return 1.0 / (m_e * p0)
+
+
+def distortion_slope(par: ParaxialResult, x, tan_out) -> np.ndarray:
+    """Exact rate of change of the characteristic distortion with the image plane,
+    ``∂D0/∂s' = tan α'_real − x·dK0/ds'`` (mm per mm of s', dimensionless), per field.
+
+    For a fixed object the real chief ray's final segment is straight, so ``y'(s')`` is affine
+    with slope ``tan α'_real = M_last/N_last`` (``tan_out``); the ideal height ``y0' = K0(s')·x``
+    is affine too, with ``dK0/ds'`` from :func:`orthoscopy_constant_slope`. Hence
+    ``D0(s'_2) − D0(s'_1) = (s'_2 − s'_1)·∂D0/∂s'`` exactly, for any two planes (Pestrecov
+    Section V, Table V). ``x`` is the abscissa of orthoscopy (:func:`orthoscopy_abscissa`).
+    ``x·dK0/ds'`` is the image-side slope of the paraxial chief ray scaled linearly to the field
+    (``tan α/m_e``), so the slope is the real minus the paraxial image-side chief-ray slope.
+    """
+    k = orthoscopy_constant_slope(par.m_e, None if par.infinite else par.p0)
+    return np.asarray(tan_out, dtype=float) - k * np.asarray(x, dtype=float)

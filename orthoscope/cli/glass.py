@@ -1,0 +1,149 @@
+"""``orthoscope glass``: a catalog glass (formula, range, nd, vd, n at wavelengths), or the
+catalog glasses nearest to an nd/vd pair (``--search nd=1.62,vd=60``). No numba: it starts
+fast."""
+
+from __future__ import annotations
+
+import argparse
+
+from .colour import add_wavelengths_arg
+
+SAMPLES = [
+    ["glass", "N-BK7", "--wavelengths", "F,d,C"],
+    ["glass", "--search", "nd=1.62,vd=60"],
+]
+OUTPUTS = []
+
+
+def _search_spec(text: str) -> tuple[float, float]:
+    """``nd=1.62,vd=60`` (either order) or a glass code ``620603`` → (nd, vd)."""
+    from raytrace.glass import parse_glass_code
+
+    t = text.strip()
+    got: dict[str, float] = {}
+    if "=" in t:
+        for part in t.split(","):
+            key, _, val = part.partition("=")
+            key = key.strip().lower()
+            if key not in ("nd", "vd") or key in got:
+                raise argparse.ArgumentTypeError(
+                    f"--search {text!r}: expected nd=VALUE,vd=VALUE (e.g. nd=1.62,vd=60)"
+                )
+            try:
+                got[key] = float(val)
+            except ValueError:
+                raise argparse.ArgumentTypeError(
+                    f"--search: {key} must be a number, got {val.strip()!r}"
+                ) from None
+        if set(got) != {"nd", "vd"}:
+            raise argparse.ArgumentTypeError("--search needs both nd= and vd=")
+        return got["nd"], got["vd"]
+    m = parse_glass_code(t)
+    if m is None:
+        raise argparse.ArgumentTypeError(
+            f"--search {text!r}: expected nd=1.62,vd=60, a code such as 620603, or 1.62/60"
+        )
+    return m.nd, m.vd
+
+
+def cmd_glass(args) -> int:
+    import numpy as np
+
+    from raytrace.glass import lookup_glass, search_glass
+
+    from ..report.glass import (
+        default_wavelengths,
+        format_glass,
+        format_search,
+        glass_to_dict,
+        search_to_dict,
+    )
+    from .common import CliError, print_json
+
+    if (args.name is None) == (args.search is None):
+        raise CliError("give a glass NAME or --search nd=...,vd=... (one of them)")
+    if args.search is not None:
+        if args.wavelengths is not None:
+            raise CliError("--wavelengths goes with a glass NAME, not with --search")
+        nd, vd = args.search
+        if not (1.0 <= nd < 5.0 and 0.0 < vd < 200.0):
+            raise CliError(f"--search: nd {nd:g} / vd {vd:g} are not glass values")
+        if args.count < 1:
+            raise CliError("--count must be at least 1")
+        cats = [c.strip() for c in args.catalog.split(",")] if args.catalog else None
+        matches = search_glass(
+            nd, vd, args.count, catalogs=cats, include_retired=args.include_retired
+        )
+        if args.json:
+            print_json(search_to_dict(nd, vd, matches))
+        else:
+            print(format_search(nd, vd, matches))
+        return 0
+    g = lookup_glass(
+        args.name, [args.catalog] if args.catalog else None, first_catalog_wins=bool(args.catalog)
+    )
+    if args.catalog and g.catalog.lower() != args.catalog.strip().lower():
+        raise CliError(f"glass {args.name} is not in the {args.catalog} catalog ({g.catalog})")
+    wls = args.wavelengths
+    if wls is None or wls == "lens":
+        if wls == "lens":
+            raise CliError("--wavelengths lens applies to lens commands; give nm or line letters")
+        wls = default_wavelengths(g)
+    wl = np.asarray(wls, dtype=float)
+    n = np.atleast_1d(g.material.index(wl, strict=args.strict))
+    if args.json:
+        print_json(glass_to_dict(g, wl, n))
+    else:
+        print(format_glass(g, wl, n))
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser(
+        "glass",
+        help="A catalog glass (formula, range, nd, vd, indices) or the nearest to nd/vd.",
+        description=(
+            "Look a glass up in the shipped catalogs (Schott, Ohara, Hoya, CDGM, Hikari, "
+            "Sumita, Misc) and print its vendor dispersion formula, coefficients, valid range, "
+            "nd, vd and its index at the requested wavelengths next to the indices the catalog "
+            "prints; or list the catalog glasses nearest to an nd/vd pair (what a patent that "
+            "gives only nd and vd leaves to choose)."
+        ),
+        epilog=(
+            "Examples:\n"
+            "  orthoscope glass N-BK7 --wavelengths 486.1327,587.5618,656.2725\n"
+            "  orthoscope glass S-BSL7 --catalog Ohara --json\n"
+            "  orthoscope glass --search nd=1.62,vd=60 --count 5"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument("name", metavar="NAME", nargs="?", help="Glass name (N-BK7, NSK16_SCHOTT).")
+    q.add_argument(
+        "--search",
+        type=_search_spec,
+        metavar="nd=N,vd=V",
+        help="List the catalog glasses nearest to this nd and vd (or a code such as 620603).",
+    )
+    q.add_argument(
+        "--catalog",
+        metavar="NAME[,NAME]",
+        help="Catalog(s) to look in: Schott, Ohara, Hoya, CDGM, Hikari, Sumita, Misc.",
+    )
+    add_wavelengths_arg(
+        q,
+        help="Wavelengths for the index listing: nm, a number with a unit (0.5876um) or a line "
+        "letter (F, d, C, e, g, ...). Default: the spectral lines inside the data range.",
+    )
+    q.add_argument(
+        "--strict",
+        action="store_true",
+        help="Refuse wavelengths outside the glass's data range (default: a warning).",
+    )
+    q.add_argument("--count", type=int, default=10, metavar="N", help="--search: how many.")
+    q.add_argument(
+        "--include-retired",
+        action="store_true",
+        help="--search: also withdrawn / legacy glasses.",
+    )
+    q.add_argument("--json", action="store_true", help="Print JSON.")
+    q.set_defaults(func=cmd_glass)

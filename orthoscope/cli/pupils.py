@@ -1,0 +1,100 @@
+"""``orthoscope pupils``: image-side chief-ray angle (telecentricity), real exit and entrance
+pupils per field, the viewpoint offset and the exact change of distortion with the image plane
+(∂D0/∂s'); :mod:`distortion.telecentricity`."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import add_field_args, add_object_args, add_output_args, add_wavelength_arg
+
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [
+    ["pupils", "cooke-triplet-f4", "--fields", "0,10,20"],
+    ["pupils", "twinplex-like-55-525", "--object-s", "-55.0009", "--fields", "0,20,45", "--json"],
+]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("--plot", ".png")]
+
+
+def cmd_pupils(args) -> int:
+    import numpy as np
+
+    from distortion.telecentricity import pupil_analysis
+
+    from ..report.telecentricity import format_pupils, pupils_csv, pupils_to_dict
+    from .common import CliError, field_keyword, load, print_json, resolve_fields, resolve_object
+    from .distortion import check_plot_path
+
+    lens = load(args.lens)
+    args._inputs = [lens.path] if lens.path else []
+    check_plot_path(args.plot, "--plot", args)
+    od = resolve_object(lens, args)
+    fields, kind = resolve_fields(lens, args)
+    if kind == "height" and od == float("inf"):
+        raise CliError("object-height fields need a finite object (--object-distance)")
+    pa = pupil_analysis(
+        lens, **field_keyword(fields, kind), object_distance=od, wavelength=args.wavelength
+    )
+    if args.json:
+        print_json({"pupils": pupils_to_dict(pa)})
+    elif args.csv:
+        print(pupils_csv(pa))
+    else:
+        print(format_pupils(pa, layout=args.table_layout))
+    if args.plot:
+        if not np.isfinite(pa.cra_deg).any():
+            raise CliError("no field could be traced (see the table): there is nothing to plot")
+        from ..plots.common import offscreen_figures
+        from ..plots.save import save_figure
+        from ..plots.telecentricity import plot_pupils
+
+        with offscreen_figures():
+            fig = plot_pupils(pa)
+        save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
+    bad = int(np.count_nonzero(pa.status != 0))
+    if bad and args.strict:
+        raise CliError(f"{bad} field(s) could not be traced (see the table); --strict fails")
+    return 0
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from .distortion import add_force_arg, add_table_layout_arg
+
+    q = sub.add_parser(
+        "pupils",
+        help="Chief-ray angle (telecentricity), real pupils and viewpoint, dD0/ds' per field.",
+        description=(
+            "Per field, from the real chief rays (through the centre of the real stop): the "
+            "image-side chief-ray angle CRA and the real exit pupil it implies (telecentric "
+            "lens: CRA = 0, exit pupil at infinity); the exact rate dD0/ds' = tan CRA - "
+            "x dK0/ds' at which the characteristic distortion changes from one image plane to "
+            "another (Pestrecov Section V; D0 is affine in s' for a fixed object); and the real "
+            "entrance pupil (viewpoint) with its shift from the paraxial E0 and the lateral "
+            "offset of the object-space chief ray from E0."
+        ),
+        epilog=(
+            "Examples:\n"
+            "  orthoscope pupils super-angulon-de975637 --plot pupils.png\n"
+            "  orthoscope pupils twinplex-like-55-525 --object-s -55.0009 --json"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_object_args(q)
+    add_field_args(q)
+    add_wavelength_arg(q)
+    add_table_layout_arg(q)
+    q.add_argument(
+        "--strict", action="store_true", help="Exit with status 2 when a field cannot be traced."
+    )
+    q.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="Save a three-panel chart (.png/.svg/.pdf): chief-ray angle, dD0/ds', entrance "
+        "pupil shift and viewpoint offset against the field.",
+    )
+    add_force_arg(q)
+    add_output_args(q)
+    q.set_defaults(func=cmd_pupils)

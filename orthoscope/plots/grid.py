@@ -1,0 +1,228 @@
+"""2-D distortion charts: the grid-distortion picture (ideal against real grid, exaggerated), the
+vector plot of the distortion field (or of one of its parts) and the radial curve per azimuth.
+
+Every function draws into ``ax`` (a new pyplot figure when ``ax`` is None) and returns the Figure
+(:mod:`orthoscope.plots.common` states the convention). Image coordinates in mm in the lens frame
+(x right, y up, looking along −z; docs/design.md, "2-D distortion"), equal axes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from distortion.errors import DataError
+from distortion.grid import DistortionGrid, GridDecomposition, RadialByAzimuth
+
+from .common import GRID, ZERO, figure_and_axes, fmt, legend, set_title
+
+IDEAL = "0.65"
+REAL = "tab:red"
+FIGSIZE_SQUARE = (6.4, 6.0)
+COMPONENTS = ("total", "radial", "decentering", "thin_prism", "offset", "scale", "residual")
+
+
+def _plane(grid: DistortionGrid, plane: int) -> int:
+    if not 0 <= int(plane) < grid.n_planes:
+        raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")
+    return int(plane)
+
+
+def nice_factor(value: float) -> float:
+    """The largest 1-2-5 number ≤ ``value`` (≥ 1): a readable exaggeration factor."""
+    if not (value > 1.0) or not math.isfinite(value):
+        return 1.0
+    mag = 10.0 ** math.floor(math.log10(value))
+    for m in (5.0, 2.0, 1.0):
+        if m * mag <= value:
+            return m * mag
+    return mag  # pragma: no cover
+
+
+def default_exaggeration(grid: DistortionGrid, plane: int = 0, fraction: float = 0.05) -> float:
+    """A 1-2-5 factor k with which the largest |D| appears as about ``fraction`` of the grid's
+    half-size (1 when the distortion is already that large)."""
+    p = _plane(grid, plane)
+    ideal = grid.ideal[p]
+    half = 0.5 * float(np.nanmax(ideal[..., 0]) - np.nanmin(ideal[..., 0]))
+    half = max(half, 0.5 * float(np.nanmax(ideal[..., 1]) - np.nanmin(ideal[..., 1])))
+    dmax = grid.max_distortion(p)
+    if not (dmax > 0 and half > 0):
+        return 1.0
+    return nice_factor(fraction * half / dmax)
+
+
+def _lines(ax, pts: np.ndarray, **kw):
+    """Draw the rows and the columns of an (ny, nx, 2) point grid as polylines."""
+    first = None
+    for row in pts:
+        (h,) = ax.plot(row[:, 0], row[:, 1], **kw)
+        if first is None:
+            first = h
+    for col in np.swapaxes(pts, 0, 1):
+        ax.plot(col[:, 0], col[:, 1], **kw)
+    return first
+
+
+def plot_grid_distortion(
+    grid: DistortionGrid,
+    plane: int = 0,
+    *,
+    exaggeration: float | None = None,
+    ax=None,
+    title: str | None = None,
+):
+    """The ideal grid (grey) and the real grid with its distortion exaggerated k times (red):
+    points ``P0' + k·D``. ``exaggeration`` k: default a 1-2-5 factor that makes the largest
+    distortion about 5 % of the picture (:func:`default_exaggeration`); k is stated in the
+    title."""
+    p = _plane(grid, plane)
+    if len(grid.shape) != 2:
+        raise DataError("plot_grid_distortion needs a 2-D grid of fields (rows x columns)")
+    k = default_exaggeration(grid, p) if exaggeration is None else float(exaggeration)
+    if not (k > 0 and math.isfinite(k)):
+        raise DataError(f"exaggeration must be a positive number, got {exaggeration!r}")
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE_SQUARE)
+    ideal = grid.ideal[p]
+    shown = ideal + k * grid.D[p]
+    hi = _lines(ax, ideal, color=IDEAL, lw=0.8, zorder=1)
+    hr = _lines(ax, shown, color=REAL, lw=1.1, zorder=2)
+    ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x' (mm)")
+    ax.set_ylabel("y' (mm)")
+    legend(ax, [hi, hr], ["ideal (Eq. 8, 2-D)", f"real, distortion x {fmt(k, 3)}"], loc="best")
+    dmax = grid.max_distortion(p)
+    set_title(
+        ax,
+        title
+        or (
+            f"{grid.name}: grid distortion, {grid.plane_label(p)}; distortion exaggerated "
+            f"{fmt(k, 3)}x (max |D| = {fmt(dmax * 1000, 4)} um, reference {grid.reference_point})"
+        ),
+    )
+    return fig
+
+
+def plot_distortion_vectors(
+    grid: DistortionGrid,
+    plane: int = 0,
+    *,
+    decomposition: GridDecomposition | None = None,
+    component: str = "total",
+    ax=None,
+    title: str | None = None,
+):
+    """Arrows of the distortion vectors D (or of one part of a ``decomposition``: "radial",
+    "decentering", "thin_prism", "offset", "scale", "residual") at the ideal image points; the
+    arrow key states the length it stands for."""
+    p = _plane(grid, plane)
+    if component not in COMPONENTS:
+        raise DataError(f"component={component!r}; use one of {', '.join(COMPONENTS)}")
+    if component == "total":
+        vec = grid.D[p]
+        what = "distortion D"
+    else:
+        if decomposition is None:
+            raise DataError(f"component={component!r} needs decomposition= (decompose_distortion)")
+        if decomposition.plane != p:
+            raise DataError(f"the decomposition is of plane {decomposition.plane}, not plane {p}")
+        vec = decomposition.components[component]
+        what = f"{component.replace('_', ' ')} part"
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE_SQUARE)
+    pos = grid.ideal[p].reshape(-1, 2)
+    v = np.asarray(vec, dtype=float).reshape(-1, 2)
+    ok = np.all(np.isfinite(pos), axis=1) & np.all(np.isfinite(v), axis=1)
+    pos, v = pos[ok], v[ok]
+    lengths = np.hypot(v[:, 0], v[:, 1])
+    vmax = float(lengths.max()) if lengths.size else 0.0
+    span = max(float(np.ptp(pos[:, 0])) if pos.size else 1.0, 1e-300)
+    n_side = max(2.0, math.sqrt(max(pos.shape[0], 1)))
+    if vmax > 0:
+        # the longest arrow spans about 1.5 grid steps
+        scale = vmax / (1.5 * span / n_side)
+        q = ax.quiver(
+            pos[:, 0], pos[:, 1], v[:, 0], v[:, 1], angles="xy", scale_units="xy", scale=scale,
+            color=REAL, width=0.004, zorder=2,
+        )  # fmt: skip
+        key = _key_length(vmax)
+        ax.quiverkey(q, 0.82, 1.02, key, f"{fmt(key * 1000, 3)} um", labelpos="E",
+                     coordinates="axes")  # fmt: skip
+    ax.plot(pos[:, 0], pos[:, 1], ".", color=IDEAL, ms=2.5, zorder=1)
+    ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x' (mm)")
+    ax.set_ylabel("y' (mm)")
+    set_title(
+        ax,
+        title
+        or (
+            f"{grid.name}: {what}, {grid.plane_label(p)} (max {fmt(vmax * 1000, 4)} um, "
+            f"reference {grid.reference_point})"
+        ),
+    )
+    return fig
+
+
+def _key_length(vmax: float) -> float:
+    """A 1-2-5 length near half the longest vector for the arrow key (mm)."""
+    mag = 10.0 ** math.floor(math.log10(vmax))
+    for m in (5.0, 2.0, 1.0):
+        if m * mag <= 0.75 * vmax:
+            return m * mag
+    return mag / 2.0
+
+
+def plot_radial_by_azimuth(
+    curves: RadialByAzimuth,
+    plane: int = 0,
+    *,
+    tangential: bool = True,
+    ax=None,
+    title: str | None = None,
+):
+    """Radial distortion (solid, outward positive) and, with ``tangential``, the tangential
+    part (dashed) against the field, one colour per azimuth: Pestrecov's characteristic curve
+    per azimuth (identical curves for a centred lens)."""
+    g = curves.grid
+    p = _plane(g, plane)
+    fig, ax = figure_and_axes(ax)
+    ax.axhline(0.0, **ZERO)
+    ax.grid(True, **GRID)
+    handles, labels = [], []
+    colors = _colors(curves.azimuths_deg.size)
+    for i, a in enumerate(curves.azimuths_deg):
+        (h,) = ax.plot(curves.fields, curves.radial[p, i] * 1000, color=colors[i], lw=1.3)
+        if tangential:
+            ax.plot(curves.fields, curves.tangential[p, i] * 1000, color=colors[i], lw=1.0,
+                    ls="--")  # fmt: skip
+        handles.append(h)
+        labels.append(f"{fmt(a, 4)} deg")
+    if curves.field_kind == "angle":
+        ax.set_xlabel("field angle theta (deg)")
+    elif curves.field_kind == "nominal-angle":
+        ax.set_xlabel("nominal field angle theta (deg)")
+    else:
+        ax.set_xlabel("object radius (mm)")
+    ax.set_ylabel("distortion (um)")
+    legend(ax, handles, labels, title="azimuth" + (" (dashed: tangential)" if tangential else ""),
+           loc="best")  # fmt: skip
+    set_title(
+        ax,
+        title
+        or (
+            f"{g.name}: radial distortion per azimuth, {g.plane_label(p)} "
+            f"(reference {g.reference_point})"
+        ),
+    )
+    return fig
+
+
+def _colors(n: int):
+    from matplotlib import colormaps
+
+    cmap = colormaps["viridis"] if n > 10 else colormaps["tab10"]
+    if n > 10:
+        return [cmap(i / max(n - 1, 1)) for i in range(n)]
+    return [cmap(i) for i in range(n)]

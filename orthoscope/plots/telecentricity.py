@@ -1,0 +1,109 @@
+"""Plots of the chief-ray angle (telecentricity), the distortion slope ∂D0/∂s' and the entrance
+pupil (viewpoint) shift against the field (:mod:`distortion.telecentricity`). Every function
+keeps the ``ax=`` convention of :mod:`orthoscope.plots.common`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from distortion.curve import HEIGHT
+from distortion.errors import DataError
+from distortion.telecentricity import PupilAnalysis
+
+from .common import GRID, ZERO, figure_and_axes, fmt, set_title
+
+
+def _check(pa) -> None:
+    if not isinstance(pa, PupilAnalysis):
+        raise DataError(
+            f"expected a PupilAnalysis (distortion.telecentricity.pupil_analysis), got "
+            f"{type(pa).__name__}"
+        )
+
+
+def _xlabel(pa: PupilAnalysis) -> str:
+    if pa.field_kind == HEIGHT:
+        return "object height y (mm)"
+    return "nominal field angle (deg)" if pa.finite else "field angle (deg)"
+
+
+def _ok(pa: PupilAnalysis, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    m = np.isfinite(v)
+    return pa.fields[m], v[m]
+
+
+def plot_chief_ray_angle(pa: PupilAnalysis, *, ax=None, title: str | None = None):
+    """The image-side chief-ray angle (deg) of the real chief ray against the field, with the
+    paraxial chief ray scaled linearly to the field (dashed; left scale), and their difference
+    (right scale) — the pupil aberration that makes distortion change from plane to plane.
+    0 everywhere = image-side telecentric."""
+    _check(pa)
+    fig, ax = figure_and_axes(ax)
+    ax.axhline(0.0, **ZERO)
+    (a,) = ax.plot(*_ok(pa, pa.cra_deg), "o-", color="tab:blue", ms=4)
+    (b,) = ax.plot(pa.fields, pa.cra_paraxial_deg, "--", color="0.35", lw=1.0)
+    ax.set_xlabel(_xlabel(pa))
+    ax.set_ylabel("chief-ray angle in image space (deg)", color="tab:blue")
+    ax.grid(True, **GRID)
+    tw = ax.twinx()
+    (c,) = tw.plot(*_ok(pa, pa.cra_deg - pa.cra_paraxial_deg), "s:", color="tab:orange", ms=3)
+    tw.set_ylabel("real − paraxial (deg)", color="tab:orange")
+    ax.legend(
+        [a, b, c],
+        [f"real (max |CRA| {fmt(pa.max_abs_cra_deg, 4)}°)", "paraxial", "real − paraxial"],
+        fontsize=8,
+        frameon=False,
+    )
+    set_title(ax, title or f"{pa.name}: image-side chief-ray angle")
+    return fig
+
+
+def plot_distortion_slope(pa: PupilAnalysis, *, ax=None, title: str | None = None):
+    """∂D0/∂s' (µm of distortion per mm of image-plane shift) against the field: how the
+    characteristic distortion changes from one image plane to another (exact, Eq. 8)."""
+    _check(pa)
+    fig, ax = figure_and_axes(ax)
+    ax.axhline(0.0, **ZERO)
+    f, v = _ok(pa, 1000.0 * pa.slope)
+    ax.plot(f, v, "o-", color="tab:red", ms=4)
+    ax.set_xlabel(_xlabel(pa))
+    ax.set_ylabel("∂D0/∂s' (µm per mm)")
+    ax.grid(True, **GRID)
+    set_title(ax, title or f"{pa.name}: change of distortion with the image plane")
+    return fig
+
+
+def plot_entrance_pupil(pa: PupilAnalysis, *, ax=None, title: str | None = None):
+    """The real entrance pupil's shift from the paraxial E0 along the axis (mm, left scale) and
+    the lateral viewpoint offset — the distance of the object-space chief ray from E0 (mm, right
+    scale) — against the field."""
+    _check(pa)
+    fig, ax = figure_and_axes(ax)
+    ax.axhline(0.0, **ZERO)
+    (a,) = ax.plot(*_ok(pa, pa.entrance_pupil_shift), "o-", color="tab:green", ms=4)
+    ax.set_xlabel(_xlabel(pa))
+    ax.set_ylabel("entrance pupil shift from E0 (mm)", color="tab:green")
+    ax.grid(True, **GRID)
+    tw = ax.twinx()
+    (b,) = tw.plot(*_ok(pa, pa.viewpoint_offset), "s--", color="tab:purple", ms=3.5)
+    tw.set_ylabel("viewpoint offset (mm)", color="tab:purple")
+    ax.legend(
+        [a, b],
+        ["entrance pupil shift (axial)", "viewpoint offset (lateral)"],
+        fontsize=8,
+        frameon=False,
+    )
+    set_title(ax, title or f"{pa.name}: entrance pupil (viewpoint) with field")
+    return fig
+
+
+def plot_pupils(pa: PupilAnalysis):
+    """One figure of three panels: chief-ray angle, ∂D0/∂s' and the entrance-pupil shift."""
+    _check(pa)
+    fig, ax0 = figure_and_axes(None, figsize=(15.0, 4.6))
+    ax0.remove()
+    axs = fig.subplots(1, 3)
+    plot_chief_ray_angle(pa, ax=axs[0])
+    plot_distortion_slope(pa, ax=axs[1])
+    plot_entrance_pupil(pa, ax=axs[2])
+    return fig

@@ -1,0 +1,209 @@
+"""Real chief rays on a 2-D field grid (raytrace.trace.chief_rays_2d, raytrace.kernels.aim2d).
+
+Referees: the meridional aim of raytrace.trace.chief_rays rotated to the field's azimuth (a
+rotationally symmetric lens has no other chief ray: an invariant, not an earlier output), and
+optiland 0.6.3 (an independent 3-D real-ray tracer with its own iterative ray aiming and its own
+angle-field definition, tan(field_x), tan(field_y) — optiland/fields/field_types/angle.py).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from raytrace.errors import TraceError
+from raytrace.files.library import load_lens
+from raytrace.paraxial import paraxial
+from raytrace.trace import STATUS_AIM_FAILED, STATUS_OK, chief_rays, chief_rays_2d
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _grid(fmax: float, n: int = 9):
+    """A square grid of field angles (deg) whose corners lie at ``fmax`` (tan-spaced)."""
+    t = np.linspace(-1.0, 1.0, n) * math.tan(math.radians(fmax)) / math.sqrt(2.0)
+    a = np.degrees(np.arctan(t))
+    return np.meshgrid(a, a)
+
+
+def _meridional_rotated(lens, X, Y, z, *, heights=False, **kw):
+    """Image points of the meridional chief rays of the same fields, rotated to each azimuth."""
+    if heights:
+        r, phi = np.hypot(X, Y), np.arctan2(Y, X)
+        cr = chief_rays(lens, object_heights_mm=r.ravel(), **kw)
+    else:
+        tx, ty = np.tan(np.radians(X)), np.tan(np.radians(Y))
+        phi = np.arctan2(ty, tx)
+        cr = chief_rays(lens, fields_deg=np.degrees(np.arctan(np.hypot(tx, ty))).ravel(), **kw)
+    h = cr.heights_at(z).reshape((len(z),) + X.shape)
+    return np.stack([h * np.cos(phi), h * np.sin(phi)], axis=-1)
+
+
+@pytest.mark.parametrize(
+    "name,od",
+    [
+        ("cooke-triplet-f4", math.inf),
+        ("cooke-triplet-f4", 500.0),
+        ("topogon-us2031792-fig1", math.inf),
+        ("topogon-like-pestrecov", math.inf),
+        ("super-angulon-de975637", math.inf),
+    ],
+)
+def test_symmetric_lens_equals_the_meridional_chief_ray_rotated(name, od):
+    lens = load_lens(name)
+    par = paraxial(lens, od)
+    X, Y = _grid(min(lens.field.value, 40.0) if lens.field.kind == "angle" else 20.0)
+    # image planes: Gaussian and defocused by ±0.4 mm. (In a plane just behind the last vertex
+    # the two differ by up to ~5e-12 mm: there a stop error moves the ray's point almost 1:1,
+    # and the meridional referee stops at |stop residual| <= 1e-12 x R_stop without polishing.)
+    z = np.array([par.z_gauss, par.z_gauss + 0.4, par.z_gauss - 0.4])
+    cr = chief_rays_2d(lens, X, Y, object_distance=od)
+    assert cr.shape == X.shape and np.all(cr.status == STATUS_OK)
+    ref = _meridional_rotated(lens, X, Y, z, object_distance=od)
+    np.testing.assert_allclose(cr.positions_at(z), ref, rtol=0, atol=1e-12)
+    # the aim: the stop point is (0, 0) to the tolerance (1e-12 x max(1, R_stop))
+    assert np.max(np.abs(cr.stop_residual_x)) <= cr.tolerance
+    assert np.max(np.abs(cr.stop_residual_y)) <= cr.tolerance
+
+
+def test_object_coordinates_equal_the_meridional_heights_rotated():
+    lens = load_lens("cooke-triplet-f4")
+    par = paraxial(lens, 500.0)
+    a = np.linspace(-60.0, 60.0, 7)
+    X, Y = np.meshgrid(a, a)
+    z = np.array([par.z_gauss, par.z_gauss - 0.2])
+    cr = chief_rays_2d(lens, object_x_mm=X, object_y_mm=Y, object_distance=500.0)
+    np.testing.assert_allclose(cr.x_start, X, rtol=0, atol=0)  # the object point itself
+    np.testing.assert_allclose(cr.z_start, -500.0)
+    ref = _meridional_rotated(lens, X, Y, z, heights=True, object_distance=500.0)
+    np.testing.assert_allclose(cr.positions_at(z), ref, rtol=0, atol=1e-12)
+
+
+def test_finite_object_at_high_magnification_within_the_meridional_aim_error():
+    # the Twinplex-like projector images at about 10x: the meridional aim's own stop error
+    # (<= 1e-12 x max(1, R_stop) mm, not polished) is magnified to the image, so the bound is
+    # relative: 1e-13 of the image radius (~3e-11 mm at the field edge; measured 3.5e-12 mm)
+    lens = load_lens("twinplex-like-55-525")
+    par = paraxial(lens)
+    X, Y = _grid(40.0, 7)
+    cr = chief_rays_2d(lens, X, Y)
+    z = np.array([par.z_gauss])
+    P = cr.positions_at(z)
+    ref = _meridional_rotated(lens, X, Y, z)
+    scale = np.maximum(1.0, np.hypot(ref[..., 0], ref[..., 1]))
+    assert np.all(np.hypot(*np.moveaxis(P - ref, -1, 0)) <= 1e-13 * scale)
+
+
+def test_field_convention_is_the_direction_tangents():
+    # object at infinity: the object-space ray has direction ∝ (tan ax, tan ay, 1); a meridional
+    # field (0, a) is the meridional chief ray's (0, sin a, cos a)
+    lens = load_lens("cooke-triplet-f4")
+    cr = chief_rays_2d(lens, [12.0, 0.0, -7.0], [5.0, 15.0, 9.0])
+    tx, ty = cr.tan_start
+    np.testing.assert_allclose(tx, np.tan(np.radians([12.0, 0.0, -7.0])), rtol=1e-15)
+    np.testing.assert_allclose(ty, np.tan(np.radians([5.0, 15.0, 9.0])), rtol=1e-15)
+    m = chief_rays(lens, fields_deg=[15.0])
+    assert cr.M_start[1] == pytest.approx(m.M_start[0], abs=3e-16)  # (0, tan a, 1)/norm: ulps
+    assert cr.N_start[1] == pytest.approx(m.N_start[0], abs=3e-16)
+    # positive fields give positive image coordinates (docs/design.md, "Conventions")
+    P = cr.positions_at(paraxial(lens).z_gauss)
+    assert P[0, 0] > 0 and P[0, 1] > 0 and P[1, 1] > 0 and P[2, 0] < 0
+
+
+def test_nominal_angles_with_a_finite_object_are_object_points_p0_tan():
+    lens = load_lens("cooke-triplet-f4")
+    par = paraxial(lens, 800.0)
+    cr = chief_rays_2d(lens, 10.0, -6.0, object_distance=800.0)
+    p0 = par.z_object - par.z_E0
+    assert float(cr.x_start) == pytest.approx(p0 * math.tan(math.radians(10.0)), rel=1e-14)
+    assert float(cr.y_start) == pytest.approx(p0 * math.tan(math.radians(-6.0)), rel=1e-14)
+
+
+def test_rays_the_lens_cannot_pass_get_a_status_and_nan():
+    lens = load_lens("cooke-triplet-f4")
+    cr = chief_rays_2d(lens, [0.0, 10.0, 45.0, 70.0], [0.0, 10.0, 45.0, 10.0])
+    assert list(cr.status[:2]) == [STATUS_OK, STATUS_OK]
+    assert np.all(cr.status[2:] != STATUS_OK)
+    assert np.all(np.isnan(cr.positions_at(60.0)[2:]))
+    assert np.all(np.isfinite(cr.positions_at(60.0)[:2]))
+    assert set(cr.status_names[2:]) <= {"aim_failed", "missed", "tir", "clipped"}
+    assert STATUS_AIM_FAILED in cr.status or np.all(cr.surface[2:] > 0)
+
+
+def test_shapes_and_plane_stacks():
+    lens = load_lens("cooke-triplet-f4")
+    X, Y = _grid(15.0, 5)
+    cr = chief_rays_2d(lens, X[:3], Y[:3])
+    assert cr.positions_at(60.0).shape == (3, 5, 2)
+    assert cr.positions_at([60.0, 61.0]).shape == (2, 3, 5, 2)
+    one = chief_rays_2d(lens, fields_y_deg=[0.0, 5.0])  # a missing component is zero
+    np.testing.assert_array_equal(one.x_last, 0.0)
+
+
+def test_bad_requests():
+    lens = load_lens("cooke-triplet-f4")
+    with pytest.raises(TraceError, match="not both"):
+        chief_rays_2d(lens, 1.0, 1.0, object_x_mm=1.0, object_distance=100.0)
+    with pytest.raises(TraceError, match="finite object"):
+        chief_rays_2d(lens, object_x_mm=[1.0], object_y_mm=[0.0])
+    with pytest.raises(TraceError, match="90"):
+        chief_rays_2d(lens, [90.0], [0.0])
+    with pytest.raises(TraceError, match="broadcast"):
+        chief_rays_2d(lens, [1.0, 2.0], [1.0, 2.0, 3.0])
+    with pytest.raises(TraceError, match="give"):
+        chief_rays_2d(lens)
+
+
+@pytest.mark.parametrize(
+    "name", ["cooke-triplet-f4", "topogon-us2031792-fig1", "topogon-like-pestrecov"]
+)
+def test_2d_chief_ray_image_points_agree_with_optiland(name):
+    """optiland 0.6.3: its own chief rays (Px = Py = 0) aimed at the stop centre by its iterative
+    aimer (tolerance 1e-13), for normalised fields Hx, Hy × its max field with its angle-field
+    convention (direction tangents tan(field_x), tan(field_y)), on its image surface."""
+    pytest.importorskip("optiland")
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import optiland_adapter as ola
+
+    lens = load_lens(name)
+    op = ola.build_optic(lens)
+    op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-13)
+    fmax = float(op.fields.max_field)
+    X, Y = _grid(lens.field.value, 9)
+    cr = chief_rays_2d(lens, X, Y)
+    ours = cr.positions_at(paraxial(lens).z_image_file)
+    rays = op.trace_generic(
+        Hx=(X / fmax).ravel(), Hy=(Y / fmax).ravel(), Px=0.0, Py=0.0,
+        wavelength=lens.wavelength / 1000.0,
+    )  # fmt: skip
+    theirs = np.stack([np.asarray(rays.x), np.asarray(rays.y)], -1).reshape(ours.shape)
+    assert np.max(np.abs(ours - theirs)) <= 1e-9
+
+
+def test_finite_object_heights_agree_with_optiland():
+    pytest.importorskip("optiland")
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import optiland_adapter as ola
+
+    lens = load_lens("cooke-triplet-f4").with_object_distance(500.0)
+    op = ola.build_optic(lens)
+    op.fields.fields.clear()  # the adapter's angle fields → object heights (mm)
+    op.fields.set_type("object_height")
+    op.fields.add(y=0.0)
+    op.fields.add(y=100.0)
+    op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-13)
+    a = np.linspace(-60.0, 60.0, 5)
+    X, Y = np.meshgrid(a, a)
+    cr = chief_rays_2d(lens, object_x_mm=X, object_y_mm=Y)
+    ours = cr.positions_at(paraxial(lens).z_image_file)
+    fmax = float(op.fields.max_field)
+    rays = op.trace_generic(
+        Hx=(X / fmax).ravel(), Hy=(Y / fmax).ravel(), Px=0.0, Py=0.0,
+        wavelength=lens.wavelength / 1000.0,
+    )  # fmt: skip
+    theirs = np.stack([np.asarray(rays.x), np.asarray(rays.y)], -1).reshape(ours.shape)
+    assert np.max(np.abs(ours - theirs)) <= 1e-9
