@@ -315,11 +315,11 @@ class GridDecomposition:
 
     def __repr__(self) -> str:
         v = self.values
+        terms = ", ".join(f"{k} = {v[k]:.4g}" for k in ("K1", "P1", "P2", "S1", "S2") if k in v)
         return (
             f"GridDecomposition(plane {self.plane}, principal point {self.principal_point}: "
-            f"c = {v['c']:.6f} mm, x0 = {v['x0']:.3g}, y0 = {v['y0']:.3g} mm, "
-            f"K1 = {v['K1']:.4g}, P1 = {v['P1']:.3g}, P2 = {v['P2']:.3g}, S1 = {v['S1']:.3g}, "
-            f"S2 = {v['S2']:.3g}; residual RMS {self.rms_mm:.3g} mm)"
+            f"c = {v['c']:.6f} mm, x0 = {v['x0']:.3g}, y0 = {v['y0']:.3g} mm, {terms}; "
+            f"residual RMS {self.rms_mm:.3g} mm)"
         )
 
 

@@ -147,8 +147,9 @@ def plot_distortion_vectors(
             color=REAL, width=0.004, zorder=2,
         )  # fmt: skip
         key = _key_length(vmax)
-        ax.quiverkey(q, 0.82, 1.02, key, f"{fmt(key * 1000, 3)} um", labelpos="E",
-                     coordinates="axes")  # fmt: skip
+        ax.quiverkey(
+            q, 0.97, 1.015, key, f"{fmt(key * 1000, 3)} um", labelpos="W", coordinates="axes"
+        )  # fmt: skip
     ax.plot(pos[:, 0], pos[:, 1], ".", color=IDEAL, ms=2.5, zorder=1)
     ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
     ax.set_aspect("equal", adjustable="datalim")
@@ -161,6 +162,7 @@ def plot_distortion_vectors(
             f"{grid.name}: {what}, {grid.plane_label(p)} (max {fmt(vmax * 1000, 4)} um, "
             f"reference {grid.reference_point})"
         ),
+        pad=16.0,
     )
     return fig
 

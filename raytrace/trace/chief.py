@@ -34,6 +34,10 @@ from ..paraxial.conjugates import resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
 
 
+#: Fields per kernel call: a larger request is aimed in chunks (Ctrl-C stops between them).
+AIM_CHUNK = 8192
+
+
 @dataclass(frozen=True, eq=False)
 class _AimSetup:
     packed: PackedLens  # at the wavelengths of the call
@@ -411,23 +415,23 @@ def aim(
     surface = np.empty((nw, n), dtype=np.int32)
     evals = np.empty((nw, n), dtype=np.int32)
     residual = np.empty((nw, n))
-    aim_chief(
-        su.packed.lens_arrays,
-        su.packed.stop,
-        1 if finite else 0,
-        z_obj,
-        np.ascontiguousarray(kf, dtype=np.float64),
-        su.slope0,
-        su.tol,
-        su.hscale,
-        bool(clip),
-        start,
-        last,
-        status,
-        surface,
-        evals,
-        residual,
-    )
+    kf = np.ascontiguousarray(kf, dtype=np.float64)
+    outs = (start, last, status, surface, evals, residual)
+    if n <= AIM_CHUNK:
+        aim_chief(su.packed.lens_arrays, su.packed.stop, 1 if finite else 0, z_obj, kf,
+                  su.slope0, su.tol, su.hscale, bool(clip), *outs)  # fmt: skip
+    else:
+        # chunks of fields in order of |field| (the kernel's own continuation order), so that
+        # Ctrl-C stops a long aim within a fraction of a second
+        order = np.argsort(np.abs(kf), kind="stable")
+        for i0 in range(0, n, AIM_CHUNK):
+            idx = order[i0 : i0 + AIM_CHUNK]
+            part = tuple(np.empty(a.shape[:-1] + (idx.size,), dtype=a.dtype) for a in outs)
+            aim_chief(su.packed.lens_arrays, su.packed.stop, 1 if finite else 0, z_obj,
+                      np.ascontiguousarray(kf[idx]), su.slope0, su.tol, su.hscale, bool(clip),
+                      *part)  # fmt: skip
+            for a, b in zip(outs, part, strict=True):
+                a[..., idx] = b
     rays = []
     for i in range(nw):
         y0, z0, M0, N0 = start[i]

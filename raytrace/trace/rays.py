@@ -30,7 +30,7 @@ PARALLEL_THRESHOLD = 32768
 
 #: Rays per kernel call: a larger batch is traced in chunks of this size (contiguous views, no
 #: copies), so that Ctrl-C stops a long trace within a fraction of a second.
-CHUNK_RAYS = 1 << 20
+CHUNK_RAYS = 1 << 18
 
 #: numba's parallel layer is not re-entrant from several Python threads (workqueue layer): every
 #: parallel kernel launch and thread-count change holds this lock.
