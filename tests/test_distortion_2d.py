@@ -41,7 +41,8 @@ thin prism S1 (r², 0) + S2 (0, r²); OpenCV (y down): p1 = −c P2, p2 = c P1, 
    whose sign for this lens is +: the strongly curved last surface (σ_6 < 0, E_6 > 0) dominates.
    Measured with optiland today (11 × 11 grid to 5°, d = ±0.05 mm): P2 + S2 within 0.4 % of
    P2_NAT; the decomposition gives P2 = +4.7e-6, S2 = +1.6e-5 mm⁻¹ for d = +0.05 mm, both
-   positive, and the Brown–Conrady fit (no prism term) OpenCV p1 = −4.4e-4 (negative), p2 = 0.
+   positive, and the Brown–Conrady fit (no prism term) OpenCV p1 = −4.5e-4 (negative), p2 = 0
+   (its b1 = 3.9e-6 is then flagged: the thin-prism part it cannot hold leaks into it).
 """
 
 from __future__ import annotations
@@ -153,6 +154,16 @@ def test_sensor_grid_fills_the_sensor_corner_to_corner(cooke):
     g = distortion_grid(cooke, sensor="24x16", grid=(7, 5))
     np.testing.assert_allclose(g.ideal[0, 0, 0], [-12.0, -8.0], rtol=0, atol=1e-9)
     np.testing.assert_allclose(g.ideal[0, -1, -1], [12.0, 8.0], rtol=0, atol=1e-9)
+    # a principal-point offset (x right, y up from the sensor centre): the axis lies there, and
+    # the Brown–Conrady principal point (photogrammetric frame, origin at the sensor centre) too
+    from distortion.camera import Sensor
+
+    s = Sensor.from_spec("24x16", pitch_um=4, principal_point_offset_mm=(1.0, 0.5))
+    g = distortion_grid(cooke, sensor=s, grid=(9, 7))
+    np.testing.assert_allclose(g.ideal[0, 0, 0], [-13.0, -8.5], rtol=0, atol=1e-9)
+    fit = fit_brown_conrady(g, opencv=False)
+    assert fit.values["xp"] == pytest.approx(1.0, abs=1e-6)  # misfit of an off-centre grid
+    assert fit.values["yp"] == pytest.approx(0.5, abs=1e-6)
 
 
 # ---------------------------------------------------------------- decomposition

@@ -53,6 +53,7 @@ from ..packing import pack
 from ..paraxial import (
     ImagePlane,
     ParaxialResult,
+    distortion_slope,
     ideal_heights,
     orthoscopy_abscissa,
     paraxial,
@@ -245,13 +246,9 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
                 raise TraceError(f"{op.label()}: the chief ray fails (status {int(cr.status[j])})")
             if t == "landing_angle":
                 v = float(cr.landing_angle_deg[j])
-            elif t == "distortion_slope":
-                # dD0/ds' = d y'/ds' - d y0'/ds': the final segment gives tan a'; y0' = K0 x
-                # with K0 affine in s' (Eq. 8), so its slope is the exact difference of Eq. 8
-                # one millimetre apart
+            elif t == "distortion_slope":  # dD0/ds' (raytrace.paraxial.distortion_slope)
                 x = orthoscopy_abscissa(par, fields[j], kind)
-                y0 = ideal_heights(par, x, np.array([0.0, 1.0]))
-                v = float(cr.tan_out[j]) - float(y0[1, 0] - y0[0, 0])
+                v = float(distortion_slope(par, x, cr.tan_out[j]))
             else:
                 z = _plane_z(par, p.get("plane"))
                 y_real = float(cr.heights_at(z)[j])

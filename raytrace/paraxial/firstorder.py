@@ -50,6 +50,9 @@ class ParaxialResult:
     p0:        s − HE0 (−inf for infinity); working_fnumber: 1/(2 n' |u'_marginal|).
     z_last:    z of the last vertex; z_image_file: the image plane the lens file defines.
     n_object, n_image: indices of object and image space.
+    chief_height_last, chief_slope_image: the paraxial chief ray of unit object-space slope
+               (tan α = 1) at the last vertex: its height (mm) and image-space slope — what
+               Eq. (8) reduces to when the exit pupil is at infinity (image-space telecentric).
     """
 
     efl: float
@@ -87,6 +90,8 @@ class ParaxialResult:
     n_object: float
     n_image: float
     wavelength: float
+    chief_height_last: float = math.nan
+    chief_slope_image: float = math.nan
 
     def __repr__(self) -> str:
         obj = (
@@ -348,4 +353,6 @@ def paraxial(
         n_object=n0,
         n_image=nk,
         wavelength=wl,
+        chief_height_last=float(yck),
+        chief_slope_image=float(uck),
     )

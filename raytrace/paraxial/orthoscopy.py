@@ -194,8 +194,18 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float) -> PestrecovConstan
 
     ``p0 = s − HE0``, ``p0' = s' − H'E0'``; ``M0 = p0' / (m_e p0)`` (finite conjugates) or
     ``F0 = p0' / m_e`` (object at infinity). In the Gaussian plane M0 = m0 and F0 = f (Eq. 7).
+
+    For an image-space telecentric lens (exit pupil at infinity, m_e = ∞) Eq. (8) is the limit
+    ∞/∞; its value is the height of the paraxial chief ray in the plane per unit abscissa, which
+    is the same in every plane: F0 = y_c (the chief ray of tan α = 1 at the last vertex), or
+    M0 = y_c / p0.
     """
     p0p = float(s_prime) - par.HpE0p
+    if math.isinf(par.m_e) and math.isfinite(par.chief_height_last):
+        z = float(s_prime) + par.z_Hp
+        h = par.chief_height_last + (z - par.z_last) * par.chief_slope_image
+        scale = h if par.infinite else h / par.p0
+        return PestrecovConstants(float(s_prime), par.p0, p0p, scale, par.infinite)
     if par.infinite:
         return PestrecovConstants(
             float(s_prime), par.p0, p0p, orthoscopy_constant_infinite(p0p, par.m_e), True
