@@ -51,6 +51,8 @@ _API: dict[str, str] = {
     "ChromaticChiefRays": "raytrace.trace",
     "trace_rays": "raytrace.trace",
     "RayBatch": "raytrace.trace",
+    "chief_rays_2d": "raytrace.trace",
+    "ChiefRays2D": "raytrace.trace",
     "ray_fan": "raytrace.trace",
     "RayFan": "raytrace.trace",
     "spot_diagram": "raytrace.trace",
@@ -78,6 +80,14 @@ _API: dict[str, str] = {
     "ProjectionDistortion": "distortion.definitions",
     "pupil_analysis": "distortion.telecentricity",
     "PupilAnalysis": "distortion.telecentricity",
+    # 2-D distortion, decentering, Brown-Conrady
+    "distortion_grid": "distortion.grid",
+    "DistortionGrid": "distortion.grid",
+    "radial_by_azimuth": "distortion.grid",
+    "decompose_distortion": "distortion.grid",
+    "GridDecomposition": "distortion.grid",
+    "fit_brown_conrady": "distortion.grid",
+    "BrownConradyFit": "distortion.grid",
     # variation with object distance (Fraser & Shortis 1992) and coefficients
     "trace_variation": "distortion.variation",
     "analyze_variation": "distortion.variation",
@@ -112,6 +122,9 @@ _API: dict[str, str] = {
     "plot_profiles": "orthoscope.plots.variation",
     "plot_g": "orthoscope.plots.variation",
     "plot_ray_fan": "orthoscope.plots.rays",
+    "plot_grid_distortion": "orthoscope.plots.grid",
+    "plot_distortion_vectors": "orthoscope.plots.grid",
+    "plot_radial_by_azimuth": "orthoscope.plots.grid",
     "plot_spot": "orthoscope.plots.rays",
     "save_figure": "orthoscope.plots.save",
     "plot_glass_map": "orthoscope.plots.glassmap",
@@ -180,6 +193,15 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         characteristic_distortion,
     )
     from distortion.coefficients import fit_radial, opencv_model
+    from distortion.grid import (
+        BrownConradyFit,
+        DistortionGrid,
+        GridDecomposition,
+        decompose_distortion,
+        distortion_grid,
+        fit_brown_conrady,
+        radial_by_azimuth,
+    )
     from distortion.colour import FocalShift, LateralColour, focal_shift, lateral_colour
     from distortion.compensation import CompensationResult, compensate
     from distortion.curve import DistortionCurve, make_curve
@@ -204,11 +226,13 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from raytrace.paraxial import ImagePlane, ParaxialResult, paraxial, pestrecov_constants
     from raytrace.trace import (
         ChiefRays,
+        ChiefRays2D,
         ChromaticChiefRays,
         RayBatch,
         RayFan,
         SpotDiagram,
         chief_rays,
+        chief_rays_2d,
         ray_fan,
         spot_diagram,
         trace_rays,
@@ -227,6 +251,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         plot_rotation,
     )
     from .plots.glassmap import plot_glass_map
+    from .plots.grid import plot_distortion_vectors, plot_grid_distortion, plot_radial_by_azimuth
     from .plots.layout import plot_layout
     from .plots.rays import plot_ray_fan, plot_spot
     from .plots.telecentricity import (
