@@ -193,6 +193,11 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         characteristic_distortion,
     )
     from distortion.coefficients import fit_radial, opencv_model
+    from distortion.colour import FocalShift, LateralColour, focal_shift, lateral_colour
+    from distortion.compensation import CompensationResult, compensate
+    from distortion.curve import DistortionCurve, make_curve
+    from distortion.definitions import ProjectionDistortion, projection_distortion
+    from distortion.errors import CalibrationError, DataError
     from distortion.grid import (
         BrownConradyFit,
         DistortionGrid,
@@ -202,11 +207,6 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         fit_brown_conrady,
         radial_by_azimuth,
     )
-    from distortion.colour import FocalShift, LateralColour, focal_shift, lateral_colour
-    from distortion.compensation import CompensationResult, compensate
-    from distortion.curve import DistortionCurve, make_curve
-    from distortion.definitions import ProjectionDistortion, projection_distortion
-    from distortion.errors import CalibrationError, DataError
     from distortion.tablefile import read_distortion_table
     from distortion.telecentricity import PupilAnalysis, pupil_analysis
     from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
@@ -254,6 +254,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from .plots.grid import plot_distortion_vectors, plot_grid_distortion, plot_radial_by_azimuth
     from .plots.layout import plot_layout
     from .plots.rays import plot_ray_fan, plot_spot
+    from .plots.save import save_figure
     from .plots.telecentricity import (
         plot_chief_ray_angle,
         plot_distortion_slope,
@@ -261,4 +262,3 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         plot_pupils,
     )
     from .plots.variation import plot_g, plot_profiles
-    from .plots.save import save_figure
