@@ -88,6 +88,11 @@ _API: dict[str, str] = {
     "GridDecomposition": "distortion.grid",
     "fit_brown_conrady": "distortion.grid",
     "BrownConradyFit": "distortion.grid",
+    # rectangular-sensor metrics (TV distortion, keystone, straightness) and the certificate
+    "sensor_metrics": "distortion.sensor_metrics",
+    "SensorMetrics": "distortion.sensor_metrics",
+    "calibration_certificate": "distortion.certificate",
+    "CalibrationCertificate": "distortion.certificate",
     # variation with object distance (Fraser & Shortis 1992) and coefficients
     "trace_variation": "distortion.variation",
     "analyze_variation": "distortion.variation",
@@ -125,6 +130,7 @@ _API: dict[str, str] = {
     "plot_grid_distortion": "orthoscope.plots.grid",
     "plot_distortion_vectors": "orthoscope.plots.grid",
     "plot_radial_by_azimuth": "orthoscope.plots.grid",
+    "plot_certificate": "orthoscope.plots.certificate",
     "plot_spot": "orthoscope.plots.rays",
     "save_figure": "orthoscope.plots.save",
     "plot_glass_map": "orthoscope.plots.glassmap",
@@ -187,6 +193,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         select_camera_model,
         write_calibration,
     )
+    from distortion.certificate import CalibrationCertificate, calibration_certificate
     from distortion.characteristic import (
         CharacteristicDistortion,
         ChromaticDistortion,
@@ -207,6 +214,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         fit_brown_conrady,
         radial_by_azimuth,
     )
+    from distortion.sensor_metrics import SensorMetrics, sensor_metrics
     from distortion.tablefile import read_distortion_table
     from distortion.telecentricity import PupilAnalysis, pupil_analysis
     from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
@@ -238,6 +246,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         trace_rays,
     )
 
+    from .plots.certificate import plot_certificate
     from .plots.colour import (
         plot_distortion_by_wavelength,
         plot_focal_shift,

@@ -22,8 +22,76 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .errors import LensError
+from .frames import AFTER_MODES, Placement
 from .kernels.codes import KIND_ASPHERE, KIND_PLANE, KIND_QUADRIC
 from .materials import AIR, LAMBDA_D, Material
+
+#: shapes of a :class:`ClearAperture`
+APERTURE_SHAPES = ("circle", "rectangle", "ellipse")
+
+
+@dataclass(frozen=True)
+class ClearAperture:
+    """A hard clear aperture of a surface (rays outside it are vignetted, status CLIPPED), in
+    the surface's own frame (:mod:`raytrace.frames`), in addition to ``Surface.semi_diameter``.
+
+    shape:          ``"circle"`` (radius ``half_x``; ``half_y`` equal to it), ``"rectangle"``
+                    (half-widths ``half_x``, ``half_y``; Zemax ``SQAP``, CODE V ``REX``/``REY``)
+                    or ``"ellipse"`` (semi-axes; Zemax ``ELAP``, CODE V ``ELX``/``ELY``).
+    half_x, half_y: mm (> 0).
+    x0, y0:         the aperture's centre in the surface frame, mm (Zemax ``OBDC``, CODE V
+                    ``ADX``/``ADY``): an off-axis section of a parent surface.
+    """
+
+    shape: str
+    half_x: float
+    half_y: float
+    x0: float = 0.0
+    y0: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.shape not in APERTURE_SHAPES:
+            raise ValueError(
+                f"clear aperture shape must be one of {', '.join(APERTURE_SHAPES)}, "
+                f"got {self.shape!r}"
+            )
+        for name in ("half_x", "half_y", "x0", "y0"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"clear aperture {name} must be a finite number, got {v!r}")
+            object.__setattr__(self, name, float(v) + 0.0)
+        if not (self.half_x > 0.0 and self.half_y > 0.0):
+            raise ValueError(
+                f"clear aperture half-widths must be positive, got {self.half_x}, {self.half_y}"
+            )
+        if self.shape == "circle" and self.half_x != self.half_y:
+            raise ValueError("a circular clear aperture has half_x == half_y (its radius)")
+
+    @property
+    def code(self) -> int:
+        """1 circle, 2 rectangle, 3 ellipse (the kernels' code)."""
+        return APERTURE_SHAPES.index(self.shape) + 1
+
+    def contains(self, x, y):
+        """Whether local points (x, y) lie inside (on the edge counts as inside)."""
+        u = (np.asarray(x, dtype=float) - self.x0) / self.half_x
+        v = (np.asarray(y, dtype=float) - self.y0) / self.half_y
+        if self.shape == "rectangle":
+            return (np.abs(u) <= 1.0) & (np.abs(v) <= 1.0)
+        return u * u + v * v <= 1.0
+
+    @property
+    def reach(self) -> float:
+        """Largest distance of an aperture point from the vertex (mm)."""
+        if self.shape == "rectangle":
+            return math.hypot(abs(self.x0) + self.half_x, abs(self.y0) + self.half_y)
+        return math.hypot(self.x0, self.y0) + max(self.half_x, self.half_y)
+
+    def describe(self) -> str:
+        off = f" at ({self.x0:g}, {self.y0:g})" if (self.x0 or self.y0) else ""
+        if self.shape == "circle":
+            return f"circle r {self.half_x:g}{off}"
+        return f"{self.shape} {self.half_x:g} x {self.half_y:g}{off}"
 
 @dataclass(frozen=True)
 class Surface:
@@ -38,6 +106,25 @@ class Surface:
     aspheric:      even-asphere coefficients (A4, A6, A8, ...) of r⁴, r⁶, r⁸, ... (mm^(1-2j)).
     label:         optional name (e.g. "STO"); listings number surfaces from 1.
     line:          the line of the source file that defined it (for messages), if any.
+
+    Placement and mirrors (:mod:`raytrace.frames` states every convention and its source):
+
+    placement:     :class:`~raytrace.frames.Placement` moving the surface's frame from the frame
+                   the light arrives in (decenter, then tilts; or tilts, then decenter); None =
+                   on the axis.
+    after:         the frame the thickness runs in after the surface: ``"stay"`` (the surface's
+                   frame; Zemax coordinate break, CODE V basic decenter), ``"return"`` (the
+                   arrival frame; CODE V ``DAR``, Zemax tilt/decenter *reverse*), ``"bend"``
+                   (the placement's rotation once more; CODE V ``BEN``) or a Placement (Zemax
+                   tilt/decenter after the surface; CODE V ``REV`` is ``placement=None`` with the
+                   inverse move here).
+    mirror:        a reflecting surface (Zemax ``GLAS MIRROR``, CODE V ``REFL``): ``material``
+                   is the medium the light returns into (the one before the mirror); thicknesses
+                   after an odd number of mirrors are negative, as in both programs.
+    coordinate_break: a Zemax ``COORDBRK``: not traced, only its placement and thickness count
+                   (curvature 0, no aperture, the medium continues).
+    aperture:      an extra hard :class:`ClearAperture` (rectangle, ellipse, off-axis circle) in
+                   the surface frame; None = only ``semi_diameter``.
     """
 
     curvature: float
@@ -49,6 +136,39 @@ class Surface:
     aspheric: tuple[float, ...] = ()
     label: str = ""
     line: int | None = field(default=None, compare=False)
+    placement: Placement | None = None
+    after: Placement | str = "stay"
+    mirror: bool = False
+    coordinate_break: bool = False
+    aperture: ClearAperture | None = None
+
+    def __post_init__(self) -> None:
+        p = self.placement
+        if p is not None and not isinstance(p, Placement):
+            raise ValueError(f"placement must be a Placement or None, got {type(p).__name__}")
+        if p is not None and p.is_identity:
+            object.__setattr__(self, "placement", None)
+        a = self.after
+        if isinstance(a, Placement):
+            if a.is_identity:
+                object.__setattr__(self, "after", "stay")
+        elif a not in AFTER_MODES:
+            raise ValueError(
+                f"after must be one of {', '.join(AFTER_MODES)} or a Placement, got {a!r}"
+            )
+        if self.aperture is not None and not isinstance(self.aperture, ClearAperture):
+            raise ValueError(
+                f"aperture must be a ClearAperture or None, got {type(self.aperture).__name__}"
+            )
+        for name in ("mirror", "coordinate_break"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name} must be True or False, got {getattr(self, name)!r}")
+
+    @property
+    def is_placed(self) -> bool:
+        """True when the surface moves the frame: a placement, or a move after it (``"return"``
+        and ``"bend"`` without a placement change nothing)."""
+        return self.placement is not None or isinstance(self.after, Placement)
 
     @property
     def radius(self) -> float:
@@ -74,6 +194,17 @@ class Surface:
             parts.append(f"asph={len(self.aspheric)} terms")
         if self.stop:
             parts.append("stop")
+        if self.mirror:
+            parts.append("mirror")
+        if self.coordinate_break:
+            parts.append("coordinate break")
+        if self.placement is not None:
+            parts.append(self.placement.describe())
+        if self.after != "stay":
+            a = self.after
+            parts.append("after " + (a.describe() if isinstance(a, Placement) else a))
+        if self.aperture is not None:
+            parts.append("aperture " + self.aperture.describe())
         return f"Surface({', '.join(parts)})"
 
     def sag(self, r: float | np.ndarray) -> float | np.ndarray:
@@ -89,31 +220,92 @@ class Surface:
         return z
 
 
+#: aperture kinds (:class:`Aperture`) and how listings show them
+APERTURE_KINDS = {
+    "fnumber": "f/{:g}",
+    "epd": "EPD {:g} mm",
+    "na": "NA {:g}",
+    "float": "float by stop size (stop semi-diameter {:g} mm)",
+    "working_fnumber": "working f/{:g}",
+    "cone_angle": "object cone angle {:g} deg",
+}
+
+
 @dataclass(frozen=True)
 class Aperture:
-    """System aperture: ``kind`` is ``"fnumber"`` (infinite-conjugate f/number, EPD = EFL/N),
-    ``"epd"`` (entrance-pupil diameter, mm) or ``"na"`` (object-space numerical aperture
-    n·sin U of the axial marginal ray; finite objects only)."""
+    """System aperture (the one conversion to an entrance-pupil diameter is
+    :func:`raytrace.paraxial.firstorder.entrance_pupil_diameter`):
+
+    - ``"fnumber"``: infinite-conjugate f/number N, EPD = EFL/N (Zemax ``FNUM x 0`` image-space
+      F/#, CODE V ``FNO``);
+    - ``"epd"``: entrance-pupil diameter, mm (Zemax ``ENPD``, CODE V ``EPD``);
+    - ``"na"``: object-space numerical aperture n·sin U of the axial marginal ray, finite objects
+      (Zemax ``OBNA x 0``, CODE V ``NAO``);
+    - ``"float"``: float by stop size (Zemax ``FLOA``): the pupil is as large as the stop lets
+      the paraxial marginal ray be; ``value`` is the stop's semi-diameter (mm);
+    - ``"working_fnumber"``: paraxial working F/# ``1/(2 |n' u'|)`` of the axial marginal ray in
+      image space (Zemax ``FNUM x 1``, "Paraxial Working F/#");
+    - ``"cone_angle"``: object cone angle, the half angle U (degrees) of the axial marginal ray in
+      object space, finite objects (Zemax ``OBNA x 1``, "Object Cone Angle").
+    """
 
     kind: str
     value: float
 
     def __post_init__(self) -> None:
-        if self.kind not in ("fnumber", "epd", "na"):
+        if self.kind not in APERTURE_KINDS:
             raise ValueError(f"unknown aperture kind {self.kind!r}")
+
+    def describe(self) -> str:
+        """E.g. ``f/4``, ``EPD 10 mm``, ``NA 0.1``."""
+        return APERTURE_KINDS[self.kind].format(self.value)
+
+
+#: image-space field specifications a reader turns into an object-space field
+IMAGE_FIELDS = ("paraxial_image_height", "real_image_height")
 
 
 @dataclass(frozen=True)
 class Field:
     """Field of view: ``kind`` ``"angle"`` (max half-field angle in degrees, the chief-ray slope
-    angle α in object space) or ``"height"`` (max object height in mm, finite objects)."""
+    angle α in object space) or ``"height"`` (max object height in mm, finite objects).
+
+    points: the field points of the file, ``(x, y)`` pairs in the field's unit (degrees: the
+        direction tangents' angles αx, αy of :func:`raytrace.trace.chief_rays_2d`; mm: object
+        coordinates); ``()`` when only the maximum is known. ``value`` is the largest radial one.
+    given:  when the file gave the field in image space (Zemax ``FTYP 2/3``, CODE V ``YIM`` /
+        ``YRI``): ``(kind, height_mm)`` with kind ``"paraxial_image_height"`` or
+        ``"real_image_height"`` — ``value`` is then the object-space field that gives that image
+        height (paraxial chief ray in the paraxial image plane, or the real chief ray on the
+        file's image surface, :func:`raytrace.trace.field_for_image_height`), so that every
+        consumer sees an object-space field, and writers can write the original back.
+    """
 
     kind: str
     value: float
+    points: tuple[tuple[float, float], ...] = ()
+    given: tuple[str, float] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in ("angle", "height"):
             raise ValueError(f"unknown field kind {self.kind!r}")
+        pts = tuple((float(a) + 0.0, float(b) + 0.0) for a, b in self.points)
+        if not all(math.isfinite(v) for p in pts for v in p):
+            raise ValueError("field points must be finite numbers")
+        object.__setattr__(self, "points", pts)
+        if self.given is not None:
+            k, v = self.given
+            if k not in IMAGE_FIELDS or not math.isfinite(float(v)):
+                raise ValueError(f"given: expected (one of {IMAGE_FIELDS}, mm), got {self.given!r}")
+            object.__setattr__(self, "given", (k, float(v)))
+
+    def describe(self) -> str:
+        """E.g. ``20 deg``, ``5 mm``, ``21.6 mm real image height (20.3 deg)``."""
+        unit = "deg" if self.kind == "angle" else "mm"
+        if self.given is None:
+            return f"{self.value:g} {unit}"
+        k, v = self.given
+        return f"{v:g} mm {k.replace('_', ' ')} ({self.value:.6g} {unit})"
 
 
 @dataclass(frozen=True)
@@ -135,6 +327,15 @@ class Lens:
         (:func:`raytrace.glass.thermal.index_at`); ``None`` = each catalog material at its own
         reference conditions (the vendor catalogs: 20 °C, 1 atm). Model glasses and fixed indices
         are not changed.
+    image_placement: decenter / tilt of the image surface (:class:`raytrace.frames.Placement`),
+        None = perpendicular to the axis the light leaves the last surface on. Final ray segments
+        are reported in the image frame (:mod:`raytrace.frames`): image planes are ``z = const``
+        there, and for a centred lens it is the global frame.
+
+    Surfaces may be decentered, tilted, coordinate breaks and mirrors (``Surface.placement``,
+    ``after``, ``mirror``, ``coordinate_break``; :mod:`raytrace.frames`). A lens with none of
+    them (or only mirrors on the axis) is *centred* (:attr:`is_centred`): first-order optics
+    (:mod:`raytrace.paraxial`) need that; :meth:`nominal` is the lens without its moves.
     """
 
     name: str
@@ -153,14 +354,20 @@ class Lens:
     weights: tuple[float, ...] = ()
     temperature_c: float | None = None
     pressure_atm: float | None = None
+    image_placement: Placement | None = None
 
     def __post_init__(self) -> None:
         _normalize_wavelengths(self)
+        p = self.image_placement
+        if p is not None and not isinstance(p, Placement):
+            raise LensError(
+                f"{self.name}: image_placement must be a Placement or None, got {type(p).__name__}"
+            )
+        if p is not None and p.is_identity:
+            object.__setattr__(self, "image_placement", None)
         validate(self)
 
     def __repr__(self) -> str:
-        ap = {"fnumber": "f/{:g}", "epd": "EPD {:g} mm", "na": "NA {:g}"}[self.aperture.kind]
-        fld = "{:g} deg" if self.field.kind == "angle" else "{:g} mm"
         obj = (
             "object at infinity"
             if math.isinf(self.object_distance)
@@ -168,7 +375,7 @@ class Lens:
         )
         return (
             f"Lens({self.name!r}: {self.n_surfaces} surfaces, stop {self.stop_index + 1}, "
-            f"{ap.format(self.aperture.value)}, field {fld.format(self.field.value)}, {obj})"
+            f"{self.aperture.describe()}, field {self.field.describe()}, {obj})"
         )
 
     def __str__(self) -> str:
@@ -189,6 +396,55 @@ class Lens:
     @property
     def n_surfaces(self) -> int:
         return len(self.surfaces)
+
+    @property
+    def is_centred(self) -> bool:
+        """True when no surface (nor the image surface) is decentered or tilted and no clear
+        aperture is off the axis: the lens is rotationally symmetric about the z axis (mirrors on
+        the axis allowed; rectangular apertures do not count, they only vignette)."""
+        return self.image_placement is None and not any(
+            s.is_placed or (s.aperture is not None and (s.aperture.x0 or s.aperture.y0))
+            for s in self.surfaces
+        )
+
+    @property
+    def has_mirrors(self) -> bool:
+        """True when any surface reflects."""
+        return any(s.mirror for s in self.surfaces)
+
+    @property
+    def image_direction(self) -> float:
+        """+1, or −1 after an odd number of mirrors: the sign of the image-space axis direction
+        along z (and of a real image distance from the last vertex)."""
+        return -1.0 if sum(s.mirror for s in self.surfaces) % 2 else 1.0
+
+    def first_placed(self) -> int | None:
+        """1-based number of the first surface that is decentered or tilted (0 for the image
+        surface), or None for a centred lens."""
+        for i, s in enumerate(self.surfaces, start=1):
+            if s.is_placed or (s.aperture is not None and (s.aperture.x0 or s.aperture.y0)):
+                return i
+        return 0 if self.image_placement is not None else None
+
+    def nominal(self) -> Lens:
+        """The lens with every decenter and tilt removed (placements, moves after surfaces,
+        the image surface's placement and aperture offsets): the centred system the moves are
+        applied to. Mirrors, coordinate-break surfaces (now doing nothing) and thicknesses stay,
+        so the surface numbers are the same."""
+        if self.is_centred:
+            return self
+        ss = tuple(
+            replace(
+                s,
+                placement=None,
+                after="stay",
+                aperture=None
+                if s.aperture is None
+                else replace(s.aperture, x0=0.0, y0=0.0),
+            )
+            for s in self.surfaces
+        )
+        return replace(self, surfaces=ss, image_placement=None)
 
     @property
     def vertex_z(self) -> np.ndarray:
@@ -301,22 +557,45 @@ class Lens:
                 thickness=s.thickness * factor,
                 semi_diameter=s.semi_diameter * factor,
                 aspheric=tuple(a * factor ** (1 - 2 * (j + 2)) for j, a in enumerate(s.aspheric)),
+                placement=_scaled_placement(s.placement, factor),
+                after=_scaled_placement(s.after, factor),
+                aperture=None
+                if s.aperture is None
+                else replace(
+                    s.aperture,
+                    half_x=s.aperture.half_x * factor,
+                    half_y=s.aperture.half_y * factor,
+                    x0=s.aperture.x0 * factor,
+                    y0=s.aperture.y0 * factor,
+                ),
             )
             for s in self.surfaces
         )
         ap = self.aperture
-        if ap.kind == "epd":
-            ap = Aperture("epd", ap.value * factor)
+        if ap.kind in ("epd", "float"):
+            ap = Aperture(ap.kind, ap.value * factor)
         fld = self.field
+        given = None if fld.given is None else (fld.given[0], fld.given[1] * factor)
         if fld.kind == "height":
-            fld = Field("height", fld.value * factor)
+            pts = tuple((a * factor, b * factor) for a, b in fld.points)
+            fld = Field("height", fld.value * factor, pts, given)
+        elif given is not None:
+            fld = replace(fld, given=given)
         return replace(
             self,
             surfaces=surfaces,
             aperture=ap,
             field=fld,
             object_distance=self.object_distance * factor,
+            image_placement=_scaled_placement(self.image_placement, factor),
         )
+
+
+def _scaled_placement(p, factor: float):
+    """A placement with its decenter scaled (tilts are angles); strings and None unchanged."""
+    if not isinstance(p, Placement):
+        return p
+    return replace(p, decenter=tuple(v * factor for v in p.decenter))
 
 
 @functools.lru_cache(maxsize=512)
@@ -377,6 +656,7 @@ def validate(lens: Lens) -> None:
     if len(stops) != 1:
         which = ", ".join(str(i + 1) for i in stops) if stops else "none"
         raise LensError(f"{lens.name}: exactly one surface must be the stop (found: {which})")
+    mirrors = 0
     for i, s in enumerate(lens.surfaces, start=1):
         for name in ("curvature", "thickness", "conic"):
             v = getattr(s, name)
@@ -388,10 +668,34 @@ def validate(lens: Lens) -> None:
             raise LensError(
                 f"{lens.name}: surface {i}: semi-diameter must be positive, got {s.semi_diameter}"
             )
-        if i < len(lens.surfaces) and s.thickness < 0.0 and not s.material.is_air:
+        if s.mirror:
+            mirrors += 1
+        direction = -1.0 if mirrors % 2 else 1.0
+        if i < len(lens.surfaces) and s.thickness * direction < 0.0 and not s.material.is_air:
+            if mirrors == 0:
+                raise LensError(
+                    f"{lens.name}: surface {i}: glass thickness must not be negative, got "
+                    f"{s.thickness}"
+                )
             raise LensError(
-                f"{lens.name}: surface {i}: glass thickness must not be negative, got {s.thickness}"
+                f"{lens.name}: surface {i}: glass thickness {s.thickness:g} has the wrong sign: "
+                f"after {mirrors} mirror(s) the light travels toward "
+                f"{'-' if direction < 0 else '+'}z, so thicknesses are "
+                f"{'negative' if direction < 0 else 'positive'} (as in Zemax and CODE V)"
             )
+        medium_before = lens.object_material if i == 1 else lens.surfaces[i - 2].material
+        if (s.mirror or s.coordinate_break) and s.material != medium_before:
+            what = "a mirror" if s.mirror else "a coordinate break"
+            raise LensError(
+                f"{lens.name}: surface {i} is {what}: the medium after it must be the one before "
+                f"it ({medium_before.describe()}), got {s.material.describe()}"
+            )
+        if s.coordinate_break:
+            if s.mirror or s.stop or s.curvature != 0.0 or any(s.aspheric) or s.conic:
+                raise LensError(
+                    f"{lens.name}: surface {i} is a coordinate break: it cannot be curved, a "
+                    "mirror or the stop (it is not traced)"
+                )
     if not (lens.object_distance > 0.0):
         raise LensError(
             f"{lens.name}: object distance must be positive (a magnitude from the object plane to "
@@ -425,8 +729,10 @@ def validate(lens: Lens) -> None:
         raise LensError(f"{lens.name}: pressure_atm must not be negative, got {lens.pressure_atm}")
     if not (math.isfinite(lens.aperture.value) and lens.aperture.value > 0.0):
         raise LensError(f"{lens.name}: aperture {lens.aperture.kind} must be positive")
-    if lens.aperture.kind == "na" and not math.isfinite(lens.object_distance):
+    if lens.aperture.kind in ("na", "cone_angle") and not math.isfinite(lens.object_distance):
         raise LensError(f"{lens.name}: an object-space NA needs a finite object distance")
+    if lens.aperture.kind == "cone_angle" and not lens.aperture.value < 90.0:
+        raise LensError(f"{lens.name}: the object cone angle must be below 90 degrees")
     if not (math.isfinite(lens.field.value) and lens.field.value >= 0.0):
         raise LensError(f"{lens.name}: field {lens.field.kind} must be a non-negative number")
     if lens.field.kind == "angle" and lens.field.value >= 90.0:
@@ -441,11 +747,17 @@ def check_file_lens(lens: Lens) -> None:
     the lens; a lens built in Python may be an idealisation, such as a thin lens of zero
     thickness): glass of zero or negative centre thickness. Raises :class:`LensError` naming the
     surface."""
+    direction = 1.0
     for i, s in enumerate(lens.surfaces[:-1], start=1):
-        if s.thickness <= 0.0 and not s.material.is_air:
+        if s.mirror:
+            direction = -direction  # after a mirror the thicknesses are negative (Zemax, CODE V)
+        if s.coordinate_break:
+            continue
+        if s.thickness * direction <= 0.0 and not s.material.is_air:
+            sign = "positive" if direction > 0 else "negative (after an odd number of mirrors)"
             raise LensError(
                 f"{lens.name}: surface {i}: the glass after it has thickness {s.thickness:g} mm; "
-                "give its centre thickness (a positive number of mm)"
+                f"give its centre thickness (a {sign} number of mm)"
             )
 
 
@@ -468,12 +780,17 @@ def check_physical(lens: Lens) -> None:
                     f"{lens.name}: surface {i}: semi-diameter {s.semi_diameter:g} mm reaches "
                     f"beyond the surface (radius {s.radius:g} mm, conic {s.conic:g}); reduce sd"
                 )
+    direction = 1.0
     for i in range(n - 1):
         a, b = lens.surfaces[i], lens.surfaces[i + 1]
+        if a.mirror:
+            direction = -direction
         if not (math.isfinite(a.semi_diameter) and math.isfinite(b.semi_diameter)):
             continue
+        if a.is_placed or b.is_placed or a.coordinate_break or b.coordinate_break:
+            continue  # not on a common axis: the axial-gap test does not apply
         h = np.linspace(0.0, min(a.semi_diameter, b.semi_diameter), 33)
-        gap = a.thickness + b.sag(h) - a.sag(h)
+        gap = direction * (a.thickness + b.sag(h) - a.sag(h))
         j = int(np.argmin(gap))
         if gap[j] < 0.0:
             raise LensError(

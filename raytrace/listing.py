@@ -80,11 +80,9 @@ def format_prescription(lens: Lens, *, summary: bool = True) -> str:
         max(len(COLUMNS[j]), *(len(r[j]) for r in rows)) if rows else len(COLUMNS[j])
         for j in range(ncol)
     ]
-    ap = {"fnumber": "f/{:g}", "epd": "EPD {:g} mm", "na": "NA {:g}"}[lens.aperture.kind]
-    fld = "{:g} deg" if lens.field.kind == "angle" else "{:g} mm"
     out = [
         f"{lens.name}",
-        f"aperture {ap.format(lens.aperture.value)}; field {fld.format(lens.field.value)}",
+        f"aperture {lens.aperture.describe()}; field {lens.field.describe()}",
         "  ".join(c.rjust(w) for c, w in zip(COLUMNS, widths, strict=True))
         + ("  label" if any(len(r) > ncol for r in rows) else ""),
         "  ".join("-" * w for w in widths),

@@ -4,8 +4,18 @@ arrays).
 
 The geometry arrays are shared by every wavelength; the indices are rows of 2-D arrays
 ``n_in_w`` / ``n_out_w`` of shape (n_wavelengths, n_surfaces). Kernels take the lens as ONE
-tuple (:attr:`PackedLens.lens_arrays`) that they unpack, so that more per-surface data (surface
-frames) can be added to the tuple without changing any kernel's argument list.
+tuple (:attr:`PackedLens.lens_arrays`) that they unpack, so that more per-surface data can be
+added without changing any kernel's argument list.
+
+Surface placement (decenters, tilts, coordinate breaks, mirrors; :mod:`raytrace.frames`) travels
+in the 2-D table ``geo`` that takes the place of the vertex positions in the tuples: column
+``G_ZV`` is the vertex z, the other columns (:mod:`raytrace.kernels.codes`) hold the flags, the
+transform into each surface's axis frame and the clear aperture. For a centred lens every row
+is the identity with flags 0, and the kernels run the coaxial code unchanged. When the final
+segments must be turned into an image frame other than the last surface's axis frame (a fold or
+tilt after the last surface, a tilted image surface), one pseudo-surface is appended (flags
+``F_SKIP | F_FRAME``): ``n_surfaces`` is then one more than the lens's
+(:attr:`PackedLens.n_lens_surfaces`).
 """
 
 from __future__ import annotations
@@ -14,7 +24,39 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .frames import relative, surface_frames
+from .kernels.codes import (
+    F_APERTURE,
+    F_FRAME,
+    F_GENERAL,
+    F_MIRROR,
+    F_SKIP,
+    G_ABS,
+    G_ABST,
+    G_AP,
+    G_FLAGS,
+    G_LENS,
+    G_REL,
+    G_RELT,
+    G_ZV,
+    KIND_PLANE,
+    L_SYMMETRIC,
+    NGEO,
+)
 from .lens import Lens
+
+
+def coaxial_geo(zv: np.ndarray, symmetric: bool = True) -> np.ndarray:
+    """The placement table of a centred lens: identity frames, no flags, column G_ZV = ``zv``."""
+    n = zv.shape[0]
+    geo = np.zeros((n, NGEO))
+    geo[:, G_ZV] = zv
+    eye = np.eye(3).ravel()
+    geo[:, G_REL : G_REL + 9] = eye
+    geo[:, G_ABS : G_ABS + 9] = eye
+    if n:
+        geo[0, G_LENS] = float(L_SYMMETRIC) if symmetric else 0.0
+    return geo
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,6 +73,8 @@ class PackedLens:
     stop:   0-based stop index;  z_image: image-plane z the file defines
     wavelengths: the packed wavelengths (nm); n_in_w, n_out_w: (n_wavelengths, n) indices, row i
             at ``wavelengths[i]`` (row 0 is ``n_in`` / ``n_out``)
+    geo:    (n, NGEO) placement table (module docstring; column G_ZV = ``zv``)
+    n_lens_surfaces: the lens's surfaces (``n_surfaces`` minus the image pseudo-surface)
     """
 
     kind: np.ndarray
@@ -47,8 +91,24 @@ class PackedLens:
     wavelengths: tuple[float, ...] = ()
     n_in_w: np.ndarray | None = None
     n_out_w: np.ndarray | None = None
+    geo: np.ndarray | None = None
+    n_lens_surfaces: int | None = None
 
     def __post_init__(self) -> None:
+        n = int(self.c.shape[0])
+        geo = self.geo
+        if geo is None or geo.shape[0] != n:
+            if geo is not None and np.any(geo[:, G_FLAGS] != 0.0):
+                raise ValueError(
+                    "the placement table (geo) does not match the surfaces; pack the lens again"
+                )
+            geo = coaxial_geo(np.asarray(self.zv, dtype=np.float64))
+        else:
+            geo = np.array(geo, dtype=np.float64)
+            geo[:, G_ZV] = self.zv
+        object.__setattr__(self, "geo", np.ascontiguousarray(geo))
+        if self.n_lens_surfaces is None or self.n_lens_surfaces > n:
+            object.__setattr__(self, "n_lens_surfaces", n)
         # a PackedLens built by hand (tests, benchmarks) at one wavelength
         if not self.wavelengths:
             object.__setattr__(self, "wavelengths", (float(self.wavelength),))
@@ -68,15 +128,21 @@ class PackedLens:
     @property
     def arrays(self) -> tuple:
         """The lens arrays at ``wavelength`` in the order the bulk and path kernels take them:
-        kind, c, k, asph, zv, n_in, n_out, sd."""
-        return (self.kind, self.c, self.k, self.asph, self.zv, self.n_in, self.n_out, self.sd)
+        kind, c, k, asph, geo (the placement table; its column G_ZV is the vertex z), n_in,
+        n_out, sd."""
+        return (self.kind, self.c, self.k, self.asph, self.geo, self.n_in, self.n_out, self.sd)
 
     @property
     def lens_arrays(self) -> tuple:
-        """The lens as the one tuple the aiming kernel takes (all wavelengths): kind, c, k, asph,
-        zv, n_in_w, n_out_w (2-D, wavelength × surface), sd. Extensions (surface frames) append
-        to this tuple."""
-        return (self.kind, self.c, self.k, self.asph, self.zv, self.n_in_w, self.n_out_w, self.sd)
+        """The lens as the one tuple the aiming kernels take (all wavelengths): kind, c, k, asph,
+        geo (placement table, module docstring), n_in_w, n_out_w (2-D, wavelength × surface),
+        sd."""
+        return (self.kind, self.c, self.k, self.asph, self.geo, self.n_in_w, self.n_out_w, self.sd)
+
+    @property
+    def is_coaxial(self) -> bool:
+        """True when no surface needs anything but the coaxial kernel code (all flags 0)."""
+        return not np.any(self.geo[:, G_FLAGS] != 0.0)
 
 
 def pack(lens: Lens, wavelength: float | None = None, *, wavelengths=None) -> PackedLens:
@@ -98,21 +164,96 @@ def pack(lens: Lens, wavelength: float | None = None, *, wavelengths=None) -> Pa
     for i, s in enumerate(ss):
         asph[i, : len(s.aspheric)] = s.aspheric
     idx = lens.indices(wl)  # (w, n + 1): object space, then after each surface
-    n_in_w = np.array(idx[:, :-1], order="C")  # writeable copies (idx is a cached read-only
-    n_out_w = np.array(idx[:, 1:], order="C")  # array): one kernel specialisation only
+    n_in_w = np.ascontiguousarray(idx[:, :-1])
+    n_out_w = np.ascontiguousarray(idx[:, 1:])
+    kind = np.array([s.kind for s in ss], dtype=np.int64)
+    c = np.array([s.curvature for s in ss], dtype=np.float64)
+    k = np.array([s.conic for s in ss], dtype=np.float64)
+    zv = np.ascontiguousarray(lens.vertex_z, dtype=np.float64)
+    sd = np.array([s.semi_diameter for s in ss], dtype=np.float64)
+    geo, extra = placement_table(lens)
+    if extra:  # the image-frame pseudo-surface: a plane in the image medium, not traced
+        kind = np.append(kind, KIND_PLANE)
+        c = np.append(c, 0.0)
+        k = np.append(k, 0.0)
+        asph = np.vstack([asph, np.zeros((1, m))])
+        zv = np.append(zv, float(lens.image_z))
+        sd = np.append(sd, np.inf)
+        n_in_w = np.ascontiguousarray(np.hstack([n_in_w, n_out_w[:, -1:]]))
+        n_out_w = np.ascontiguousarray(np.hstack([n_out_w, n_out_w[:, -1:]]))
     return PackedLens(
-        kind=np.array([s.kind for s in ss], dtype=np.int64),
-        c=np.array([s.curvature for s in ss], dtype=np.float64),
-        k=np.array([s.conic for s in ss], dtype=np.float64),
+        kind=kind,
+        c=c,
+        k=k,
         asph=np.ascontiguousarray(asph),
-        zv=np.ascontiguousarray(lens.vertex_z, dtype=np.float64),
-        n_in=n_in_w[0].copy(),
-        n_out=n_out_w[0].copy(),
-        sd=np.array([s.semi_diameter for s in ss], dtype=np.float64),
+        zv=zv,
+        n_in=np.ascontiguousarray(n_in_w[0]),
+        n_out=np.ascontiguousarray(n_out_w[0]),
+        sd=sd,
         stop=lens.stop_index,
         z_image=float(lens.image_z),
         wavelength=wl[0],
         wavelengths=wl,
         n_in_w=n_in_w,
         n_out_w=n_out_w,
+        geo=geo,
+        n_lens_surfaces=n,
     )
+
+
+def placement_table(lens: Lens) -> tuple[np.ndarray, bool]:
+    """(geo, extra): the placement table of ``lens`` (module docstring) and whether it holds the
+    image-frame pseudo-surface as its last row."""
+    ss = lens.surfaces
+    n = len(ss)
+    zv = np.asarray(lens.vertex_z, dtype=np.float64)
+    if lens.is_centred and not lens.has_mirrors and all(s.aperture is None for s in ss) and not any(
+        s.coordinate_break for s in ss
+    ):
+        return coaxial_geo(zv), False
+    fr = surface_frames(lens)
+    general = lens.has_mirrors or not lens.is_centred
+    rows = []
+    prev = (np.eye(3), np.zeros(3))
+    for j, s in enumerate(ss):
+        row = np.zeros(NGEO)
+        row[G_ZV] = zv[j]
+        cur = (np.asarray(fr.axis_rotation[j]), np.asarray(fr.axis_origin[j]))
+        row[G_ABS : G_ABS + 9] = cur[0].ravel()
+        row[G_ABST : G_ABST + 3] = cur[1]
+        row[G_REL : G_REL + 9] = np.eye(3).ravel()
+        flags = 0
+        if s.coordinate_break:
+            flags |= F_SKIP
+        else:
+            if not (np.array_equal(prev[0], cur[0]) and np.array_equal(prev[1], cur[1])):
+                M, t = relative(prev, cur)
+                row[G_REL : G_REL + 9] = M.ravel()
+                row[G_RELT : G_RELT + 3] = t
+                flags |= F_FRAME
+            prev = cur
+            if s.mirror:
+                flags |= F_MIRROR
+            if general:
+                flags |= F_GENERAL
+            if s.aperture is not None:
+                a = s.aperture
+                row[G_AP : G_AP + 5] = (a.code, a.half_x, a.half_y, a.x0, a.y0)
+                flags |= F_APERTURE
+        row[G_FLAGS] = float(flags)
+        rows.append(row)
+    img = (np.asarray(fr.image_rotation), np.asarray(fr.image_origin))
+    extra = not (np.array_equal(prev[0], img[0]) and np.array_equal(prev[1], img[1]))
+    if extra:
+        row = np.zeros(NGEO)
+        row[G_ZV] = float(lens.image_z)
+        M, t = relative(prev, img)
+        row[G_REL : G_REL + 9] = M.ravel()
+        row[G_RELT : G_RELT + 3] = t
+        row[G_ABS : G_ABS + 9] = img[0].ravel()
+        row[G_ABST : G_ABST + 3] = img[1]
+        row[G_FLAGS] = float(F_SKIP | F_FRAME)
+        rows.append(row)
+    geo = np.ascontiguousarray(np.array(rows))
+    geo[0, G_LENS] = float(L_SYMMETRIC) if lens.is_centred else 0.0
+    return geo, extra

@@ -9,6 +9,7 @@ Topogon (US 2,031,792 Fig. 1) chief-ray heights.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -410,3 +411,18 @@ def test_chief_rays_cheap_to_call_repeatedly():
     b = chief_rays(lens, f)
     np.testing.assert_array_equal(a.y_last, b.y_last)
     assert np.all(a.iterations[1:] < 40)
+
+
+def test_a_stop_smaller_than_the_aperture_says_so():
+    from raytrace.trace.chief import ApertureWarning
+
+    lens = load_lens("cooke-triplet-f4")
+    s = list(lens.surfaces)
+    s[3] = replace(s[3], semi_diameter=3.0)  # the f/4 aperture needs 4.75 mm at the stop
+    small = replace(lens, surfaces=tuple(s))
+    with pytest.warns(ApertureWarning, match="clipped at the stop"):
+        chief_rays(small, [0.0, 10.0])
+    s[3] = replace(s[3], semi_diameter=5.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ApertureWarning)
+        chief_rays(replace(lens, surfaces=tuple(s)), [0.0, 10.0])

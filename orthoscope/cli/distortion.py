@@ -384,6 +384,7 @@ def _add_grid_args(q: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--plot-vectors", metavar="FILE", help="Save the vector plot of the distortion field."
     )
+    _add_sensor_metrics_arg(g)
 
 
 def _grid_mode(args) -> bool:
@@ -434,6 +435,7 @@ def _grid(args, lens) -> int:
         raise CliError(f"--grid (2-D distortion) does not combine with {', '.join(bad)}")
     nx, ny = _grid_size(args.grid)
     check_size(nx * ny, MAX_FIELDS, "--grid (fields)", args, per_item_bytes=400)
+    _check_sensor_metrics(args, nx, ny)
     for flag in ("plot_grid", "plot_vectors"):
         check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
     od = resolve_object(lens, args)
@@ -473,10 +475,11 @@ def _grid(args, lens) -> int:
         if np.count_nonzero(g.ok) >= 8:
             decs.append(decompose_distortion(g, p))
             fits.append(fit_brown_conrady(g, p))
+    metrics = _sensor_metrics(args, g)
     if args.json:
-        print_json({"distortion_grid": grid_to_dict(g, decs, fits)})
+        print_json({"distortion_grid": grid_to_dict(g, decs, fits), **metrics[0]})
     else:
-        print(format_grid(g, decs, fits))
+        print(format_grid(g, decs, fits) + metrics[1])
     if (args.plot_grid or args.plot_vectors) and not np.isfinite(g.actual).any():
         raise CliError("no field could be traced: there is nothing to plot")
     if args.plot_grid or args.plot_vectors:
@@ -496,3 +499,44 @@ def _grid(args, lens) -> int:
     if n_bad and args.strict:
         raise CliError(f"{n_bad} field(s) could not be traced; --strict fails")
     return 0
+
+
+# ------------------------------------------------ picture metrics of a sensor (--sensor-metrics)
+SENSOR_METRICS_HELP = (
+    "With --sensor: the picture metrics of the sensor from the grid - TV distortion (SMIA 1.0 "
+    "(A-B)/B and the traditional dH/H = half of it), keystone, line straightness of the edges "
+    "and centre lines, anamorphic ratio. The grid counts must be odd (default 21x21)."
+)
+
+
+def _add_sensor_metrics_arg(g) -> None:
+    g.add_argument("--sensor-metrics", action="store_true", help=SENSOR_METRICS_HELP)
+
+
+def _check_sensor_metrics(args, nx: int, ny: int) -> None:
+    """Refuse --sensor-metrics without --sensor or with even counts, before any trace."""
+    from .common import CliError
+
+    if not getattr(args, "sensor_metrics", False):
+        return
+    if args.sensor is None:
+        raise CliError("--sensor-metrics needs --sensor WxH (the picture it measures)")
+    if nx % 2 == 0 or ny % 2 == 0:
+        raise CliError(
+            f"--sensor-metrics with --grid {nx}x{ny}: the edge centres must be grid points; give "
+            f"odd counts, e.g. --grid {nx + (nx % 2 == 0)}x{ny + (ny % 2 == 0)}"
+        )
+
+
+def _sensor_metrics(args, g) -> tuple[dict, str]:
+    """(JSON entries, text) of the picture metrics per plane; empty without --sensor-metrics."""
+    if not getattr(args, "sensor_metrics", False):
+        return {}, ""
+    from distortion.sensor_metrics import sensor_metrics
+
+    from ..report.sensor_metrics import format_sensor_metrics, sensor_metrics_to_dict
+
+    ms = [sensor_metrics(g, p) for p in range(g.n_planes)]
+    return {"sensor_metrics": [sensor_metrics_to_dict(m) for m in ms]}, (
+        "\n\n" + format_sensor_metrics(ms)
+    )

@@ -26,11 +26,32 @@ Supported commands:
 * Glasses: catalog names (``NSK16_SCHOTT``, ``N-SK16``; a ``_VENDOR`` suffix picks the catalog),
   ``nd:vd`` model glasses (``1.620:60.3``) and six-digit codes (``620603`` or ``620.603``).
 
-Anything that changes the optics and cannot be modelled (decenters and tilts ``ADE BDE CDE XDE
-YDE ZDE DAR BEN REV``, mirrors ``REFL``, diffractive or special surfaces, gradient index, pickups)
-raises :class:`~raytrace.errors.PrescriptionError` with the file, line and what to do; other
-unknown commands are listed in one :class:`~raytrace.zemax.InteropWarning`. Every problem with the
-input raises PrescriptionError (never another exception type).
+* Decenters and tilts (:mod:`raytrace.frames` states the conventions): ``XDE YDE ZDE`` (mm) and
+  ``ADE BDE CDE`` (degrees; α, β left-handed, γ right-handed: stored as right-handed tilts
+  (−α, −β, γ)), applied decenter first, then α, β, γ about the moving axes; the decenter type
+  ``DEC`` (basic, the default: the following surfaces stay in the new frame), ``DAR`` (decenter
+  and return), ``BEN`` (bend: the axis turns by the tilt once more, for fold mirrors) or ``REV``
+  (reverse: the surface stays, the following surfaces move by the inverse). On ``SI`` they
+  place the image surface. ``RET`` and ``GLB`` (coordinates of another surface) are refused.
+* Mirrors: ``REFL`` on the surface line (``S r t REFL``) or as a command after it; the medium
+  after a mirror is the one before it, and thicknesses after an odd number of mirrors are
+  negative (as CODE V writes them).
+* Clear apertures: ``CIR r`` (circular, about the vertex unless ``ADX``/``ADY`` move it),
+  ``REX``/``REY`` (rectangle half-widths), ``ELX``/``ELY`` (ellipse semi-axes), with ``ADX``,
+  ``ADY`` (aperture decenter); ``EDG`` (mechanical edge) is ignored, ``HOL``/``OBS`` (holes,
+  obscurations) are ignored with a warning.
+* Fields in image space: ``YIM``/``XIM`` (paraxial image height) and ``YRI``/``XRI`` (real image
+  height) are turned into the object-space angle (or height) that gives them
+  (``Field.given`` keeps the original).
+* Pickups (``PIK item Sk ... item Sj ... [scale [offset]]`` for ``RDY``, ``CUY``, ``THI``): CODE V
+  writes the picked-up values into the surface lines, so a pickup is only checked against them
+  (within 1e-9 relative) and refused when they disagree.
+
+Anything that changes the optics and cannot be modelled (diffractive or special surfaces,
+gradient index, other pickups) raises :class:`~raytrace.errors.PrescriptionError` with the file,
+line and what to do; other unknown commands are listed in one
+:class:`~raytrace.zemax.InteropWarning`. Every problem with the input raises PrescriptionError
+(never another exception type).
 """
 
 from __future__ import annotations
@@ -40,8 +61,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
+from ..frames import Placement, codev_tilt
 from ..glass import lookup_glass, normalize_name, parse_glass_code, private_material
-from ..lens import Aperture, Field, Lens, Surface, check_file_lens
+from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material
 from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
 
@@ -54,7 +76,9 @@ _IGNORED = set(
     """LEN WTF VUY VLY VUX VLX INI DER CCY THC GLC CUF KC AC BC CC DC EC FC GC HC
     JC POL CLS TOL TOLE AUT SAV DES""".split()
 )
-_DECENTER = {"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE", "DAR", "BEN", "REV", "RET", "DEC", "TILT"}
+_DECENTER = {"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE"}
+_DECENTER_TYPES = {"DEC": "basic", "DAR": "dar", "BEN": "bend", "REV": "rev"}
+_APERTURES = {"CIR", "REX", "REY", "ELX", "ELY", "ADX", "ADY"}
 _SPECIAL = {"DIF", "HOE", "HCO", "HWL", "HOR", "GRT", "SPS", "UDS", "GRIN", "GRD", "ZRN"}
 _MAX_WARNINGS = 50
 
@@ -72,6 +96,10 @@ class _CSurf:
     conic: float = 0.0
     asph: dict[int, float] = field(default_factory=dict)
     pim: int | None = None
+    dec: dict[str, tuple[float, int]] = field(default_factory=dict)  # XDE ... CDE -> (value, line)
+    dtype: str = "basic"
+    refl: bool = False
+    ap: dict[str, float] = field(default_factory=dict)  # REX REY ELX ELY ADX ADY
 
 
 def _logical_lines(text: str) -> list[tuple[int, list[str]]]:
@@ -180,6 +208,7 @@ class _SeqParser:
         in_prv = False
         prv_wl: tuple[list[float], int] | None = None
         self.private: dict[str, Material] = {}
+        self.pickups: list[tuple[list[str], int]] = []
         rdm_seen = False
         for line, toks in _logical_lines(self.text):
             cmd, args = toks[0].upper(), toks[1:]
@@ -243,11 +272,7 @@ class _SeqParser:
                 else:
                     xob = vals
             elif cmd in ("YIM", "XIM", "YRI", "XRI"):
-                raise self.err(
-                    f"{cmd}: image-height fields are not supported; give the field as angles "
-                    "(YAN) or object heights (YOB)",
-                    line,
-                )
+                h.setdefault("IMF", {})[cmd] = (self.nums(args, cmd, line), line)
             elif cmd in ("SO", "S", "SI") or (cmd in ("STO", "STOP") and len(args) >= 2):
                 kind = "S" if cmd in ("STO", "STOP") else cmd
                 if kind == "SO" and surfs:
@@ -266,15 +291,17 @@ class _SeqParser:
                     cur.t = self.num(args, 1, cmd, line)
                     if kind == "SO" and cur.t >= CODEV_INFINITY:
                         cur.t = math.inf
-                rest = args[2:]
-                for tok in rest:
-                    if tok.upper() in ("REFL", "REFLECT"):
-                        raise self.err(
-                            "REFL: mirrors are not supported; orthoscope traces refracting "
-                            "lenses only",
-                            line,
-                            len(surfs),
-                        )
+                rest = [a for a in args[2:] if a.upper() not in ("REFL", "REFLECT")]
+                cur.refl = len(rest) < len(args[2:])
+                if cur.refl and kind != "S":
+                    raise self.err(f"REFL on {cmd}: only a lens surface (S) can be a mirror", line)
+                if cur.refl and rest:
+                    raise self.err(
+                        f"REFL with a glass ({rest[0]}): a mirror returns the light into the medium "
+                        "before it; write the glass on the surfaces around the mirror",
+                        line,
+                        len(surfs),
+                    )
                 if rest:
                     cur.glass = (_unquote(rest[0]), line)
                 if len(rest) > 1:
@@ -285,16 +312,30 @@ class _SeqParser:
                 if cur is None or cur.kind != "S":
                     raise self.err("STO must follow a surface line (S r t glass)", line)
                 cur.stop = True
-            elif cmd in ("SLB", "CIR", "ASP", "CON", "SPH", "K", "PIM") or (
+            elif cmd in ("SLB", "ASP", "CON", "SPH", "K", "PIM") or cmd in _APERTURES or (
                 cmd in _ASPH_LETTERS and len(cmd) == 1
             ):
                 if cur is None:
                     raise self.err(f"{cmd} before the first surface line", line)
                 self.surface_command(cur, cmd, args, line, len(surfs) - 1)
-            elif cmd in _DECENTER:
+            elif cmd in _DECENTER or cmd in _DECENTER_TYPES:
+                if cur is None or cur.kind == "SO":
+                    raise self.err(
+                        f"{cmd}: a decenter or tilt of the object surface is not supported; "
+                        "decenter the first lens surface instead",
+                        line,
+                    )
+                if cmd in _DECENTER:
+                    cur.dec[cmd] = (self.num(args, 0, cmd, line), line)
+                else:
+                    if cur.kind == "SI" and cmd != "DEC":
+                        raise self.err(f"{cmd} on the image surface (SI) has no meaning", line)
+                    cur.dtype = _DECENTER_TYPES[cmd]
+            elif cmd in ("RET", "GLB", "TILT"):
                 raise self.err(
-                    f"{cmd}: decenters and tilts are not supported; orthoscope models centred "
-                    "lenses only — remove the decenter in CODE V and save the .seq again",
+                    f"{cmd}: coordinates relative to another surface are not supported; in "
+                    "CODE V convert the decenters to DEC/DAR/BEN/REV form (local to each "
+                    "surface) and save the .seq again",
                     line,
                     max(len(surfs) - 1, 0) or None,
                 )
@@ -307,16 +348,17 @@ class _SeqParser:
                     max(len(surfs) - 1, 0) or None,
                 )
             elif cmd in ("REFL", "REFLECT"):
-                raise self.err(
-                    "REFL: mirrors are not supported; orthoscope traces refracting lenses only",
-                    line,
-                )
+                if cur is None or cur.kind != "S":
+                    raise self.err("REFL must follow a lens surface line (S r t)", line)
+                if cur.glass is not None:
+                    raise self.err(
+                        "REFL on a surface with a glass: a mirror returns the light into the "
+                        "medium before it",
+                        line,
+                    )
+                cur.refl = True
             elif cmd == "PIK":
-                raise self.err(
-                    "PIK: pickups are not supported; in CODE V freeze the pickups (replace "
-                    "them by their values) and save the .seq again",
-                    line,
-                )
+                self.pickups.append((toks, line))
             elif cmd in _IGNORED:
                 pass
             else:
@@ -328,15 +370,24 @@ class _SeqParser:
     def surface_command(self, cur: _CSurf, cmd: str, args: list[str], line: int, no: int):
         if cmd == "SLB":
             cur.label = " ".join(_unquote(a) for a in args)
-        elif cmd == "CIR":
+        elif cmd in _APERTURES:
             if args and args[0].upper() in ("EDG", "HOL", "OBS"):
                 if args[0].upper() != "EDG":
-                    self.warn(f"line {line}: CIR {args[0]} (hole/obscuration) ignored")
+                    self.warn(f"line {line}: {cmd} {args[0]} (hole/obscuration) ignored")
                 return
-            r = self.num(args, 0, "CIR", line)
-            if not r > 0.0:
-                raise self.err(f"CIR: the aperture radius must be positive, got {r}", line, no)
-            cur.cir = r
+            vals = [a for a in args if not (a[:1] in "'\"" or a.upper().startswith("L'"))]
+            r = self.num(vals, 0, cmd, line)
+            if cmd == "CIR":
+                if not r > 0.0:
+                    raise self.err(f"CIR: the aperture radius must be positive, got {r}", line, no)
+                cur.cir = r
+            elif cmd in ("ADX", "ADY"):
+                cur.ap[cmd] = r
+            else:
+                if not r > 0.0:
+                    raise self.err(f"{cmd}: the aperture half-width must be positive, got {r}",
+                                   line, no)  # fmt: skip
+                cur.ap[cmd] = r
         elif cmd == "K":
             cur.conic = self.num(args, 0, "K", line)
         elif cmd in ("ASP", "CON", "SPH"):
@@ -403,6 +454,95 @@ class _SeqParser:
             raise self.err(f"glass {name}: {e.reason}", line, no) from None
         return cg.material
 
+    def object_material(self, obj: _CSurf) -> Material:
+        return self.material(obj.glass, 0) if obj.glass else AIR
+
+    def placement(self, s: _CSurf, scale: float) -> tuple[Placement | None, Placement | str]:
+        """(placement, after) of a surface's XDE ... CDE and decenter type
+        (:mod:`raytrace.frames`: CODE V α, β are left-handed, γ right-handed)."""
+        if not s.dec:
+            return None, "stay"
+
+        def v(key):
+            return s.dec.get(key, (0.0, 0))[0]
+
+        p = Placement(
+            (v("XDE") * scale, v("YDE") * scale, v("ZDE") * scale),
+            codev_tilt(v("ADE"), v("BDE"), v("CDE")),
+            "decenter-tilt",
+        )
+        if s.dtype == "dar":
+            return p, "return"
+        if s.dtype == "bend":
+            return p, "bend"
+        if s.dtype == "rev":
+            return None, p.inverse()
+        return p, "stay"
+
+    def aperture(self, s: _CSurf, scale: float, no: int) -> tuple[float, ClearAperture | None]:
+        """(semi-diameter, clear aperture) of CIR / REX REY / ELX ELY with ADX ADY."""
+        a = s.ap
+        x0 = a.get("ADX", 0.0) * scale
+        y0 = a.get("ADY", 0.0) * scale
+        rect = "REX" in a or "REY" in a
+        ell = "ELX" in a or "ELY" in a
+        if rect and ell:
+            raise self.err("REX/REY and ELX/ELY on one surface: give one aperture shape", s.line, no)
+        if rect or ell:
+            kx, ky = ("REX", "REY") if rect else ("ELX", "ELY")
+            hx = a.get(kx, a.get(ky))
+            hy = a.get(ky, a.get(kx))
+            shape = "rectangle" if rect else "ellipse"
+            return s.cir * scale, ClearAperture(shape, hx * scale, hy * scale, x0, y0)
+        if (x0 or y0) and math.isfinite(s.cir):
+            r = s.cir * scale
+            return math.inf, ClearAperture("circle", r, r, x0, y0)
+        return s.cir * scale, None
+
+    def check_pickups(self, surfs: list[_CSurf], scale: float, radius_mode: bool) -> None:
+        """CODE V stores picked-up values in the surface lines: check each ``PIK`` against them
+        (module docstring) and refuse one that disagrees."""
+
+        def value(item: str, k: int, line: int) -> float:
+            if not 0 <= k < len(surfs):
+                raise self.err(f"PIK: there is no surface S{k}", line)
+            srf = surfs[k]
+            if item == "THI":
+                return srf.t * scale if math.isfinite(srf.t) else srf.t
+            c = 0.0 if srf.r == 0.0 else (1.0 / (srf.r * scale) if radius_mode else srf.r / scale)
+            if item == "CUY":
+                return c
+            return math.inf if c == 0.0 else 1.0 / c
+
+        for toks, line in self.pickups:
+            t = [x.upper() for x in toks[1:] if not (x[:1] in "Zz" and x[1:].isdigit())]
+            try:
+                item, tgt, item2, src = t[0], t[1], t[2], t[3]
+                nums = [float(x) for x in t[4:]]
+                kt, ks = int(tgt.lstrip("S") or 0), int(src.lstrip("S") or 0)
+            except (IndexError, ValueError):
+                raise self.err(
+                    f"PIK {' '.join(toks[1:])[:40]}: expected 'PIK item Sk item Sj [scale "
+                    "[offset]]'",
+                    line,
+                ) from None
+            if item not in ("RDY", "CUY", "THI") or item2 != item:
+                raise self.err(
+                    f"PIK {item}: pickups are not supported (only RDY, CUY, THI pickups are "
+                    "checked); in CODE V freeze the pickups and save the .seq again",
+                    line,
+                )
+            scale_k = nums[0] if nums else 1.0
+            offset = nums[1] if len(nums) > 1 else 0.0
+            want = scale_k * value(item, ks, line) + offset * (scale if item == "THI" else 1.0)
+            have = value(item, kt, line)
+            if not (want == have or abs(want - have) <= 1e-9 * max(1.0, abs(want))):
+                raise self.err(
+                    f"PIK {item} S{kt}: the picked-up value {want:.10g} differs from the stored "
+                    f"{have:.10g}; in CODE V freeze the pickups and save the .seq again",
+                    line,
+                )
+
     def build(self, surfs, h, xan, yan, xob, yob) -> ImportResult:
         last_line = len(self.text.split("\n"))
         scale = h.get("DIM", 1.0)
@@ -440,19 +580,33 @@ class _SeqParser:
             asph = tuple(s.asph.get(j, 0.0) * scale ** (-3 - 2 * j) for j in range(n))
             while asph and asph[-1] == 0.0:
                 asph = asph[:-1]
+            before = self.object_material(obj) if not out else out[-1].material
+            mat = before if s.refl else self.material(s.glass, k)
+            placement, after = self.placement(s, scale)
+            sd, aperture = self.aperture(s, scale, k)
             out.append(
                 Surface(
                     curvature=c,
                     thickness=s.t * scale,
-                    material=self.material(s.glass, k),
-                    semi_diameter=s.cir * scale,
+                    material=mat,
+                    semi_diameter=sd,
                     stop=s.stop or (not stops and k == 1),
                     conic=s.conic,
                     aspheric=asph,
                     label=s.label,
                     line=s.line,
+                    placement=placement,
+                    after=after,
+                    mirror=s.refl,
+                    aperture=aperture,
                 )
             )
+        image_placement = None
+        if img is not None and img.dec:
+            image_placement, _ = self.placement(img, scale)
+        if img is not None and img.pim is not None:
+            self.warn(f"line {img.pim}: PIM on the image surface (SI) ignored")
+        self.check_pickups(surfs, scale, radius_mode)
         pims = [s for s in body if s.pim is not None]
         if pims and pims[-1] is not body[-1]:
             raise self.err("PIM (paraxial image solve) only on the last surface", pims[-1].pim)
@@ -519,16 +673,28 @@ class _SeqParser:
             for i in range(max(len(xv), len(yv)))
         ]
         fmax = max(radial, default=0.0)
-        if not radial:
+        pts = tuple(
+            (xv[i] if i < len(xv) else 0.0, yv[i] if i < len(yv) else 0.0)
+            for i in range(max(len(xv), len(yv)))
+        )
+        imf = h.get("IMF")
+        image_field = None
+        if imf and not (xob or yob or xan or yan):
+            image_field = self.image_field(imf, scale)
+        elif imf:
+            self.warn("image-height fields (YIM/YRI) ignored: the object-space field is used")
+        if not radial and image_field is None:
             self.warn("no field (YAN/YOB): the field is 0")
-        if kind == "angle":
+        if image_field is not None:
+            fld = Field("height" if math.isfinite(od) else "angle", 0.0)
+        elif kind == "angle":
             if fmax >= 90.0:
                 raise self.err(f"field angle {fmax:g} deg: must be below 90", fline)
-            fld = Field("angle", fmax)
+            fld = Field("angle", fmax, pts)
         else:
             if math.isinf(od):
                 raise self.err("YOB: object heights need a finite object distance (SO)", fline)
-            fld = Field("height", fmax * scale)
+            fld = Field("height", fmax * scale, tuple((a * scale, b * scale) for a, b in pts))
         if self.unknown:
             listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
             self.warn(f"unknown commands skipped: {listing}")
@@ -546,7 +712,8 @@ class _SeqParser:
             source=f"imported from the CODE V file {Path(self.path).name}" if self.path else "",
             notes="",
             units="mm",
-            object_material=self.material(obj.glass, 0) if obj.glass else AIR,
+            object_material=self.object_material(obj),
+            image_placement=image_placement,
             path=self.path,
         )
         lines = [s.line for s in body]
@@ -556,8 +723,45 @@ class _SeqParser:
         except (LensError, ValueError) as e:
             raise lens_error(self.err, e, lines, obj.line) from None
         if pims:
-            lens = self.solve_image(lens, pims[-1].pim, lines)
+            if lens.is_centred:
+                lens = self.solve_image(lens, pims[-1].pim, lines)
+            else:
+                self.warn(
+                    f"line {pims[-1].pim}: PIM on a decentered or tilted lens: the stored image "
+                    "distance is used (paraxial solves need a centred lens)"
+                )
+        if image_field is not None:
+            lens = self.convert_image_field(lens, image_field, lines)
         return ImportResult(lens, tuple(self.warnings))
+
+    def image_field(self, imf: dict, scale: float) -> tuple[str, float, int]:
+        """(kind, largest radial image height mm, line) of YIM/XIM or YRI/XRI."""
+        paraxial_f = "YIM" in imf or "XIM" in imf
+        real_f = "YRI" in imf or "XRI" in imf
+        if paraxial_f and real_f:
+            line = max(v[1] for v in imf.values())
+            raise self.err("both paraxial (YIM) and real (YRI) image heights: give one", line)
+        kx, ky = ("XIM", "YIM") if paraxial_f else ("XRI", "YRI")
+        xv, line_x = imf.get(kx, ([], 0))
+        yv, line_y = imf.get(ky, ([], 0))
+        hmax = max(
+            (math.hypot(xv[i] if i < len(xv) else 0.0, yv[i] if i < len(yv) else 0.0)
+             for i in range(max(len(xv), len(yv)))),
+            default=0.0,
+        )  # fmt: skip
+        kind = "paraxial_image_height" if paraxial_f else "real_image_height"
+        return kind, hmax * scale, max(line_x, line_y)
+
+    def convert_image_field(self, lens: Lens, image_field, lines: list[int]) -> Lens:
+        from ..trace.image_field import field_for_image_height
+
+        kind, height, line = image_field
+        try:
+            fld = field_for_image_height(lens, height, kind)
+        except (LensError, ValueError) as e:
+            cmd = "YIM" if kind.startswith("paraxial") else "YRI"
+            raise self.err(f"{cmd} {height:g}: {e}", line) from None
+        return replace(lens, field=fld)
 
     def solve_image(self, lens: Lens, line: int, lines: list[int]) -> Lens:
         from ..paraxial import paraxial
@@ -566,7 +770,7 @@ class _SeqParser:
             d = float(paraxial(lens.with_image_distance(0.0)).gaussian_image_distance)
         except (LensError, ValueError, ArithmeticError) as e:
             raise lens_error(self.err, e, lines, line) from None
-        if not (math.isfinite(d) and d >= 0.0):
+        if not (math.isfinite(d) and d * lens.image_direction >= 0.0):
             raise self.err(
                 f"PIM: the paraxial image is {'at infinity' if not math.isfinite(d) else 'virtual'}"
                 "; give the image distance as the last thickness instead",

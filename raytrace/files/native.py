@@ -35,6 +35,20 @@ optional ``range_nm = [min, max]``); ``sd`` (semi-diameter, mm); ``stop = true``
 ``asph = [A4, A6, ...]``; ``label``. ``[object]`` may also carry ``glass`` / ``n`` for an
 immersed object space.
 
+Placement and mirrors (:mod:`raytrace.frames` states the conventions; ``lenses/README.md`` for
+users): per surface ``decenter = [x, y]`` or ``[x, y, z]`` (mm), ``tilt = [a, b, c]`` (degrees,
+right-handed about x, y, z, Zemax's convention), ``order = "decenter-tilt"`` (default) or
+``"tilt-decenter"``; ``after = "stay" | "return" | "bend"`` or ``after = { decenter = [...],
+tilt = [...], order = ... }`` (the frame the thickness runs in after the surface); ``mirror =
+true`` (the medium after it is the one before; thicknesses after an odd number of mirrors are
+negative); ``type = "coordinate_break"`` (not traced: only its decenter / tilt and ``t``);
+``aperture = { circle = r | rectangle = [hx, hy] | ellipse = [a, b], center = [x0, y0] }`` (a
+clear aperture in the surface frame). Top level: ``image = { decenter = ..., tilt = ..., order
+= ... }`` (the image surface). Aperture kinds also ``float`` (stop semi-diameter, mm),
+``working_fnumber``, ``cone_angle`` (degrees); field kinds also ``paraxial_image_height`` and
+``real_image_height`` (mm; turned into the object-space field on reading), and ``points =
+[[x, y], ...]`` beside the kind.
+
 The provenance is kept as the first line of ``Lens.notes`` (``"provenance: patent"``), so that it
 survives :func:`dumps` / :func:`loads`; :func:`provenance` reads it back.
 
@@ -56,7 +70,8 @@ import numpy as np
 import tomllib
 
 from ..errors import LensError, PrescriptionError
-from ..lens import Aperture, Field, Lens, Surface
+from ..frames import AFTER_MODES, ORDERS, Placement
+from ..lens import APERTURE_KINDS, IMAGE_FIELDS, Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from .output import write_atomic
 from .text import decode_text, read_bytes
@@ -82,7 +97,16 @@ _SURFACE_KEYS: dict[str, tuple[str, ...]] = {
     "asph": ("asph", "aspheric"),
     "stop": ("stop",),
     "label": ("label",),
+    "decenter": ("decenter",),
+    "tilt": ("tilt",),
+    "order": ("order",),
+    "after": ("after",),
+    "mirror": ("mirror",),
+    "type": ("type",),
+    "aperture": ("aperture",),
 }
+_PLACEMENT_KEYS = ("decenter", "tilt", "order")
+_CLEAR_APERTURE_KEYS = ("circle", "rectangle", "ellipse", "center")
 _TOP_KEYS = (
     "name",
     "source",
@@ -100,10 +124,11 @@ _TOP_KEYS = (
     "aperture",
     "field",
     "surfaces",
+    "image",
 )
 _OBJECT_KEYS = ("distance", "glass", "catalog", "model", "n", "formula", "coefficients", "range_nm")
-_APERTURE_KEYS = ("fnumber", "epd", "na")
-_FIELD_KEYS = ("angle", "height")
+_APERTURE_KEYS = tuple(APERTURE_KINDS)
+_FIELD_KEYS = ("angle", "height", *IMAGE_FIELDS)
 
 _PROVENANCE_RE = re.compile(r"provenance: (patent|derived|rescaled)(\n|$)")
 
@@ -582,9 +607,15 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
         )
 
     aperture = _choice(src, data, "aperture", _APERTURE_KEYS, Aperture)
-    fld = _choice(src, data, "field", _FIELD_KEYS, Field)
+    fld, image_field = _field(src, data, math.isfinite(object_distance))
+    image_placement = None
+    img = _table(src, data, "image")
+    if img is not None:
+        allowed = {k: (k,) for k in _PLACEMENT_KEYS}
+        _check_keys(src, img, allowed, "[image]", lambda k: src.key_line("image", k))
+        image_placement = _placement(src, img, "[image]", src.key_line("image"), None)
 
-    surfaces = _surfaces(src, data)
+    surfaces = _surfaces(src, data, object_material)
 
     lens_notes = notes
     if prov is not None:
@@ -609,12 +640,103 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
         units="mm",
         object_material=object_material,
         path=src.path,
+        image_placement=image_placement,
     )
     if solve:
         lens = _solve_gaussian(src, lens)
     if scale_to is not None:
         lens = _scale_to_efl(src, lens, scale_to)
+    if image_field is not None:
+        from ..errors import TraceError
+        from ..trace.image_field import field_for_image_height
+
+        kind, height = image_field
+        try:
+            lens = replace(lens, field=field_for_image_height(lens, height, kind))
+        except (LensError, TraceError, ValueError) as e:
+            raise src.error(f"field {kind} = {height!r}: {e}", src.key_line("field", kind))
     return lens
+
+
+def _field(src: _Source, data: dict[str, Any], finite: bool) -> tuple[Field, Any]:
+    """(Field, image_field): the [field] table — one kind with its value, optional ``points``;
+    an image-space kind gives a provisional field and ``(kind, height)`` to solve later."""
+    t = _table(src, data, "field")
+    wanted = " / ".join(_FIELD_KEYS)
+    if t is None:
+        raise src.error(f"missing [field] table: give exactly one of {wanted}", line=src.last_line)
+    allowed = {k: (k,) for k in (*_FIELD_KEYS, "points")}
+    _check_keys(src, t, allowed, "[field]", lambda k: src.key_line("field", k))
+    given = [k for k in _FIELD_KEYS if k in t]
+    if len(given) != 1:
+        got = ", ".join(given) if given else "none"
+        raise src.error(f"[field] needs exactly one of {wanted} (got: {got})", src.key_line("field"))
+    kind = given[0]
+    line = src.key_line("field", kind)
+    value = _number(src, t[kind], f"field {kind}", line)
+    if value < 0.0:
+        raise src.error(f"field {kind} must be positive, got {value!r}", line)
+    if kind == "angle" and value >= 90.0:
+        raise src.error(f"field angle must be below 90 degrees, got {value!r}", line)
+    pts: tuple[tuple[float, float], ...] = ()
+    if "points" in t:
+        pl = src.key_line("field", "points")
+        raw = t["points"]
+        if not isinstance(raw, list) or not all(isinstance(p, list) and len(p) == 2 for p in raw):
+            raise src.error("field points must be a list of [x, y] pairs", pl)
+        pts = tuple(
+            (_number(src, a, "field point x", pl), _number(src, b, "field point y", pl))
+            for a, b in raw
+        )
+    if kind in IMAGE_FIELDS:
+        return Field("height" if finite else "angle", 0.0), (kind, value)
+    return Field(kind, value, pts), None
+
+
+def _triple_value(src: _Source, value: Any, what: str, line, no) -> tuple[float, float, float]:
+    if not isinstance(value, list) or len(value) not in (2, 3):
+        raise src.error(f"{what} must be a list of 2 or 3 numbers, got {value!r}", line, no)
+    vals = [_number(src, v, what, line, no) for v in value]
+    return (vals[0], vals[1], vals[2] if len(vals) == 3 else 0.0)
+
+
+def _placement(src: _Source, e: dict[str, Any], where: str, line, no) -> Placement | None:
+    """A Placement from ``decenter``, ``tilt``, ``order`` keys (None when none is given)."""
+    if not any(k in e for k in _PLACEMENT_KEYS):
+        return None
+    dec = _triple_value(src, e["decenter"], "decenter (mm)", line, no) if "decenter" in e else None
+    tilt = _triple_value(src, e["tilt"], "tilt (degrees)", line, no) if "tilt" in e else None
+    order = e.get("order", ORDERS[0])
+    if order not in ORDERS:
+        raise src.error(f"order must be one of {', '.join(ORDERS)}, got {order!r}", line, no)
+    return Placement(dec or (0.0, 0.0, 0.0), tilt or (0.0, 0.0, 0.0), order)
+
+
+def _clear_aperture(src: _Source, value: Any, line, no) -> ClearAperture:
+    if not isinstance(value, dict):
+        raise src.error(
+            "aperture must be a table { circle = r | rectangle = [hx, hy] | ellipse = [a, b], "
+            f"center = [x0, y0] }}, got {value!r}",
+            line,
+            no,
+        )
+    _check_keys(src, value, {k: (k,) for k in _CLEAR_APERTURE_KEYS}, "aperture", line, no)
+    shapes = [k for k in ("circle", "rectangle", "ellipse") if k in value]
+    if len(shapes) != 1:
+        raise src.error("aperture needs exactly one of circle / rectangle / ellipse", line, no)
+    shape = shapes[0]
+    if shape == "circle":
+        r = _number(src, value["circle"], "aperture circle radius (mm)", line, no)
+        hx = hy = r
+    else:
+        hx, hy, _ = _triple_value(src, value[shape], f"aperture {shape} (mm)", line, no)
+    x0 = y0 = 0.0
+    if "center" in value:
+        x0, y0, _ = _triple_value(src, value["center"], "aperture center (mm)", line, no)
+    try:
+        return ClearAperture(shape, hx, hy, x0, y0)
+    except ValueError as e:
+        raise src.error(str(e), line, no) from None
 
 
 def _choice(src: _Source, data: dict[str, Any], table: str, keys: tuple[str, ...], cls: type):
@@ -642,7 +764,7 @@ def _choice(src: _Source, data: dict[str, Any], table: str, keys: tuple[str, ...
     return cls(kind, value)
 
 
-def _surfaces(src: _Source, data: dict[str, Any]) -> list[Surface]:
+def _surfaces(src: _Source, data: dict[str, Any], object_material: Material = AIR) -> list[Surface]:
     raw = data.get("surfaces")
     if raw is None:
         raise src.error(
@@ -661,6 +783,38 @@ def _surfaces(src: _Source, data: dict[str, Any]) -> list[Surface]:
         if not isinstance(entry, dict):
             raise src.error(f"each surface must be a {{ ... }} table, got {entry!r}", line, no)
         out.append(_surface(src, entry, line, no, last=(i == n - 1)))
+    # media of mirrors and coordinate breaks (the one before), thickness signs
+    direction = 1.0
+    placed = any(s.is_placed or s.coordinate_break for s in out)
+    for i, srf in enumerate(out):
+        no, line = i + 1, src.surface_line(i)
+        before = object_material if i == 0 else out[i - 1].material
+        given = raw[i].get("glass", raw[i].get("material", raw[i].get("n", raw[i].get("index"))))
+        if srf.mirror or srf.coordinate_break:
+            if given is not None and srf.material != before:
+                what = "a mirror" if srf.mirror else "a coordinate break"
+                raise src.error(
+                    f"{what} returns the light into the medium before it "
+                    f"({before.describe()}): remove the glass", line, no
+                )  # fmt: skip
+            out[i] = srf = replace(srf, material=before)
+        if srf.mirror:
+            direction = -direction
+        t = srf.thickness
+        if isinstance(t, str) or i == n - 1 or srf.coordinate_break:
+            continue
+        if not srf.material.is_air and t * direction <= 0.0:
+            if direction > 0:
+                raise src.error(f"glass thickness must be positive, got t = {t!r}", line, no)
+            raise src.error(
+                f"glass thickness must be negative after an odd number of mirrors, got t = {t!r}",
+                line,
+                no,
+            )
+        if srf.material.is_air and t * direction < 0.0 and not placed and not any(
+            x.mirror for x in out
+        ):
+            raise src.error(f"air thickness must not be negative, got t = {t!r}", line, no)
 
     stops = [i for i, s in enumerate(out) if s.stop]
     if not stops:
@@ -724,12 +878,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
         thickness = "gaussian"
     else:
         thickness = _number(src, t, "t (thickness, mm)", line, no)
-        if last:
-            pass  # the image distance may be negative (a virtual image plane the file defines)
-        elif not material.is_air and thickness <= 0.0:
-            raise src.error(f"glass thickness must be positive, got t = {thickness!r}", line, no)
-        elif thickness < 0.0:
-            raise src.error(f"air thickness must not be negative, got t = {thickness!r}", line, no)
+        # signs are checked by _surfaces (after mirrors thicknesses are negative)
 
     sd = math.inf
     sdv = _one_of(src, e, "sd", K, line, no)
@@ -765,6 +914,38 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
             line,
             no,
         )
+    placement = _placement(src, e, "surface", line, no)
+    after: Placement | str = "stay"
+    if "after" in e:
+        a = e["after"]
+        if isinstance(a, dict):
+            _check_keys(src, a, {k: (k,) for k in _PLACEMENT_KEYS}, "after", line, no)
+            after = _placement(src, a, "after", line, no) or "stay"
+        elif a in AFTER_MODES:
+            after = a
+        else:
+            raise src.error(
+                f'after must be one of {", ".join(AFTER_MODES)} or {{ decenter = [...], tilt = '
+                f"[...], order = ... }}, got {a!r}",
+                line,
+                no,
+            )
+    mirror = e.get("mirror", False)
+    if not isinstance(mirror, bool):
+        raise src.error(f"mirror must be true or false, got {mirror!r}", line, no)
+    kind = e.get("type", "surface")
+    if kind not in ("surface", "coordinate_break"):
+        raise src.error(
+            f'type must be "surface" or "coordinate_break", got {kind!r}', line, no
+        )
+    cb = kind == "coordinate_break"
+    if cb and (curvature != 0.0 or mirror or stop or conic or asph or math.isfinite(sd)):
+        raise src.error(
+            "a coordinate break has only decenter, tilt, order and t (it is not traced)", line, no
+        )
+    aperture = None
+    if "aperture" in e:
+        aperture = _clear_aperture(src, e["aperture"], line, no)
     return Surface(
         curvature=curvature,
         thickness=thickness,  # type: ignore[arg-type]  ("gaussian" is resolved by the caller)
@@ -775,6 +956,11 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
         aspheric=asph,
         label=label,
         line=line,
+        placement=placement,
+        after=after,
+        mirror=mirror,
+        coordinate_break=cb,
+        aperture=aperture,
     )
 
 
@@ -829,9 +1015,9 @@ def _solve_gaussian(src: _Source, lens: Lens) -> Lens:
             line,
             n,
         )
-    if d < 0.0:
+    if d * lens.image_direction < 0.0:
         raise src.error(
-            f't = "gaussian": the paraxial image is virtual ({d:.6g} mm before the last '
+            f't = "gaussian": the paraxial image is virtual ({abs(d):.6g} mm before the last '
             "vertex); give the image distance",
             line,
             n,
@@ -894,6 +1080,8 @@ _COLUMNS = """\
 #   sd      semi-diameter, mm (omitted = unlimited)
 #   k       conic constant;  asph = [A4, A6, ...] even-asphere coefficients of r^4, r^6, ...
 #   stop    true on the aperture stop (exactly one);  label = optional name
+#   decenter, tilt, order, after, mirror, type, aperture: placement (mm, degrees right-handed
+#           about x, y, z), mirrors and coordinate breaks, clear apertures (lenses/README.md)
 """
 
 
@@ -976,17 +1164,70 @@ def _material_cells(m: Material) -> list[tuple[str, str] | None]:
     return [glass, ("model", _toml_str(m.model)) if m.model != "cauchy2" else None]
 
 
+def _list(values) -> str:
+    return "[" + ", ".join(repr(float(v) + 0.0) for v in values) + "]"
+
+
+def _placement_text(p: Placement) -> str:
+    """``{ decenter = [...], tilt = [...], order = ... }`` body cells of a placement."""
+    parts = []
+    if any(p.decenter):
+        d = p.decenter if p.decenter[2] else p.decenter[:2]
+        parts.append(f"decenter = {_list(d)}")
+    if any(p.tilt):
+        parts.append(f"tilt = {_list(p.tilt)}")
+    if p.order != ORDERS[0]:
+        parts.append(f'order = "{p.order}"')
+    return ", ".join(parts)
+
+
+def _geometry_cells(s: Surface) -> list[tuple[str, str] | None]:
+    """Cells of the placement, mirror, coordinate-break and clear-aperture keys."""
+    cells: list[tuple[str, str] | None] = [
+        ("type", '"coordinate_break"') if s.coordinate_break else None,
+        ("mirror", "true") if s.mirror else None,
+    ]
+    p = s.placement
+    if p is not None:
+        text = _placement_text(p)
+        first, _, rest = text.partition(" = ")
+        cells.append((first, rest))
+    else:
+        cells.append(None)
+    a = s.after
+    if isinstance(a, Placement):
+        cells.append(("after", "{ " + _placement_text(a) + " }"))
+    else:
+        cells.append(("after", f'"{a}"') if a != "stay" else None)
+    ap = s.aperture
+    if ap is None:
+        cells.append(None)
+    else:
+        size = (
+            repr(ap.half_x)
+            if ap.shape == "circle"
+            else _list((ap.half_x, ap.half_y))
+        )
+        body = f"{ap.shape} = {size}"
+        if ap.x0 or ap.y0:
+            body += f", center = {_list((ap.x0, ap.y0))}"
+        cells.append(("aperture", "{ " + body + " }"))
+    return cells
+
+
 def _surface_cells(s: Surface, last: bool, solve: str | None) -> list[tuple[str, str] | None]:
     t = '"gaussian"' if (last and solve == "gaussian") else _fnum(s.thickness)
+    own_medium = not (s.mirror or s.coordinate_break)
     cells: list[tuple[str, str] | None] = [
         _radius_cell(s.curvature),
         ("t", t),
-        *_material_cells(s.material),
+        *(_material_cells(s.material) if own_medium else [None, None]),
         ("sd", _fnum(s.semi_diameter)) if math.isfinite(s.semi_diameter) else None,
         ("k", repr(float(s.conic))) if s.conic != 0.0 else None,
         ("asph", "[" + ", ".join(repr(float(a)) for a in s.aspheric) + "]") if s.aspheric else None,
         ("stop", "true") if s.stop else None,
         ("label", _toml_str(s.label)) if s.label else None,
+        *_geometry_cells(s),
     ]
     return cells
 
@@ -1030,16 +1271,38 @@ def dumps(lens: Lens) -> str:
         '# object distance: mm from the object plane to the first vertex (positive), or "inf"\n'
     )
     out.append(f"object   = {{ {', '.join(obj)} }}\n")
-    ap_help = {"fnumber": "f-number", "epd": "entrance-pupil diameter, mm", "na": "object NA"}
+    ap_help = {
+        "fnumber": "f-number",
+        "epd": "entrance-pupil diameter, mm",
+        "na": "object NA",
+        "float": "float by stop size: the stop's semi-diameter, mm",
+        "working_fnumber": "paraxial working f-number",
+        "cone_angle": "object cone angle, degrees",
+    }
     out.append(
         f"aperture = {{ {lens.aperture.kind} = {_fnum(lens.aperture.value)} }}"
         f"   # {ap_help[lens.aperture.kind]}\n"
     )
+    fld = lens.field
     fld_help = {"angle": "max half-field angle, degrees", "height": "max object height, mm"}
-    out.append(
-        f"field    = {{ {lens.field.kind} = {_fnum(lens.field.value)} }}"
-        f"   # {fld_help[lens.field.kind]}\n\n"
-    )
+    if fld.given is not None:
+        out.append(
+            f"field    = {{ {fld.given[0]} = {_fnum(fld.given[1])} }}"
+            f"   # mm, = {fld.kind} {fld.value!r} in object space\n"
+        )
+    else:
+        pts = ""
+        if fld.points:
+            pts = ", points = [" + ", ".join(_list(p) for p in fld.points) + "]"
+        out.append(
+            f"field    = {{ {fld.kind} = {_fnum(fld.value)}{pts} }}   # {fld_help[fld.kind]}\n"
+        )
+    if lens.image_placement is not None:
+        out.append(
+            f"image    = {{ {_placement_text(lens.image_placement)} }}"
+            "   # decenter (mm) / tilt (deg) of the image surface\n"
+        )
+    out.append("\n")
 
     out.append(_COLUMNS)
     n = lens.n_surfaces

@@ -1,7 +1,7 @@
 """Zemax OpticStudio ``.zmx`` files: read (ASCII, UTF-8 or UTF-16) and write.
 
 Reading (:func:`read_zmx`, :func:`loads_zmx`, :func:`parse_zmx`) supports a sequential lens made
-of ``STANDARD`` and ``EVENASPH`` surfaces:
+of ``STANDARD`` and ``EVENASPH`` surfaces, coordinate breaks and mirrors:
 
 * ``SURF n`` blocks in order; surface 0 is the object, the last one the image, the ones between
   are the lens. ``CURV`` (curvature, 1/lens unit), ``DISZ`` (thickness to the next vertex;
@@ -18,21 +18,38 @@ of ``STANDARD`` and ``EVENASPH`` surfaces:
   are nd and vd; vd = 0 means a non-dispersive index, as in OpticStudio) or a catalog name
   (``GLAS N-BK7 0 0 1.5 40 …`` — OpticStudio stores placeholder numbers for catalog glasses, so
   they are NOT used): the name is resolved through :mod:`raytrace.glass`, the ``GCAT`` catalogs
-  first (first one that has it wins, as in OpticStudio). ``GLAS MIRROR`` is refused.
-* Aperture: ``ENPD`` (entrance-pupil diameter), ``FNUM`` (image-space F/#, EFL/EPD for an
-  infinite conjugate = orthoscope's f-number), ``OBNA`` (object-space NA). Field: ``FTYP t``
-  with t = 0 (angle, degrees) or 1 (object height); the field values are ``XFLN``/``YFLN`` (or
-  the older ``XFLD``/``YFLD``), of which the first ``FTYP``-count are used; the lens's field is
-  the largest radial value √(x² + y²). Wavelength: ``WAVM i λ w`` (or ``WAVL λ1 λ2 …``) in µm and
-  ``PWAV i`` (the primary) → nm.
+  first (first one that has it wins, as in OpticStudio).
+* Geometry (:mod:`raytrace.frames` states the conventions): ``TYPE COORDBRK`` (``PARM 1..6`` =
+  decenter x, y, tilt about x, y, z in degrees, order flag; its ``DISZ`` runs in the new frame)
+  becomes a coordinate-break surface; the surface Tilt/Decenter tab ``SCBD 1 order 0 dx dy tx ty
+  tz`` (before the surface) and ``SCBD 2 order 0 dx dy tx ty tz`` (after it, explicit values)
+  becomes the surface's placement and ``after``; on the image surface it places the image plane.
+  ``GLAS MIRROR`` makes the surface a mirror (the medium after it is the one before; thicknesses
+  after an odd number of mirrors are negative, as OpticStudio writes them).
+* Clear apertures: ``CLAP rmin r`` (circular; an annular minimum radius is ignored with a
+  warning), ``SQAP hx hy`` (rectangular), ``ELAP a b`` (elliptical), moved by ``OBDC x y``
+  (aperture decenter; then the surface's semi-diameter does not clip: the aperture is the
+  off-axis section). ``OBSC`` (obscuration) and other vignetting apertures are ignored with a
+  warning.
+* Aperture: ``ENPD`` (entrance-pupil diameter), ``FNUM x 0`` (image-space F/#, EFL/EPD for an
+  infinite conjugate = orthoscope's f-number), ``FNUM x 1`` (paraxial working F/#), ``OBNA x 0``
+  (object-space NA), ``OBNA x 1`` (object cone angle, degrees), ``FLOA`` (float by stop size:
+  the stop's semi-diameter ``DIAM`` sets the pupil). Field: ``FTYP t`` with t = 0 (angle,
+  degrees), 1 (object height), 2 (paraxial image height) or 3 (real image height; both turned
+  into the object-space field that gives them, ``Field.given`` keeps the original); the field
+  values are ``XFLN``/``YFLN`` (or the older ``XFLD``/``YFLD``), of which the first
+  ``FTYP``-count are used (``Field.points``); the lens's field is the largest radial value
+  √(x² + y²). Wavelength: ``WAVM i λ w`` (or ``WAVL λ1 λ2 …``) in µm and ``PWAV i`` (the
+  primary) → nm.
 * ``UNIT MM|CM|IN|M``: lengths are converted to mm.
 
 Solves (``PZUP``, solve fields on ``CURV``/``DISZ``) are ignored: OpticStudio stores the solved
 values, which are read. Display, tolerance, coating and merit-function commands are skipped.
 Other unknown commands are reported in one :class:`InteropWarning`. Anything that would change
-the optics and cannot be modelled (coordinate breaks, tilts/decenters, non-sequential mode,
-mirrors, other surface types, gradient index, the r² term, float-by-stop aperture, image-height
-fields) raises :class:`~raytrace.errors.PrescriptionError` with the file, line and what to do.
+the optics and cannot be modelled (non-sequential mode, other surface types such as gratings,
+toroids and freeforms, gradient index, the r² term, a tilt/decenter mode other than explicit
+where the order matters) raises :class:`~raytrace.errors.PrescriptionError` with the file, line
+and what to do.
 Every problem with the input raises PrescriptionError (never another exception type).
 
 Writing (:func:`dumps_zmx`, :func:`write_zmx`) produces a sequential file OpticStudio reads, with
@@ -46,12 +63,13 @@ from __future__ import annotations
 import codecs
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
+from ..frames import ORDERS, Placement
 from ..glass import lookup_glass, parse_glass_code
-from ..lens import Aperture, Field, Lens, Surface, check_file_lens
+from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from .output import write_atomic
 from .text import (
@@ -88,14 +106,16 @@ _IGNORED_GLOBAL = set(
 # 1 object cone angle) or FLOA (float by stop size).
 _IGNORED_SURFACE = set(
     """HIDE MIRR SLAB POPS VDSZ FLAP MEMA FIMP COAT PZUP PPAR VPAR VCON EDGE UDAD USAP BLNK
-    TCED OBDC CDCS DCPM THMP""".split()
+    TCED CDCS DCPM THMP""".split()
 )
-_VIGNETTING = {"SQAP", "ELAP", "OBSC", "UDAP", "RBAP", "SPID"}
+_VIGNETTING = {"OBSC", "UDAP", "RBAP", "SPID"}
+_APERTURE_CMDS = {"SQAP", "ELAP", "OBDC"}
 _TILTS = {"DECX", "DECY", "TILX", "TILY", "TILZ", "TILT", "SCBD"}
 _SURF_CMDS = (
     {"TYPE", "CURV", "DISZ", "DIAM", "CONI", "PARM", "GLAS", "STOP", "COMM", "CLAP", "XDAT"}
     | _IGNORED_SURFACE
     | _VIGNETTING
+    | _APERTURE_CMDS
     | _TILTS
 )
 _MAX_WARNINGS = 50
@@ -120,6 +140,12 @@ class _ZSurf:
     glas: tuple[list[str], int] | None = None
     stop: bool = False
     comm: str = ""
+    mirror: bool = False
+    scbd: dict[int, tuple[list[float], int]] = field(default_factory=dict)
+    sqap: tuple[float, float] | None = None
+    elap: tuple[float, float] | None = None
+    obdc: tuple[float, float] = (0.0, 0.0)
+    ap_line: int = 0
 
 
 class _ZmxParser:
@@ -224,18 +250,17 @@ class _ZmxParser:
                     )
                 h["UNIT"] = (_UNITS[u], lineno)
             elif cmd in ("FNUM", "OBNA") and len(args) > 1 and args[1] not in ("0", "0.0"):
-                meaning = "paraxial working F/#" if cmd == "FNUM" else "object cone angle"
-                raise self.err(
-                    f"{cmd} {' '.join(args[:2])}: aperture type '{meaning}' is not supported; in "
-                    "OpticStudio set the system aperture to Entrance Pupil Diameter (ENPD), Image "
-                    "Space F/# (FNUM) or Object Space NA (OBNA) and save again",
-                    lineno,
-                )
+                flag = self.integer(args, 1, cmd, lineno)
+                if flag != 1:
+                    raise self.err(f"{cmd} {' '.join(args[:2])}: unknown aperture flag", lineno)
+                key = "WFNO" if cmd == "FNUM" else "OBCA"  # working F/#, object cone angle
+                h["APER"] = (key, self.num(args, 0, cmd, lineno), lineno)
             elif cmd in ("ENPD", "FNUM", "OBNA"):
                 h["APER"] = (cmd, self.num(args, 0, cmd, lineno), lineno)
-            elif cmd in ("FLOA", "OBCA", "PWFN"):
+            elif cmd == "FLOA":
+                h["APER"] = ("FLOA", math.nan, lineno)
+            elif cmd in ("OBCA", "PWFN"):
                 meaning = {
-                    "FLOA": "float by stop size",
                     "OBCA": "object cone angle",
                     "PWFN": "paraxial working F/#",
                 }[cmd]
@@ -301,17 +326,9 @@ class _ZmxParser:
         no = cur.number
         if cmd == "TYPE":
             t = args[0].upper() if args else ""
-            if t in ("STANDARD", "EVENASPH"):
+            if t in ("STANDARD", "EVENASPH", "COORDBRK"):
                 cur.type, cur.type_line = t, line
                 return
-            if t == "COORDBRK":
-                raise self.err(
-                    "TYPE COORDBRK: coordinate breaks (tilts and decenters) are not supported; "
-                    "orthoscope models centred lenses only — remove the coordinate breaks (or "
-                    "set them to zero and delete them) in OpticStudio and save again",
-                    line,
-                    no,
-                )
             hint = ""
             if "GRIN" in t or "GRAD" in t:
                 hint = " (gradient-index media are not supported)"
@@ -356,12 +373,8 @@ class _ZmxParser:
             if not args:
                 raise self.err("GLAS needs a glass name", line, no)
             if args[0].upper() == "MIRROR":
-                raise self.err(
-                    "GLAS MIRROR: mirrors are not supported; orthoscope traces refracting "
-                    "lenses only",
-                    line,
-                    no,
-                )
+                cur.mirror = True
+                return
             cur.glas = (list(args), line)
         elif cmd == "STOP":
             cur.stop = True
@@ -369,9 +382,30 @@ class _ZmxParser:
             cur.comm = rest
         elif cmd in _VIGNETTING:
             self.warn(
-                f"line {line}: {cmd} (a non-circular aperture or obscuration on surface {no}) "
+                f"line {line}: {cmd} (an obscuration or user aperture on surface {no}) "
                 "ignored: it can vignette rays but orthoscope does not clip with it"
             )
+        elif cmd in ("SQAP", "ELAP"):
+            a, b = self.num(args, 0, cmd, line), self.num(args, 1, cmd, line)
+            if not (a > 0.0 and b > 0.0):
+                raise self.err(f"{cmd}: the aperture half-widths must be positive", line, no)
+            if cmd == "SQAP":
+                cur.sqap = (a, b)
+            else:
+                cur.elap = (a, b)
+            cur.ap_line = line
+        elif cmd == "OBDC":
+            cur.obdc = (self.num(args, 0, cmd, line), self.num(args, 1, cmd, line))
+        elif cmd == "SCBD":
+            vals = [self.num(args, i, cmd, line) for i in range(len(args))]
+            if len(vals) < 8 or vals[0] not in (1.0, 2.0):
+                raise self.err(
+                    "SCBD: expected 'SCBD 1|2 order mode dx dy tilt_x tilt_y tilt_z' (surface "
+                    "tilt/decenter before (1) or after (2) the surface)",
+                    line,
+                    no,
+                )
+            cur.scbd[int(vals[0])] = (vals[1:8], line)
         elif cmd in _TILTS:
             vals = []
             for a in args:
@@ -383,8 +417,9 @@ class _ZmxParser:
                 cmd != "SCBD" and any(v != 0.0 for v in vals)
             ):
                 raise self.err(
-                    f"{cmd}: surface tilts and decenters are not supported; orthoscope models "
-                    "centred lenses only — remove the tilt/decenter in OpticStudio and save again",
+                    f"{cmd}: this form of surface tilt/decenter is not supported; in OpticStudio "
+                    "give it in the surface's Tilt/Decenter tab or as coordinate breaks and save "
+                    "again",
                     line,
                     no,
                 )
@@ -496,6 +531,79 @@ class _ZmxParser:
         wls = tuple(e[0] for e in entries)
         return wls, tuple(e[1] for e in entries), entries[primary_pos][2], wls[primary_pos]
 
+    def coordinate_break(self, z: _ZSurf, scale: float, medium: Material) -> Surface:
+        """A ``COORDBRK`` surface: PARM 1..6 = decenter x, y, tilt x, y, z (deg), order flag."""
+
+        def parm(i: int) -> float:
+            return z.parm.get(i, (0.0, 0))[0]
+
+        order = ORDERS[0] if parm(6) == 0.0 else ORDERS[1]
+        for i, (v, line) in z.parm.items():
+            if not 1 <= i <= 6:
+                raise self.err(f"COORDBRK PARM {i}: a coordinate break has PARM 1 to 6", line)
+        if z.stop:
+            raise self.err("STOP on a coordinate break: the stop must be a lens surface", z.line)
+        if z.mirror or z.glas is not None:
+            self.warn(f"line {z.line}: GLAS on a coordinate break (surface {z.number}) ignored")
+        p = Placement(
+            (parm(1) * scale, parm(2) * scale, 0.0), (parm(3), parm(4), parm(5)), order
+        )
+        return Surface(
+            curvature=0.0,
+            thickness=z.disz * scale,
+            material=medium,
+            label=z.comm,
+            line=z.line,
+            placement=p,
+            coordinate_break=True,
+        )
+
+    def tilt_decenter(self, z: _ZSurf, scale: float) -> tuple[Placement | None, Placement | str]:
+        """(placement, after) of the surface Tilt/Decenter tab (``SCBD 1`` before, ``SCBD 2``
+        after the surface): values ``order mode dx dy tx ty tz``."""
+        out: list[Placement | None] = [None, None]
+        for which in (1, 2):
+            if which not in z.scbd:
+                continue
+            (order, mode, dx, dy, tx, ty, tz), line = z.scbd[which]
+            p = Placement((dx * scale, dy * scale, 0.0), (tx, ty, tz))
+            moves = sum(v != 0.0 for v in (tx, ty, tz)) + (dx != 0.0 or dy != 0.0)
+            if moves > 1 and (order != 0.0 or mode != 0.0):
+                raise self.err(
+                    f"SCBD {which}: a tilt/decenter with order flag {order:g} / mode {mode:g} "
+                    "is not supported where the order matters; in OpticStudio use explicit "
+                    "values with the order 'decenter then tilt' (or coordinate breaks) and "
+                    "save again",
+                    line,
+                    z.number,
+                )
+            out[which - 1] = None if p.is_identity else p
+        before, after = out
+        return before, (after if after is not None else "stay")
+
+    def clear_aperture(self, z: _ZSurf, sd: float, scale: float):
+        """(semi-diameter, ClearAperture or None) from CLAP / SQAP / ELAP and OBDC."""
+        x0, y0 = z.obdc[0] * scale, z.obdc[1] * scale
+        shapes = [s for s, v in (("rectangle", z.sqap), ("ellipse", z.elap)) if v is not None]
+        if len(shapes) > 1 or (shapes and math.isfinite(z.clap)):
+            raise self.err(
+                "more than one clear aperture (CLAP / SQAP / ELAP) on one surface",
+                z.ap_line or z.line,
+                z.number,
+            )
+        if shapes:
+            hx, hy = z.sqap if z.sqap is not None else z.elap
+            ap = ClearAperture(shapes[0], hx * scale, hy * scale, x0, y0)
+            return (math.inf if (x0 or y0) else sd), ap
+        if math.isfinite(z.clap):
+            r = z.clap * scale
+            if x0 or y0:
+                return math.inf, ClearAperture("circle", r, r, x0, y0)
+            return min(sd, r), None
+        if x0 or y0:
+            self.warn(f"OBDC on surface {z.number} without a clear aperture ignored")
+        return sd, None
+
     def build(self, surfaces, h, notes_meta, plain_notes, xfln, yfln, wavm, wavl, gcat):
         last_line = len(self.text.split("\n"))
         if len(surfaces) < 3:
@@ -542,8 +650,16 @@ class _ZmxParser:
                 "orthoscope uses a flat image plane at the same vertex"
             )
         out: list[Surface] = []
+        mirrors = 0
         for k, z in enumerate(body):
-            mat = self.material(z.glas, gcat, z.number)
+            before = object_material if not out else out[-1].material
+            if z.type == "COORDBRK":
+                out.append(self.coordinate_break(z, scale, before))
+                continue
+            if z.mirror and z.glas is not None:
+                raise self.err("GLAS MIRROR and another GLAS on one surface", z.line, z.number)
+            mat = before if z.mirror else self.material(z.glas, gcat, z.number)
+            mirrors += z.mirror
             sd = math.inf
             if z.diam_fixed:
                 if z.diam == 0.0:
@@ -560,15 +676,17 @@ class _ZmxParser:
                     )
                 else:
                     sd = z.diam * scale
-            if math.isfinite(z.clap):
-                sd = min(sd, z.clap * scale)
+            sd, aperture = self.clear_aperture(z, sd, scale)
             th = z.disz * scale
-            if th < 0.0 and not mat.is_air:
+            direction = -1.0 if mirrors % 2 else 1.0
+            if th * direction < 0.0 and not mat.is_air:
                 raise self.err(
-                    f"DISZ {z.disz!r}: a glass thickness must not be negative",
+                    f"DISZ {z.disz!r}: a glass thickness must not be "
+                    f"{'negative' if direction > 0 else 'positive after an odd number of mirrors'}",
                     z.disz_line or z.line,
                     z.number,
                 )
+            placement, after = self.tilt_decenter(z, scale)
             out.append(
                 Surface(
                     curvature=z.curv / scale,
@@ -580,8 +698,15 @@ class _ZmxParser:
                     aspheric=self.aspheric(z, scale),
                     label=z.comm,
                     line=z.line,
+                    placement=placement,
+                    after=after,
+                    mirror=z.mirror,
+                    aperture=aperture,
                 )
             )
+        if img.scbd.get(2):
+            self.warn(f"line {img.scbd[2][1]}: a tilt/decenter after the image surface ignored")
+        image_placement, _ = self.tilt_decenter(img, scale)
         # wavelengths (nm): the first FTYP-count WAVM slots (or WAVL), PWAV the primary
         wls, wts, _wl_line, primary = self.wavelengths(h, wavm, wavl)
         # aperture
@@ -592,12 +717,33 @@ class _ZmxParser:
                 last_line,
             )
         acmd, aval, aline = h["APER"]
+        if acmd == "FLOA":
+            st = [z for z in out if z.stop][0]
+            if not math.isfinite(st.semi_diameter):
+                raise self.err(
+                    "FLOA (float by stop size): the stop surface needs a semi-diameter (DIAM); "
+                    "give it in OpticStudio and save again",
+                    aline,
+                )
+            aval = st.semi_diameter / scale
         if not aval > 0.0:
             raise self.err(f"{acmd} must be positive, got {aval!r}", aline)
         if acmd == "ENPD":
             aperture = Aperture("epd", aval * scale)
         elif acmd == "FNUM":
             aperture = Aperture("fnumber", aval)
+        elif acmd == "FLOA":
+            aperture = Aperture("float", aval * scale)
+        elif acmd == "WFNO":
+            aperture = Aperture("working_fnumber", aval)
+        elif acmd == "OBCA":
+            if math.isinf(od) or not aval < 90.0:
+                raise self.err(
+                    "OBNA x 1 (object cone angle): needs a finite object distance and an angle "
+                    "below 90 degrees",
+                    aline,
+                )
+            aperture = Aperture("cone_angle", aval)
         else:
             if aval >= 1.0 * object_material.nd or math.isinf(od):
                 raise self.err(
@@ -616,10 +762,10 @@ class _ZmxParser:
                 )
             if (t, pr) != (20.0, 1.0):
                 temperature, pressure = t, pr
-        if ft not in (0, 1):
+        if ft not in (0, 1, 2, 3):
             raise self.err(
-                f"FTYP {ft}: field type {'paraxial image height' if ft == 2 else 'real image height' if ft == 3 else ft} "  # noqa: E501
-                "is not supported; set the field type to Angle (0) or Object Height (1) in "
+                f"FTYP {ft}: field type {ft} is not supported; set the field type to Angle (0), "
+                "Object Height (1), Paraxial Image Height (2) or Real Image Height (3) in "
                 "OpticStudio and save again",
                 fline,
             )
@@ -628,25 +774,31 @@ class _ZmxParser:
         n = max(len(xs), len(ys)) if nf is None else nf
         if n < 0:
             raise self.err(f"FTYP: negative number of fields {n}", fline)
-        radial = [
-            math.hypot(xs[i] if i < len(xs) else 0.0, ys[i] if i < len(ys) else 0.0)
-            for i in range(min(n, max(len(xs), len(ys))))
-        ]
+        npts = min(n, max(len(xs), len(ys)))
+        pts = tuple(
+            (xs[i] if i < len(xs) else 0.0, ys[i] if i < len(ys) else 0.0) for i in range(npts)
+        )
+        radial = [math.hypot(a, b) for a, b in pts]
         fmax = max(radial, default=0.0)
         if not radial:
             self.warn("no field values (YFLN/XFLN): the field is 0")
         fline = (yfln or xfln or (None, fline))[1] or fline or 1
-        if ft == 0:
+        image_field = None
+        if ft in (2, 3):
+            kind = "paraxial_image_height" if ft == 2 else "real_image_height"
+            image_field = (kind, fmax * scale, fline)
+            fld = Field("height" if math.isfinite(od) else "angle", 0.0)
+        elif ft == 0:
             if fmax >= 90.0:
                 raise self.err(f"field angle {fmax} deg: must be below 90 deg", fline)
-            fld = Field("angle", fmax)
+            fld = Field("angle", fmax, pts)
         else:
             if math.isinf(od):
                 raise self.err(
                     "FTYP 1 (object height) needs a finite object distance (DISZ of surface 0)",
                     fline,
                 )
-            fld = Field("height", fmax * scale)
+            fld = Field("height", fmax * scale, tuple((a * scale, b * scale) for a, b in pts))
         # names and notes
         name_text = h.get("NAME", ("", None))[0]
         meta = {}
@@ -687,10 +839,20 @@ class _ZmxParser:
                 object_material=object_material,
                 image_solve=solve,
                 path=self.path,
+                image_placement=image_placement,
             )
             check_file_lens(lens)
         except (LensError, ValueError) as e:
             raise lens_error(self.err, e, [z.line for z in body], surfaces[0].line) from None
+        if image_field is not None:
+            from ..errors import TraceError
+            from ..trace.image_field import field_for_image_height
+
+            kind, height, line = image_field
+            try:
+                lens = replace(lens, field=field_for_image_height(lens, height, kind))
+            except (LensError, TraceError, ValueError) as e:
+                raise self.err(f"FTYP {ft} ({kind.replace('_', ' ')} {height:g} mm): {e}", line)
         return ImportResult(lens, tuple(self.warnings))
 
 
@@ -788,17 +950,32 @@ def dumps_zmx(lens: Lens) -> str:
         out.append("GCAT " + " ".join(gcat))
     ap = lens.aperture
     out.append(
-        {"epd": f"ENPD {_r(ap.value)}", "fnumber": f"FNUM {_r(ap.value)} 0"}.get(
-            ap.kind, f"OBNA {_r(ap.value)} 0"
-        )
+        {
+            "epd": f"ENPD {_r(ap.value)}",
+            "fnumber": f"FNUM {_r(ap.value)} 0",
+            "na": f"OBNA {_r(ap.value)} 0",
+            "float": "FLOA",
+            "working_fnumber": f"FNUM {_r(ap.value)} 1",
+            "cone_angle": f"OBNA {_r(ap.value)} 1",
+        }[ap.kind]
     )
-    fv = float(lens.field.value)
-    fields = [0.0] if fv == 0.0 else [0.0, 0.7 * fv, fv]
+    fld = lens.field
+    fv = float(fld.value)
+    if fld.given is not None:
+        ftyp = 2 if fld.given[0] == "paraxial_image_height" else 3
+        gv = fld.given[1]
+        points = [(0.0, 0.0)] if gv == 0.0 else [(0.0, 0.0), (0.0, 0.7 * gv), (0.0, gv)]
+    else:
+        ftyp = 0 if fld.kind == "angle" else 1
+        if fld.points and len(fld.points) <= 12:
+            points = list(fld.points)
+        else:
+            points = [(0.0, 0.0)] if fv == 0.0 else [(0.0, 0.0), (0.0, 0.7 * fv), (0.0, fv)]
     nw = len(lens.wavelengths)
-    out.append(f"FTYP {0 if lens.field.kind == 'angle' else 1} 0 {len(fields)} {nw} 0 0 0")
-    pad = fields + [0.0] * (12 - len(fields))
-    out.append("XFLN " + " ".join("0" for _ in pad))
-    out.append("YFLN " + " ".join(_r(v) if v else "0" for v in pad))
+    out.append(f"FTYP {ftyp} 0 {len(points)} {nw} 0 0 0")
+    pad = points + [(0.0, 0.0)] * (12 - len(points))
+    out.append("XFLN " + " ".join(_r(x) if x else "0" for x, _ in pad))
+    out.append("YFLN " + " ".join(_r(y) if y else "0" for _, y in pad))
     out.append("FWGN " + " ".join("1" for _ in pad))
     for i, (w, wt) in enumerate(zip(lens.wavelengths, lens.weights, strict=True), start=1):
         out.append(f"WAVM {i} {nm_to_micron_text(w)} {_r(wt)}")
@@ -810,7 +987,34 @@ def dumps_zmx(lens: Lens) -> str:
     g = _glas(lens.object_material)
     if g:
         out.append("  " + g)
+    k = 0  # the last SURF number written
+
+    def surf() -> int:
+        nonlocal k
+        k += 1
+        out.append(f"SURF {k}")
+        return k
+
+    def coordbrk(p: Placement, thickness: float) -> None:
+        surf()
+        out.append("  TYPE COORDBRK")
+        out.append('  CURV 0.0 0 0.0 0.0 0')
+        order = 0 if p.order == "decenter-tilt" else 1
+        vals = (p.decenter[0], p.decenter[1], *p.tilt, order)
+        for j, v in enumerate(vals, start=1):
+            out.append(f"  PARM {j} {_r(v) if v else '0'}")
+        out.append(f"  DISZ {_r(thickness)}")
+        if p.decenter[2]:
+            raise PrescriptionError(
+                "a decenter along z cannot be written to .zmx (a coordinate break has x and y "
+                "only); write the lens as .toml instead",
+                surface=k,
+            )
+
     for i, s in enumerate(lens.surfaces, start=1):
+        if s.coordinate_break:
+            coordbrk(s.placement or Placement(), s.thickness)
+            continue
         asph = list(s.aspheric)
         while asph and asph[-1] == 0.0:
             asph.pop()
@@ -820,18 +1024,31 @@ def dumps_zmx(lens: Lens) -> str:
                 "EVENASPH surface holds A4 to A16 (7 terms)",
                 surface=i,
             )
-        out.append(f"SURF {i}")
+        before, after_cb, after_tab = _tab_moves(s)
+        if before is not None and not _tab_ok(before):
+            coordbrk(before, 0.0)
+            before = None
+        surf()
         out.append(f"  TYPE {'EVENASPH' if asph else 'STANDARD'}")
         if s.label:
             out.append(f"  COMM {_one_line(s.label)}")
         out.append(f'  CURV {_r(s.curvature)} 0 0 0 0 ""')
         if s.stop:
             out.append("  STOP")
-        out.append(f"  DISZ {_r(s.thickness)}")
-        g = _glas(s.material)
-        if g:
-            out.append("  " + g)
-        if math.isfinite(s.semi_diameter):
+        if before is not None:
+            out.append("  " + _scbd(1, before))
+        if after_tab is not None:
+            out.append("  " + _scbd(2, after_tab))
+        out.append(f"  DISZ {_r(0.0 if after_cb is not None else s.thickness)}")
+        if s.mirror:
+            out.append("  GLAS MIRROR 0 0 1.5 40 0 0 0 0 0 0")
+        else:
+            g = _glas(s.material)
+            if g:
+                out.append("  " + g)
+        if s.stop and ap.kind == "float":
+            out.append(f'  DIAM {_r(ap.value)} 1 0 0 1 ""')
+        elif math.isfinite(s.semi_diameter):
             out.append(f'  DIAM {_r(s.semi_diameter)} 1 0 0 1 ""')
         else:
             out.append('  DIAM 0 0 0 0 1 ""')
@@ -841,9 +1058,67 @@ def dumps_zmx(lens: Lens) -> str:
             out.append("  PARM 1 0")
             for j in range(2, 9):
                 out.append(f"  PARM {j} {_r(asph[j - 2]) if j - 2 < len(asph) else '0'}")
-    n = len(lens.surfaces) + 1
-    out += [f"SURF {n}", "  TYPE STANDARD", '  CURV 0.0 0 0 0 0 ""', "  DISZ 0", ""]
+        a = s.aperture
+        if a is not None:
+            if a.shape == "circle":
+                out.append(f"  CLAP 0 {_r(a.half_x)} 0")
+            else:
+                key = "SQAP" if a.shape == "rectangle" else "ELAP"
+                out.append(f"  {key} {_r(a.half_x)} {_r(a.half_y)} 0")
+            if a.x0 or a.y0:
+                out.append(f"  OBDC {_r(a.x0)} {_r(a.y0)}")
+        if after_cb is not None:
+            coordbrk(after_cb, s.thickness)
+    ip = lens.image_placement
+    if ip is not None and not _tab_ok(ip):
+        coordbrk(ip, 0.0)
+        ip = None
+    surf()
+    out += ["  TYPE STANDARD", '  CURV 0.0 0 0 0 0 ""']
+    if ip is not None:
+        out.append("  " + _scbd(1, ip))
+    out += ["  DISZ 0", ""]
     return "\r\n".join(out)
+
+
+def _moves_commute(p: Placement) -> bool:
+    """True when the order of the placement's moves does not matter (at most one of: a decenter,
+    a tilt about x, about y, about z)."""
+    n = sum(v != 0.0 for v in p.tilt) + (any(v != 0.0 for v in p.decenter[:2]))
+    return n <= 1 and p.decenter[2] == 0.0
+
+
+def _tab_ok(p: Placement) -> bool:
+    """True when the Tilt/Decenter tab (``SCBD``, order flag 0 as OpticStudio writes it) holds
+    ``p`` exactly: no z decenter, and the order is decenter-then-tilt or does not matter."""
+    return p.decenter[2] == 0.0 and (p.order == "decenter-tilt" or _moves_commute(p))
+
+
+def _scbd(which: int, p: Placement) -> str:
+    """``SCBD 1|2 0 0 dx dy tx ty tz`` (before / after the surface, order flag 0, explicit)."""
+    vals = (p.decenter[0], p.decenter[1], *p.tilt)
+    return f"SCBD {which} 0 0 " + " ".join(_r(v) if v else "0" for v in vals)
+
+
+def _tab_moves(s: Surface) -> tuple[Placement | None, Placement | None, Placement | None]:
+    """(before, after as a coordinate break, after in the tab) of a traced surface: the moves
+    the .zmx writer needs (``after`` modes turned into explicit moves)."""
+    p = s.placement
+    a = s.after
+    after: Placement | None
+    if isinstance(a, Placement):
+        after = a
+    elif a == "return":
+        after = p.inverse() if p is not None else None
+    elif a == "bend":
+        after = Placement((0.0, 0.0, 0.0), p.tilt, p.order) if p is not None else None
+    else:
+        after = None
+    if after is None:
+        return p, None, None
+    if _tab_ok(after):
+        return p, None, after
+    return p, after, None
 
 
 def write_zmx(lens: Lens, path: str | Path, *, encoding: str = "utf-16", **options) -> None:

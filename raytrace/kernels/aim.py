@@ -1,6 +1,14 @@
 """Chief-ray aiming in one kernel call: for every field, the meridional real ray through the
 centre of the stop (height zero at the stop surface), by field continuation and a safeguarded
 secant solve (Pestrecov 1958, Fig. 1: the principal ray through the centre of the real stop).
+
+The stop height is measured in the stop surface's own frame (:mod:`raytrace.frames`), so a
+decentered or tilted stop is aimed at its centre. A rotationally symmetric lens (lens flag
+``L_SYMMETRIC``) aims |field| and mirrors negative fields, with the zero field on the axis; any
+other lens aims each signed field by continuation from the zero field, which is solved too. A
+meridional ray can only reach the stop centre of a lens symmetric about the y-z plane (decenters
+in y, tilts about x): where the aimed ray meets the stop off the y axis by more than the
+tolerance, the field is AIM_FAILED (use the 2-D aim of :mod:`.aim2d`).
 """
 
 from __future__ import annotations
@@ -9,7 +17,7 @@ import math
 
 import numpy as np
 
-from .codes import STATUS_AIM_FAILED, STATUS_OK
+from .codes import G_LENS, L_SYMMETRIC, STATUS_AIM_FAILED, STATUS_OK
 from .jit import kernel
 from .surface import trace_span
 
@@ -33,35 +41,35 @@ def _start_ray(finite, z_obj, f, u):
 
 
 @kernel(error_model="numpy")
-def _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u):
+def _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u):
     """Meridional height at the stop surface of the ray (f, u) (unclipped); (status, y)."""
     y0, z0, M0, N0 = _start_ray(finite, z_obj, f, u)
     st, sf, x, y, z, L, M, N = trace_span(
-        kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, False, 0.0, y0, z0, 0.0, M0, N0
+        kind, c, k, asph, geo, n_in, n_out, sd, 0, stop + 1, False, 0.0, y0, z0, 0.0, M0, N0
     )
     return st, y
 
 
 @kernel(error_model="numpy")
-def _solve_field(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u0, tol, hscale):
+def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0, tol, hscale):
     """Safeguarded secant solve of y_stop(u) = 0 from the guess u0.
 
     Returns (converged, u, residual, evaluations). A sign change between two traceable points
     keeps a bracket; secant steps outside it are replaced by bisection; an untraceable trial
     point is pulled halfway back toward the last good point (up to 20 times)."""
     nev = 1
-    st, r0 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u0)
+    st, r0 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0)
     if st != STATUS_OK or not math.isfinite(r0):
         return False, u0, np.nan, nev
     if abs(r0) <= tol:
         return True, u0, r0, nev
     h = 1e-7 * max(abs(u0), hscale)
     u1 = u0 + h
-    st, r1 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+    st, r1 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u1)
     nev += 1
     if st != STATUS_OK:
         u1 = u0 - h
-        st, r1 = _stop_residual(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+        st, r1 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u1)
         nev += 1
         if st != STATUS_OK:
             return False, u0, r0, nev
@@ -93,7 +101,7 @@ def _solve_field(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, 
         rn = 0.0
         for _k in range(20):
             st, rn = _stop_residual(
-                kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f, un
+                kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, un
             )
             nev += 1
             if st == STATUS_OK and math.isfinite(rn):
@@ -131,7 +139,7 @@ def aim_chief(lens, stop, finite, z_obj, fields, slope0, tol, hscale, clip, star
     """Aim the meridional chief ray (through the stop vertex) for every wavelength × field; one
     call.
 
-    lens: the tuple :attr:`raytrace.packing.PackedLens.lens_arrays` — kind, c, k, asph, zv,
+    lens: the tuple :attr:`raytrace.packing.PackedLens.lens_arrays` — kind, c, k, asph, geo,
     n_in_w, n_out_w, sd, with the indices as (n_wavelengths, n_surfaces) arrays (row i =
     wavelength i). fields: field values (α in rad for ``finite == 0``; object height in mm for
     ``finite == 1``), the same for every wavelength, any order and sign (negative fields are
@@ -144,15 +152,15 @@ def aim_chief(lens, stop, finite, z_obj, fields, slope0, tol, hscale, clip, star
     ``status`` int8, ``surface`` int32, ``evals`` int32 and ``residual`` float64, each
     (n_wavelengths, n).
     """
-    kind, c, k, asph, zv, n_in_w, n_out_w, sd = lens
+    kind, c, k, asph, geo, n_in_w, n_out_w, sd = lens
     for iw in range(n_in_w.shape[0]):
-        _aim_fields(kind, c, k, asph, zv, n_in_w[iw], n_out_w[iw], sd, stop, finite, z_obj, fields,
+        _aim_fields(kind, c, k, asph, geo, n_in_w[iw], n_out_w[iw], sd, stop, finite, z_obj, fields,
                     slope0[iw], tol[iw], hscale[iw], clip, start[iw], last[iw], status[iw],
                     surface[iw], evals[iw], residual[iw])  # fmt: skip
 
 
 @kernel(error_model="numpy")
-def _aim_fields(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
+def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
                 hscale, clip, start, last, status, surface, evals, residual):  # fmt: skip
     """Aim the meridional chief ray (through the stop vertex) for every field at one wavelength
     (indices ``n_in``, ``n_out``).
@@ -175,49 +183,72 @@ def _aim_fields(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fiel
     """
     n = fields.shape[0]
     ns = c.shape[0]
+    symmetric = (int(geo[0, G_LENS]) & L_SYMMETRIC) != 0
     order = np.argsort(np.abs(fields))
-    # continuation state: last solved field (fb, ub) and the secant slope du/df there
-    fb = 0.0
-    ub = 0.0
-    slope = slope0
+    # continuation state per side (0: f >= 0, 1: f < 0; a symmetric lens uses side 0 for |f|):
+    # last solved field fb, its solution ub and the secant slope du/df there
+    fb = np.zeros(2)
+    ub = np.zeros(2)
+    slope = np.array([slope0, slope0])
+    ok0 = True
+    u0 = 0.0
+    r0 = 0.0
+    ne0 = 0
+    if not symmetric:  # the zero field is not on the axis: solve it first
+        ok0, u0, r0, ne0 = _solve_field(
+            kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, 0.0, 0.0, tol, hscale
+        )
+        ub[0] = u0
+        ub[1] = u0
     for ii in range(n):
         i = order[ii]
-        ftarget = abs(fields[i])
-        sign = 1.0 if fields[i] >= 0.0 else -1.0
+        if symmetric:
+            ftarget = abs(fields[i])
+            sign = 1.0 if fields[i] >= 0.0 else -1.0
+            side = 0
+        else:
+            ftarget = fields[i]
+            sign = 1.0
+            side = 0 if fields[i] >= 0.0 else 1
         nev = 0
         conv = False
         u = 0.0
         res = 0.0
         if ftarget == 0.0:
-            conv = True
-            u = 0.0
-            res = 0.0
+            conv = ok0
+            u = u0
+            res = r0
+            nev = ne0
+        elif not ok0:
+            conv = False
         else:
-            fcur = fb
-            ucur = ub
+            fcur = fb[side]
+            ucur = ub[side]
             step = ftarget - fcur
             halvings = 0
             while True:
                 ftry = fcur + step
                 if step == ftarget - fcur:
                     ftry = ftarget
-                guess = ucur + slope * (ftry - fcur)
+                guess = ucur + slope[side] * (ftry - fcur)
                 ok, usol, rsol, ne = _solve_field(
-                    kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, ftry, guess, tol,
+                    kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, ftry, guess, tol,
                     hscale,
                 )  # fmt: skip
                 nev += ne
                 if ok:
                     if ftry != fcur:
-                        slope = (usol - ucur) / (ftry - fcur)
+                        slope[side] = (usol - ucur) / (ftry - fcur)
                     fcur, ucur = ftry, usol
-                    fb, ub = fcur, ucur
+                    fb[side], ub[side] = fcur, ucur
                     if ftry == ftarget:
                         conv = True
                         u = usol
                         res = rsol
                         break
-                    step = min(2.0 * step, ftarget - fcur)
+                    step = 2.0 * step
+                    if abs(step) > abs(ftarget - fcur):
+                        step = ftarget - fcur
                 else:
                     halvings += 1
                     if halvings > AIM_MAX_HALVINGS or nev > AIM_MAX_EVALS:
@@ -225,12 +256,29 @@ def _aim_fields(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fiel
                         res = rsol
                         break
                     step *= 0.5
-        y0, z0, M0, N0 = _start_ray(finite, z_obj, ftarget, u)
+        y0, z0, M0, N0 = _start_ray(finite, z_obj, abs(ftarget) if symmetric else ftarget, u)
         start[0, i] = sign * y0
         start[1, i] = z0
         start[2, i] = sign * M0
         start[3, i] = N0
         evals[i] = nev
+        st = STATUS_OK
+        sf = 0
+        x = 0.0
+        y = 0.0
+        z = 0.0
+        L = 0.0
+        M = 0.0
+        N = 0.0
+        ystop = 0.0
+        if conv:
+            st, sf, x, y, z, L, M, N = trace_span(
+                kind, c, k, asph, geo, n_in, n_out, sd, 0, stop + 1, clip, 0.0, y0, z0, 0.0, M0,
+                N0,
+            )  # fmt: skip
+            ystop = y
+            if st == STATUS_OK and not (abs(x) <= tol):
+                conv = False  # the stop centre is off the meridional plane: not reachable
         if not conv:
             start[0, i] = np.nan
             start[2, i] = np.nan
@@ -241,13 +289,9 @@ def _aim_fields(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fiel
             surface[i] = 0
             residual[i] = np.nan
             continue
-        st, sf, x, y, z, L, M, N = trace_span(
-            kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, clip, 0.0, y0, z0, 0.0, M0, N0
-        )
-        ystop = y
         if st == STATUS_OK:
             st, sf, x, y, z, L, M, N = trace_span(
-                kind, c, k, asph, zv, n_in, n_out, sd, stop + 1, ns, clip, x, y, z, L, M, N
+                kind, c, k, asph, geo, n_in, n_out, sd, stop + 1, ns, clip, x, y, z, L, M, N
             )
         status[i] = st
         surface[i] = sf
@@ -261,4 +305,3 @@ def _aim_fields(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, fiel
             for r in range(4):
                 last[r, i] = np.nan
             residual[i] = sign * res
-

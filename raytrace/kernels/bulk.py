@@ -5,6 +5,11 @@ prange kernels, and the analytic transfer of final segments to a plane (DESIGN: 
 Every plane / quadric surface is one branch-free, vectorised pass over the rays of a block; even
 aspheres use vectorised Newton passes. Status and failed surface are kept per ray (see
 :mod:`.codes`).
+
+A surface with any flag in the placement table (a moved frame, a mirror, a clear aperture, a
+coordinate break, rays toward −z: :mod:`.surface`) is traced ray by ray with the scalar
+:func:`.surface.surface_step` (:func:`_general_rows`); a centred refracting lens has no flags and
+runs only the vectorised passes.
 """
 
 from __future__ import annotations
@@ -14,9 +19,19 @@ import math
 import numpy as np
 from numba import prange
 
-from .codes import KIND_ASPHERE, STATUS_CLIPPED, STATUS_MISSED, STATUS_TIR
+from .codes import (
+    F_FRAME,
+    F_SKIP,
+    G_FLAGS,
+    G_ZV,
+    KIND_ASPHERE,
+    STATUS_CLIPPED,
+    STATUS_MISSED,
+    STATUS_OK,
+    STATUS_TIR,
+)
 from .jit import kernel
-from .surface import NEWTON_MAX, NEWTON_TOL, quadric_root, snell
+from .surface import NEWTON_MAX, NEWTON_TOL, quadric_root, reframe, snell, surface_step
 
 BLOCK = 256
 #: Blocks per parallel work item (one scratch buffer per item): 16 x 256 = 4096 rays.
@@ -222,14 +237,49 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1):
         buf[_RF + i] = jp1 if fresh else buf[_RF + i]
 
 
+@kernel(error_model="numpy")
+def _general_rows(buf, nb, kind, c, k, asph, geo, j, mu, sdj, clip):
+    """Surface j (flagged in the placement table) for the nb rays of the scratch buffer, one ray
+    at a time with :func:`.surface.surface_step` (frame move, mirror, aperture, rays toward −z).
+    Rays that failed before are left as they are."""
+    fl = int(geo[j, G_FLAGS])
+    jp1 = float(j + 1)
+    for i in range(nb):
+        if buf[_RS + i] != 0.0:
+            continue
+        x = buf[_RX + i]
+        y = buf[_RY + i]
+        z = buf[_RZ + i]
+        L = buf[_RL + i]
+        M = buf[_RM + i]
+        N = buf[_RN + i]
+        if (fl & F_FRAME) != 0:
+            x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
+        st = STATUS_OK
+        if (fl & F_SKIP) == 0:
+            st, x, y, z, L, M, N = surface_step(
+                kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N
+            )
+        buf[_RX + i] = x
+        buf[_RY + i] = y
+        buf[_RZ + i] = z
+        buf[_RL + i] = L
+        buf[_RM + i] = M
+        buf[_RN + i] = N
+        if st != STATUS_OK:
+            buf[_RS + i] = float(st)
+            buf[_RF + i] = jp1
+
+
 @kernel(error_model="numpy", inline="always")
-def _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, i1, x, y, z, L, M, N,
+def _trace_block(kind, c, k, asph, geo, n_in, n_out, sd, clip, i0, i1, x, y, z, L, M, N,
                  ox, oy, oz, oL, oM, oN, ost, osf, buf):  # fmt: skip
     """Trace rays i0..i1-1 (i1 - i0 <= BLOCK) surface by surface in the scratch buffer ``buf``
     (NROWS * BLOCK float64, rows ``_RX`` ... ``_RDP``), then write them to the output arrays.
 
     Plane / quadric surfaces run the vectorised branch-free loop :func:`_quadric_rows`, even
-    aspheres the vectorised Newton passes of :func:`_asphere_rows`."""
+    aspheres the vectorised Newton passes of :func:`_asphere_rows`, flagged surfaces (placement
+    table) :func:`_general_rows`."""
     nb = i1 - i0
     for i in range(nb):
         ii = i0 + i
@@ -245,15 +295,19 @@ def _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, i1, x, y, z, L
         buf[_RF + i] = 0.0 if good else 1.0
     for j in range(c.shape[0]):
         mu = n_in[j] / n_out[j]
+        if geo[j, G_FLAGS] != 0.0:
+            _general_rows(buf, nb, kind[j], c[j], k[j], asph, geo, j, mu, sd[j], clip)
+            continue
+        zvj = geo[j, G_ZV]
         if kind[j] == KIND_ASPHERE:
             sd2 = sd[j] * sd[j] if clip else np.inf
-            _asphere_rows(buf, nb, c[j], k[j], asph, j, zv[j], sd2, mu, float(j + 1))
+            _asphere_rows(buf, nb, c[j], k[j], asph, j, zvj, sd2, mu, float(j + 1))
             continue
         sd2 = sd[j] * sd[j] if clip else np.inf
         if k[j] == 0.0:
-            _quadric_rows(buf, nb, c[j], 0.0, zv[j], sd2, mu, float(j + 1), True)
+            _quadric_rows(buf, nb, c[j], 0.0, zvj, sd2, mu, float(j + 1), True)
         else:
-            _quadric_rows(buf, nb, c[j], k[j], zv[j], sd2, mu, float(j + 1), False)
+            _quadric_rows(buf, nb, c[j], k[j], zvj, sd2, mu, float(j + 1), False)
     for i in range(nb):
         ii = i0 + i
         s = buf[_RS + i]
@@ -270,7 +324,7 @@ def _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, i1, x, y, z, L
 
 @kernel(error_model="numpy", fastmath={"contract"})
 def trace_batch_serial(
-    kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
+    kind, c, k, asph, geo, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
 ):
     """Bulk trace, one thread. Inputs/outputs are 1-D arrays of equal length (structure of
     arrays); outputs hold the final segment (point on the last surface, direction after it),
@@ -280,13 +334,13 @@ def trace_batch_serial(
     buf = np.empty(NROWS * BLOCK)
     for b in range((n + BLOCK - 1) // BLOCK):
         i0 = b * BLOCK
-        _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
+        _trace_block(kind, c, k, asph, geo, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
                      x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf, buf)  # fmt: skip
 
 
 @kernel(error_model="numpy", parallel=True, fastmath={"contract"})
 def trace_batch_parallel(
-    kind, c, k, asph, zv, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
+    kind, c, k, asph, geo, n_in, n_out, sd, clip, x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf
 ):
     """Same as :func:`trace_batch_serial`; chunks of ``CHUNK_BLOCKS`` blocks are split over
     numba's threads (prange), each with its own scratch buffer."""
@@ -297,7 +351,7 @@ def trace_batch_parallel(
         buf = np.empty(NROWS * BLOCK)
         for b in range(ch * CHUNK_BLOCKS, min(ch * CHUNK_BLOCKS + CHUNK_BLOCKS, nblk)):
             i0 = b * BLOCK
-            _trace_block(kind, c, k, asph, zv, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
+            _trace_block(kind, c, k, asph, geo, n_in, n_out, sd, clip, i0, min(i0 + BLOCK, n),
                          x, y, z, L, M, N, ox, oy, oz, oL, oM, oN, ost, osf, buf)  # fmt: skip
 
 

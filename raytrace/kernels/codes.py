@@ -28,3 +28,23 @@ STATUS_NAMES = {
 KIND_PLANE = 0
 KIND_QUADRIC = 1
 KIND_ASPHERE = 2
+
+# ---- per-surface placement table ``geo`` (:func:`raytrace.packing.pack`, float64, one row per
+# packed surface, NGEO columns; :mod:`raytrace.frames` for the frames). Column offsets:
+G_ZV = 0  #: nominal vertex z (mm): the vertex is at (0, 0, zv) in the surface's axis frame
+G_FLAGS = 1  #: surface flags (F_* below, as a float)
+G_REL = 2  #: 9 values: M (row-major) of p_j = M p_prev + t, from the previous traced axis frame
+G_RELT = 11  #: 3 values: t
+G_ABS = 14  #: 9 values: rotation of the axis frame in global coordinates (row-major)
+G_ABST = 23  #: 3 values: origin of the axis frame in global coordinates
+G_AP = 26  #: 5 values: clear-aperture shape code (1 circle, 2 rectangle, 3 ellipse), hx, hy, x0, y0
+G_LENS = 31  #: lens flags (L_* below), row 0 only
+NGEO = 32
+
+F_FRAME = 1  #: transform the ray into this surface's axis frame first
+F_MIRROR = 2  #: reflect instead of refracting
+F_SKIP = 4  #: not traced (a coordinate break, or the image-frame pseudo-surface at the end)
+F_APERTURE = 8  #: clip with the clear aperture of columns G_AP..G_AP+4 too
+F_GENERAL = 16  #: rays may meet the surface travelling toward -z (mirrors, tilts)
+
+L_SYMMETRIC = 1  #: rotationally symmetric lens: a negative meridional field mirrors a positive one

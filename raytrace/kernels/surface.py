@@ -6,7 +6,25 @@ layer in :mod:`raytrace.trace` owns objects, validation and errors.
 
 Geometry (docs/design.md, "Conventions"): millimetres, light toward +z, first vertex at z = 0. A ray is a point
 (x, y, z) and unit direction cosines (L, M, N). The lens arrays are those of
-:class:`raytrace.lens.PackedLens`: ``kind, c, k, asph, zv, n_in, n_out, sd``.
+:class:`raytrace.packing.PackedLens`: ``kind, c, k, asph, geo, n_in, n_out, sd``, where ``geo`` is
+the placement table (:mod:`.codes`, column ``G_ZV`` the vertex z).
+
+Frames (:mod:`raytrace.frames`)
+    A ray is carried in the *axis frame* of the surface it last met (the global frame before the
+    first surface): the vertex of surface j is at (0, 0, zv_j) of its axis frame and its axis is
+    the z axis, so the coaxial code below works in it unchanged. Before a surface flagged
+    ``F_FRAME`` the ray is moved into that surface's axis frame (``p' = M p + t``, ``d' = M d``,
+    :func:`reframe`); for a centred lens no surface is flagged and nothing is moved. Surfaces
+    flagged ``F_SKIP`` (coordinate breaks, the image-frame pseudo-surface) are not traced. The
+    final segment is therefore in the image frame, where image planes are z = const.
+
+Mirrors (``F_MIRROR``): ``d' = d − 2 (d·n̂) n̂`` (either orientation of n̂), direction cosines in
+the physical sense (after a mirror N < 0 on the axis, as the negative thicknesses of Zemax and
+CODE V say). Surfaces flagged ``F_GENERAL`` accept rays travelling toward −z of their axis frame:
+the vertex-plane transfer and the quadric root use the direction's sign
+``σ = sign(N)`` (``s = σ C / (σ B + sqrt(B² − A C))``, the root continuous with the vertex for
+either direction); N = 0 → MISSED. Without the flag (a centred refracting lens) a ray with
+N <= 0 is MISSED, as before.
 
 Intersection (cancellation-free curvature form)
     The ray is first transferred to the vertex tangent plane of the surface (local z = 0) at
@@ -27,8 +45,11 @@ Refraction (vector Snell)
     normal (−c x, −c y, 1 − c z) is unit without normalisation): the direction cosines stay unit
     length to <= 2e-15 over 11 surfaces.
 
-Status codes: OK 0, MISSED 1, TIR 2, CLIPPED 3 (outside the semi-diameter, when clipping is on),
-AIM_FAILED 4. A failed ray carries the 1-based number of the surface where it failed and NaN
+Clear apertures (``F_APERTURE``, clipping on): circle / rectangle / ellipse of half-widths
+(hx, hy) about (x0, y0) in the surface frame, besides the semi-diameter about the vertex.
+
+Status codes: OK 0, MISSED 1, TIR 2, CLIPPED 3 (outside the semi-diameter or clear aperture, when
+clipping is on), AIM_FAILED 4. A failed ray carries the 1-based number of the surface where it failed and NaN
 coordinates; every ray gets a status.
 """
 
@@ -38,6 +59,16 @@ from __future__ import annotations
 import math
 
 from .codes import (
+    F_APERTURE,
+    F_FRAME,
+    F_GENERAL,
+    F_MIRROR,
+    F_SKIP,
+    G_AP,
+    G_FLAGS,
+    G_REL,
+    G_RELT,
+    G_ZV,
     KIND_PLANE,
     KIND_QUADRIC,
     STATUS_CLIPPED,
@@ -97,11 +128,51 @@ def quadric_root(c, k, x, y, L, M, N):
 
 
 @kernel(error_model="numpy", inline="always")
-def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
-    """Intersect one surface and refract. Returns (status, x, y, z, L, M, N) with the point on the
-    surface (global z) and the direction after it; status != 0 leaves the values meaningless."""
-    if not (N > 0.0):
+def reframe(geo, j, x, y, z, L, M, N):
+    """The ray (x, y, z, L, M, N) moved into surface j's axis frame: p' = M p + t, d' = M d with
+    M = geo[j, G_REL:G_REL + 9] (row-major) and t = geo[j, G_RELT:G_RELT + 3]."""
+    m0 = geo[j, G_REL]
+    m1 = geo[j, G_REL + 1]
+    m2 = geo[j, G_REL + 2]
+    m3 = geo[j, G_REL + 3]
+    m4 = geo[j, G_REL + 4]
+    m5 = geo[j, G_REL + 5]
+    m6 = geo[j, G_REL + 6]
+    m7 = geo[j, G_REL + 7]
+    m8 = geo[j, G_REL + 8]
+    xn = m0 * x + m1 * y + m2 * z + geo[j, G_RELT]
+    yn = m3 * x + m4 * y + m5 * z + geo[j, G_RELT + 1]
+    zn = m6 * x + m7 * y + m8 * z + geo[j, G_RELT + 2]
+    Ln = m0 * L + m1 * M + m2 * N
+    Mn = m3 * L + m4 * M + m5 * N
+    Nn = m6 * L + m7 * M + m8 * N
+    return xn, yn, zn, Ln, Mn, Nn
+
+
+@kernel(error_model="numpy", inline="always")
+def outside_aperture(geo, j, x, y):
+    """True when (x, y) (surface frame) lies outside surface j's clear aperture."""
+    shape = geo[j, G_AP]
+    u = (x - geo[j, G_AP + 3]) / geo[j, G_AP + 1]
+    v = (y - geo[j, G_AP + 4]) / geo[j, G_AP + 2]
+    if shape == 2.0:
+        return abs(u) > 1.0 or abs(v) > 1.0
+    return u * u + v * v > 1.0
+
+
+@kernel(error_model="numpy", inline="always")
+def surface_step(kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N):
+    """Intersect surface j and refract (or reflect). The ray is in surface j's axis frame
+    (module docstring). Returns (status, x, y, z, L, M, N) with the point on the surface (axis
+    frame) and the direction after it; status != 0 leaves the values meaningless."""
+    fl = int(geo[j, G_FLAGS])
+    zvj = geo[j, G_ZV]
+    if (fl & F_GENERAL) != 0:
+        if N == 0.0 or not math.isfinite(N):
+            return STATUS_MISSED, x, y, z, L, M, N
+    elif not (N > 0.0):
         return STATUS_MISSED, x, y, z, L, M, N
+    sg = 1.0 if N > 0.0 else -1.0
     t0 = (zvj - z) / N
     x = x + t0 * L
     y = y + t0 * M
@@ -110,7 +181,8 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
     ny = 0.0
     nz = 1.0
     if kind != KIND_PLANE:
-        s, have = quadric_root(c, k, x, y, L, M, N)
+        s, have = quadric_root(c, k, x, y, sg * L, sg * M, sg * N)
+        s *= sg
         if not have:
             s = 0.0
         if kind == KIND_QUADRIC:
@@ -153,9 +225,25 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
             ny = -2.0 * y * dsag
             nz = 1.0
     z = zvj + zl
-    if clip and x * x + y * y > sdj * sdj:
-        return STATUS_CLIPPED, x, y, z, L, M, N
-    if mu != 1.0:
+    if clip:
+        if x * x + y * y > sdj * sdj:
+            return STATUS_CLIPPED, x, y, z, L, M, N
+        if (fl & F_APERTURE) != 0 and outside_aperture(geo, j, x, y):
+            return STATUS_CLIPPED, x, y, z, L, M, N
+    if (fl & F_MIRROR) != 0:
+        inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+        nx *= inv
+        ny *= inv
+        nz *= inv
+        g = 2.0 * (L * nx + M * ny + N * nz)
+        L = L - g * nx
+        M = M - g * ny
+        N = N - g * nz
+        inv = 1.0 / math.sqrt(L * L + M * M + N * N)
+        L *= inv
+        M *= inv
+        N *= inv
+    elif mu != 1.0:
         inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
         nx *= inv
         ny *= inv
@@ -172,13 +260,19 @@ def surface_step(kind, c, k, asph, j, zvj, mu, sdj, clip, x, y, z, L, M, N):
 
 
 @kernel(error_model="numpy", inline="always")
-def trace_span(kind, c, k, asph, zv, n_in, n_out, sd, j0, j1, clip, x, y, z, L, M, N):
-    """Trace surfaces j0 .. j1-1 (0-based). Returns (status, surface_1based, x, y, z, L, M, N)."""
+def trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L, M, N):
+    """Trace surfaces j0 .. j1-1 (0-based) of the packed lens; the ray comes in the axis frame of
+    the last traced surface before j0 (global for j0 = 0) and leaves in that of the last one
+    traced (for j1 = n: the image frame). Returns (status, surface_1based, x, y, z, L, M, N)."""
     for j in range(j0, j1):
+        fl = int(geo[j, G_FLAGS])
+        if (fl & F_FRAME) != 0:
+            x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
+        if (fl & F_SKIP) != 0:
+            continue
         st, x, y, z, L, M, N = surface_step(
-            kind[j], c[j], k[j], asph, j, zv[j], n_in[j] / n_out[j], sd[j], clip, x, y, z, L, M, N
+            kind[j], c[j], k[j], asph, geo, j, n_in[j] / n_out[j], sd[j], clip, x, y, z, L, M, N
         )
         if st != STATUS_OK:
             return st, j + 1, x, y, z, L, M, N
     return STATUS_OK, 0, x, y, z, L, M, N
-

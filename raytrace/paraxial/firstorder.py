@@ -15,7 +15,17 @@ system matrix and two rays; the chief ray is the paraxial ray through the centre
 Pestrecov's Eq. (6), ``m_e = lim tan α / tan α'`` (object- over image-space slope of the
 paraxial chief ray), and Eq. (5), the Gaussian magnification, are computed here; the constants of
 orthoscopy in any image plane (Eqs. 7–8) are in :mod:`.orthoscopy`.
+
+Mirrors (centred mirror systems: Cassegrain, Mangin, catadioptric lenses): the trace is the same
+y-nu trace with the index after a mirror taken as ``n' = −n`` and every index after an odd number
+of mirrors negative (the convention of Zemax and CODE V, whose thicknesses are then negative:
+``y₂ = y₁ + t u'`` with u' = n'u'/n' keeps working, and positions stay absolute z along the
+axis). So ``n_image`` is negative after an odd number of mirrors; a concave mirror (R < 0 facing
+the light) has a positive focal length. A lens that is not centred (decenters, tilts, folds:
+``Lens.is_centred``) has no first-order data here: :func:`paraxial` refuses it in one line, and
+``lens.nominal()`` gives the centred lens without its moves.
 """
+
 
 from __future__ import annotations
 
@@ -134,12 +144,30 @@ def _shift(origin: float, d: float | np.ndarray) -> float | np.ndarray:
 
 
 def _system(lens: Lens, wavelength: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Curvatures, thicknesses (between vertices), indices before and after each surface."""
+    """Curvatures, thicknesses (between vertices), indices before and after each surface; after
+    an odd number of mirrors the indices are negative (n' = −n at a mirror; module docstring)."""
     ss = lens.surfaces
     c = np.array([s.curvature for s in ss], dtype=float)
     t = np.array([s.thickness for s in ss[:-1]], dtype=float)
-    idx = lens.indices(wavelength)[0]  # object space, then after each surface
+    idx = np.array(lens.indices(wavelength)[0])  # object space, then after each surface
+    if lens.has_mirrors:
+        sign = np.cumprod([-1.0 if s.mirror else 1.0 for s in ss])
+        idx[1:] *= sign
     return c, t, idx[:-1], idx[1:]
+
+
+def require_centred(lens: Lens) -> None:
+    """Raise :class:`LensError` (one line, naming the surface and the fix) unless ``lens`` is
+    centred: first-order optics need a common axis."""
+    j = lens.first_placed()
+    if j is None:
+        return
+    where = "the image surface" if j == 0 else f"surface {j}"
+    raise LensError(
+        f"{lens.name}: {where} is decentered or tilted: first-order (paraxial) data need a "
+        "centred lens; use lens.nominal() for the data of the lens without its decenters and "
+        "tilts, or real rays (chief_rays_2d) for the lens as it is"
+    )
 
 
 def _trace(
@@ -178,15 +206,22 @@ def _entrance_pupil(c, t, n_in, n_out, stop: int) -> tuple[float, float, float]:
     return float(a), float(b), z_E0
 
 
-def entrance_pupil_diameter(lens: Lens, efl: float, n0: float, z_E0: float, z_obj: float) -> float:
+def entrance_pupil_diameter(
+    lens: Lens, efl: float, n0: float, z_E0: float, z_obj: float, *, system=None
+) -> float:
     """The paraxial entrance-pupil diameter the lens's aperture specification implies (mm) — the
-    one conversion in the project.
+    one conversion in the project (:class:`raytrace.lens.Aperture` lists the kinds).
 
     ``fnumber`` N: ``EPD = |EFL| / N`` (infinite-conjugate f-number); ``epd``: as given;
     ``na`` (object-space n sin U of the axial marginal ray): the marginal ray leaves the axial
     object point at the real angle ``U = asin(NA/n)`` toward the paraxial pupil edge,
     ``EPD = 2 |z_E0 − z_obj| tan(asin(NA/n))`` — optiland's convention
-    (``ObjectNAAperture.compute_epd``), checked against optiland in tests/test_paraxial.py.
+    (``ObjectNAAperture.compute_epd``), checked against optiland in tests/test_paraxial.py;
+    ``cone_angle`` U (degrees): the same with U given, ``EPD = 2 |z_E0 − z_obj| tan U``;
+    ``float`` (stop semi-diameter r): the paraxial marginal ray meets the stop at height r;
+    ``working_fnumber`` W: the paraxial marginal ray leaves the last surface with
+    ``|n' u'| = 1/(2 W)``. The last two are linear in the EPD and scale a unit trace;
+    ``system`` = ``(c, t, n_in, n_out)`` of :func:`_system` (default: at the lens's wavelength).
     """
     ap = lens.aperture
     if ap.kind == "fnumber":
@@ -195,12 +230,27 @@ def entrance_pupil_diameter(lens: Lens, efl: float, n0: float, z_E0: float, z_ob
         return abs(efl) / ap.value
     if ap.kind == "epd":
         return ap.value
-    if ap.value >= n0:
+    if ap.kind in ("float", "working_fnumber"):
+        c, t, n_in, n_out = system if system is not None else _system(lens, lens.wavelength)
+        y1, nu1 = _marginal_start(lens, 2.0, n0, z_E0, z_obj)  # EPD 2: unit pupil radius
+        if ap.kind == "float":
+            a, b, _ = _entrance_pupil(c, t, n_in, n_out, lens.stop_index)
+            h = abs(a * y1 + b * nu1)
+            if not h > 0.0:
+                raise LensError(f"{lens.name}: float by stop size: the stop is at an image")
+            return 2.0 * ap.value / h
+        _, nuk = _trace(c, t, n_in, n_out, y1, nu1, len(c))
+        if nuk == 0.0:
+            raise LensError(f"{lens.name}: a working F/# needs a lens that is not afocal")
+        return 2.0 * (1.0 / (2.0 * abs(nuk))) / ap.value
+    if ap.kind == "na" and ap.value >= n0:
         raise LensError(f"{lens.name}: NA {ap.value} must be below the object index {n0}")
     if math.isinf(z_obj):
         raise LensError(f"{lens.name}: an object-space NA needs a finite object distance")
     if math.isinf(z_E0):
         raise LensError(f"{lens.name}: entrance pupil at infinity with an object-space NA")
+    if ap.kind == "cone_angle":
+        return 2.0 * abs(z_E0 - z_obj) * math.tan(math.radians(ap.value))
     return 2.0 * abs(z_E0 - z_obj) * math.tan(math.asin(ap.value / n0))
 
 
@@ -221,8 +271,10 @@ def aim_geometry(
 ) -> tuple[float, float]:
     """(z_E0, stop radius) in mm for chief-ray aiming: the paraxial entrance pupil and the
     paraxial marginal-ray height at the stop. Unlike :func:`paraxial` it works for an afocal lens
-    whose aperture is not an f-number."""
+    whose aperture is not an f-number, and for a lens that is not centred it uses the centred
+    lens ``lens.nominal()`` (first guesses and the tolerance scale of the aim only)."""
     wl = lens.wavelength if wavelength is None else float(wavelength)
+    lens = lens.nominal()  # decentered/tilted: the centred lens gives the first guesses
     c, t, n_in, n_out = _system(lens, wl)
     a, b, z_E0 = _entrance_pupil(c, t, n_in, n_out, lens.stop_index)
     if a == 0.0:
@@ -232,7 +284,9 @@ def aim_geometry(
     if lens.aperture.kind == "fnumber":
         (_, _), (C, _) = _matrix(c, t, n_in, n_out, len(c))
         efl = -1.0 / C if C != 0.0 else math.inf
-    epd = entrance_pupil_diameter(lens, efl, float(n_in[0]), z_E0, z_obj)
+    epd = entrance_pupil_diameter(
+        lens, efl, float(n_in[0]), z_E0, z_obj, system=(c, t, n_in, n_out)
+    )
     ym1, num1 = _marginal_start(lens, epd, float(n_in[0]), z_E0, z_obj)
     return z_E0, abs(a * ym1 + b * num1)
 
@@ -245,11 +299,13 @@ def paraxial(
     object_distance: positive magnitude from the object plane to the first vertex, or ``inf``;
         defaults to the lens's. wavelength: nm, defaults to the lens's.
     Raises :class:`LensError` for an afocal lens, a stop the paraxial chief ray cannot locate
-    (pupil at infinity is allowed and reported as ±inf), or an object at a focal point.
+    (pupil at infinity is allowed and reported as ±inf), an object at a focal point, or a lens
+    that is not centred (:func:`require_centred`; mirrors on the axis are fine).
     """
     od = lens.object_distance if object_distance is None else float(object_distance)
     if not (od > 0.0):
         raise LensError(f"object distance must be a positive magnitude or inf, got {od}")
+    require_centred(lens)
     wl = lens.wavelength if wavelength is None else float(wavelength)
     c, t, n_in, n_out = _system(lens, wl)
     ns = len(c)
@@ -285,7 +341,7 @@ def paraxial(
     # Object plane and marginal ray.
     infinite = math.isinf(od)
     z_obj = -math.inf if infinite else -od
-    epd = entrance_pupil_diameter(lens, efl, n0, z_E0, z_obj)
+    epd = entrance_pupil_diameter(lens, efl, n0, z_E0, z_obj, system=(c, t, n_in, n_out))
     ym1, num1 = _marginal_start(lens, epd, n0, z_E0, z_obj)
     stop_radius = abs(a * ym1 + b * num1)
     ymk, numk = _trace(c, t, n_in, n_out, ym1, num1, ns)
@@ -294,7 +350,7 @@ def paraxial(
         xpd = math.inf
     else:
         xpd = 2.0 * abs(ymk + umk * (z_E0p - z_last))
-    working_f = math.inf if umk == 0.0 else 1.0 / (2.0 * nk * abs(umk))
+    working_f = math.inf if umk == 0.0 else 1.0 / (2.0 * abs(nk) * abs(umk))
 
     if infinite:
         s = -math.inf

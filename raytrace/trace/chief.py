@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,6 +33,10 @@ from ..lens import Lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
+
+
+class ApertureWarning(UserWarning):
+    """The stop is smaller than the aperture specification asks it to pass."""
 
 
 #: Fields per kernel call: a larger request is aimed in chunks (Ctrl-C stops between them).
@@ -63,6 +68,15 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
             raise TraceError(str(e)) from None
         z_E0[i] = z
         r_stop[i] = sd_stop if math.isfinite(sd_stop) else r_par
+        if math.isfinite(sd_stop) and r_par > sd_stop * (1.0 + 1e-9):
+            warnings.warn(
+                f"{lens.name}: the stop (surface {p.stop + 1}) has a semi-diameter of "
+                f"{sd_stop:g} mm but the aperture ({lens.aperture.kind} {lens.aperture.value:g}) "
+                f"asks it to pass {r_par:.6g} mm: the marginal rays are clipped at the stop — "
+                "enlarge the stop's semi-diameter or reduce the aperture",
+                ApertureWarning,
+                stacklevel=4,
+            )
     if math.isfinite(object_distance):
         den = z_E0 + object_distance  # z_E0 − z_obj
         slope0 = np.array([-1.0 / d if d != 0.0 else 0.0 for d in den])

@@ -2,7 +2,10 @@
 
 Units: millimetres; light travels toward +z with the first vertex at z = 0. A ray is a point and
 a direction (normalised here); it may start anywhere before the first surface (it is a line: it
-is carried to each vertex plane). Every ray gets a status code (:mod:`raytrace.kernels.codes`);
+is carried to each vertex plane). Rays start in global (object-space) coordinates; final
+segments are in the lens's image frame (:mod:`raytrace.frames`: the global frame for a centred
+lens; for a folded or tilted one the frame whose z axis is the image-space axis, so that image
+planes are z = const). Every ray gets a status code (:mod:`raytrace.kernels.codes`);
 a failed ray has NaN coordinates and the 1-based number of the surface where it failed.
 """
 
@@ -41,7 +44,8 @@ PARALLEL_LOCK = threading.RLock()
 class RayBatch:
     """Result of :func:`trace_rays`: the final segment of each ray.
 
-    x, y, z: point on the last surface (mm); L, M, N: direction cosines after it.
+    x, y, z: point on the last surface (mm); L, M, N: direction cosines after it; in the image
+    frame (module docstring).
     status:  int8 status code per ray (:mod:`raytrace.kernels.codes`); surface: int32 1-based
     surface where the ray failed (0 when OK). Failed rays have NaN coordinates.
     """
@@ -218,7 +222,8 @@ def _launch(bulk, args: tuple, n: int, threads: int | None) -> None:
 @dataclass(frozen=True, eq=False)
 class RayPaths:
     """Intersection points of each ray with every surface: x, y, z of shape (n_rays, n_surfaces)
-    in mm (NaN after a failure), with status and failed surface per ray as in :class:`RayBatch`."""
+    in mm, global coordinates (NaN after a failure and on coordinate breaks), with status and
+    failed surface per ray as in :class:`RayBatch`."""
 
     x: np.ndarray
     y: np.ndarray
@@ -243,7 +248,7 @@ def ray_paths(
     arrs = [np.atleast_1d(a) for a in _columns(origins, "origins") + _columns(directions, "dirs")]
     n = int(np.broadcast_shapes(*(a.shape for a in arrs))[0])
     xs = [np.ascontiguousarray(np.broadcast_to(a, (n,)), dtype=np.float64) for a in arrs]
-    ns = packed.n_surfaces
+    ns = packed.n_lens_surfaces
     px, py, pz = (np.empty((n, ns)) for _ in range(3))
     st = np.empty(n, dtype=np.int8)
     sf = np.empty(n, dtype=np.int32)

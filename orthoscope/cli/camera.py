@@ -1,0 +1,640 @@
+"""``orthoscope camera``: from a prescription to the camera models of OpenCV, COLMAP, Metashape and
+Australis, and back (:mod:`distortion.camera`).
+
+Four actions, chosen by the first word:
+
+- ``orthoscope camera LENS ...`` — real chief rays traced onto a sensor, a model fitted to them
+  (``--model``), written as a calibration file (``-o``), a table of models per object distance
+  (``--object-distances``), a picture of the distortion (``--picture``) and ``cv2.remap`` maps
+  (``--maps``);
+- ``orthoscope camera compare LENS CALIBRATION`` — a measured calibration against the
+  prescription's prediction at the same focus and object distance;
+- ``orthoscope camera convert CALIBRATION --model TARGET`` — any model to any model over the
+  sensor, with the residual;
+- ``orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 ...`` — models per object
+  distance from two measured calibrations (Brown; Fraser & Shortis 1992).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [
+    ["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pixels", "1200x800", "--grid", "9x7",
+     "-o", "{tmp}/cooke.yml"],
+    ["camera", "topogon-like-pestrecov", "--sensor", "200x200", "--pixels", "2000x2000",
+     "--model", "fisheye", "--grid", "9x9", "--json"],
+    ["camera", "compare", "cooke-triplet-f4", "{data}/camera/cooke-measured-2m.yml",
+     "--sensor", "24x16", "--focus", "2m", "--object-distance", "2m", "--grid", "9x7"],
+    ["camera", "convert", "{data}/camera/cooke-measured-2m.yml", "--model", "metashape",
+     "-o", "{tmp}/cooke.xml"],
+    ["camera", "variation", "{data}/camera/cooke-measured-1m.yml",
+     "{data}/camera/cooke-measured-5m.yml", "--calibrated-at", "1m,5m", "--focal-length", "50",
+     "--focus", "2m", "--object-distances", "1m,2m,5m", "--sensor", "24x16"],
+    ["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pixels", "1200x800", "--grid", "9x7",
+     "--focus", "2m", "--object-distances", "1m,2m,inf", "--csv"],
+]  # fmt: skip
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("-o", ".yml"), ("--plot", ".png")]
+
+ACTIONS = ("compare", "convert", "variation")
+MODEL_WORDS = ("opencv", "fisheye", "colmap", "colmap-fisheye", "metashape", "australis")
+PATTERNS = ("grid", "checkerboard")
+
+
+# ---------------------------------------------------------------------------------- helpers
+def _check_out(path, args, flag: str) -> None:
+    if path is None:
+        return
+    from raytrace.files.output import check_output
+
+    check_output(path, inputs=args._inputs, overwrite=args.force, flag="--force")
+
+
+def _write(path, data, args) -> None:
+    from raytrace.files.output import write_atomic
+
+    write_atomic(path, data, inputs=args._inputs, overwrite=args.force, flag="--force")
+    import sys
+
+    print(f"wrote {path}", file=sys.stderr)
+
+
+def _grid(text: str | None):
+    if text is None:
+        return None
+    from distortion.camera.sensor import parse_pixels
+
+    from .common import CliError
+
+    try:
+        return parse_pixels(text)
+    except Exception as e:  # noqa: BLE001 - DataError with its own words
+        raise CliError(f"--grid {text}: {e}; write it as columns x rows, e.g. 25x17") from None
+
+
+def _setup_keywords(args) -> dict:
+    """The object / focus / trace keywords of CameraSetup from the flags (strings are parsed by
+    CameraSetup, one path for the API and the command line)."""
+    from .common import CliError
+
+    plane = {
+        k: getattr(args, k)
+        for k in ("s_prime", "from_last_vertex", "defocus")
+        if getattr(args, k, None) is not None
+    }
+    focus = {
+        k: getattr(args, k)
+        for k in ("focus", "focus_s", "focus_scale")
+        if getattr(args, k, None) is not None
+    }
+    if len(plane) + len(focus) > 1:
+        flags = ", ".join("--" + k.replace("_", "-") for k in (*focus, *plane))
+        raise CliError(f"give the focus one way, not {flags}")
+    if getattr(args, "gaussian", False) and (plane or focus):
+        raise CliError("--gaussian (focused on the object) goes alone, without another focus flag")
+    kw = {
+        "object_distance": args.object_distance,
+        "object_s": args.object_s,
+        "object_scale": args.object_scale,
+        **focus,
+        **plane,
+        "wavelength": args.wavelength,
+        "grid": _grid(args.grid),
+    }
+    if args.no_clip:
+        kw["clip"] = False
+    return {k: v for k, v in kw.items() if v is not None}
+
+
+def _sensor(args, calibration=None):
+    """The Sensor from --camera / --sensor / --pixels / --pitch / --principal-point (a
+    calibration's pixel count when one is given)."""
+    from distortion.camera import Sensor, read_camera_setup
+    from distortion.camera.traced import sensor_for_calibration
+
+    from .common import CliError
+
+    base = read_camera_setup(args.camera).sensor if args.camera else None
+    off = args.principal_point
+    if calibration is not None:
+        if args.pixels is not None:
+            from distortion.camera.sensor import parse_pixels
+
+            if parse_pixels(args.pixels) != (calibration.width, calibration.height):
+                raise CliError(
+                    f"--pixels {args.pixels} differs from the calibration's "
+                    f"{calibration.width}x{calibration.height} px"
+                )
+        if args.sensor is None and args.pitch is None and base is not None:
+            return sensor_for_calibration(calibration, base)
+        return sensor_for_calibration(
+            calibration,
+            size=args.sensor,
+            pitch_um=args.pitch,
+            principal_point_offset_mm=off if off is not None else (0.0, 0.0),
+        )
+    given = [v for v in (args.sensor, args.pixels, args.pitch) if v is not None]
+    if not given:
+        if base is None:
+            raise CliError(
+                "give the sensor: --sensor WxH (mm) with --pixels CxR or --pitch UM, or --camera "
+                "SPEC.toml"
+            )
+        if off is not None:
+            return Sensor(base.width_mm, base.height_mm, base.width_px, base.height_px, off)
+        return base
+    if len(given) < 2:
+        raise CliError(
+            "the sensor flags define the sensor: give two of --sensor WxH (mm), --pixels CxR "
+            "and --pitch UM"
+        )
+    return Sensor.from_spec(
+        size=args.sensor,
+        pixels=args.pixels,
+        pitch_um=args.pitch,
+        principal_point_offset_mm=off if off is not None else (0.0, 0.0),
+    )
+
+
+def _setup(args, sensor):
+    from distortion.camera import CameraSetup, read_camera_setup
+
+    kw = _setup_keywords(args)
+    if args.camera:
+        return read_camera_setup(args.camera).replace(sensor=sensor, **kw)
+    return CameraSetup(sensor, **kw)
+
+
+def _calibration_format(path: str, fmt: str | None) -> str:
+    from distortion.camera.files import FORMATS, detect_format
+
+    from .common import CliError
+
+    if fmt is not None:
+        if fmt not in FORMATS:
+            raise CliError(f"--format {fmt}: use one of {', '.join(FORMATS)}")
+        return fmt
+    return detect_format(path)
+
+
+def _emit(args, text: str, data: dict, csv: str | None = None) -> None:
+    from .common import print_json
+
+    if args.json:
+        print_json(data)
+    elif getattr(args, "csv", False) and csv is not None:
+        print(csv, end="" if csv.endswith("\n") else "\n")
+    else:
+        print(text)
+
+
+def _save_plot(make, path, args) -> None:
+    from ..plots.common import offscreen_figures
+    from ..plots.save import save_figure
+
+    with offscreen_figures():
+        fig = make()
+    save_figure(fig, path, overwrite=args.force, inputs=args._inputs)
+
+
+# ---------------------------------------------------------------------------------- actions
+def _cmd_lens(args, lens_name: str) -> int:
+    from distortion.camera import (
+        camera_model,
+        distortion_picture,
+        remap_maps,
+        traced_models_by_distance,
+    )
+
+    from ..report.camera import (
+        format_model_table,
+        format_traced_camera,
+        model_table_csv,
+        model_table_to_dict,
+        points_csv,
+        traced_camera_to_dict,
+    )
+    from .common import CliError, load
+    from .distortion import check_plot_path
+
+    lens = load(lens_name)
+    args._inputs = [p for p in (lens.path, args.camera) if p]
+    check_plot_path(args.plot, "--plot", args)
+    for flag, path in (("-o", args.output), ("--picture", args.picture), ("--maps", args.maps)):
+        _check_out(path, args, flag)
+    if args.picture and not str(args.picture).lower().endswith(".png"):
+        raise CliError(f"--picture {args.picture}: the picture is a .png image")
+    if args.maps and not str(args.maps).lower().endswith(".npz"):
+        raise CliError(f"--maps {args.maps}: the maps are written as a numpy .npz file")
+    sensor = _sensor(args)
+    setup = _setup(args, sensor)
+    n = args.coefficients
+    if args.object_distances is not None:
+        if any(k is not None for k in (args.object_distance, args.object_s, args.object_scale)):
+            raise CliError("--object-distances are the table's rows: leave out --object-distance")
+        objs = [s.strip() for s in str(args.object_distances).split(",") if s.strip()]
+        if not objs:
+            raise CliError("--object-distances: empty list")
+        table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
+        if args.output:
+            suffix = str(args.output).lower().rsplit(".", 1)[-1]
+            if suffix not in ("csv", "json"):
+                raise CliError(f"-o {args.output}: a table of models is written as .csv or .json")
+            from ..report.jsonout import dumps
+
+            data = (
+                model_table_csv(table)
+                if suffix == "csv"
+                else dumps({"models_by_distance": model_table_to_dict(table)}) + "\n"
+            )
+            _write(args.output, data, args)
+        _emit(
+            args,
+            format_model_table(table),
+            {"models_by_distance": model_table_to_dict(table)},
+            model_table_csv(table),
+        )
+        return 0
+    tc = camera_model(lens, setup, args.model, n_coefficients=n)
+    if args.output:
+        fmt = _calibration_format(args.output, args.format)
+        _write(args.output, tc.calibration_text(fmt), args)
+    _emit(args, format_traced_camera(tc), traced_camera_to_dict(tc), points_csv(tc))
+    if args.plot:
+        from ..plots.camera import plot_camera_residuals
+
+        _save_plot(lambda: plot_camera_residuals(tc), args.plot, args)
+    if args.picture:
+        pic = distortion_picture(tc.camera, args.pattern)
+        _write(args.picture, _png(pic.image), args)
+    if args.maps:
+        maps = remap_maps(tc.camera, args.maps_direction)
+        _write(args.maps, _npz(maps), args)
+    if tc.points.n_failed and args.strict:
+        raise CliError(f"{tc.points.n_failed} chief ray(s) could not be traced; --strict fails")
+    return 0
+
+
+def _png(image) -> bytes:
+    import cv2
+
+    ok, buf = cv2.imencode(".png", image)
+    if not ok:  # pragma: no cover - OpenCV always encodes a uint8 image
+        from .common import CliError
+
+        raise CliError("OpenCV could not encode the picture as PNG")
+    return buf.tobytes()
+
+
+def _npz(maps) -> bytes:
+    import io
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.savez(
+        buf,
+        map1=maps.map1,
+        map2=maps.map2,
+        camera_matrix=maps.camera_matrix,
+        direction=np.array(maps.direction),
+        scale=np.array(maps.scale),
+    )
+    return buf.getvalue()
+
+
+def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
+    from distortion.camera import compare_calibration, read_calibration
+
+    from ..report.camera import comparison_csv, comparison_to_dict, format_comparison
+    from .common import load
+    from .distortion import check_plot_path
+
+    lens = load(lens_name)
+    args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
+    check_plot_path(args.plot, "--plot", args)
+    _check_out(args.output, args, "-o")
+    cal = read_calibration(cal_path)
+    sensor = _sensor(args, cal)
+    setup = _setup(args, sensor)
+    cmp = compare_calibration(lens, cal, setup, label=f"measured ({cal_path})")
+    if args.output:
+        from ..report.jsonout import dumps
+
+        suffix = str(args.output).lower().rsplit(".", 1)[-1]
+        data = (
+            comparison_csv(cmp)
+            if suffix == "csv"
+            else dumps({"comparison": comparison_to_dict(cmp)})
+        )
+        _write(args.output, data, args)
+    _emit(args, format_comparison(cmp), {"comparison": comparison_to_dict(cmp)},
+          comparison_csv(cmp))  # fmt: skip
+    if args.plot:
+        from ..plots.camera import plot_calibration_comparison
+
+        _save_plot(lambda: plot_calibration_comparison(cmp), args.plot, args)
+    return 0
+
+
+def _cmd_convert(args, cal_path: str) -> int:
+    from distortion.camera import convert_camera_model, read_calibration, smallest_exact
+    from distortion.camera.models import CameraModel
+    from distortion.errors import DataError
+
+    from ..report.camera import conversion_to_dict, format_conversion
+    from .common import CliError
+
+    args._inputs = [p for p in (cal_path, args.camera) if p]
+    _check_out(args.output, args, "-o")
+    cal = read_calibration(cal_path)
+    target = {"fisheye": "opencv_fisheye", "colmap": "colmap:FULL_OPENCV",
+              "colmap-fisheye": "colmap:OPENCV_FISHEYE"}.get(args.model, args.model)  # fmt: skip
+    ps = cal.pixel_size_mm
+    if ps is None and (args.sensor is not None or args.pitch is not None or args.camera):
+        ps = _sensor(args, cal).pixel_size_mm
+    if ps is not None and cal.pixel_size_mm is None:
+        cal = CameraModel(cal.model, cal.params, cal.width, cal.height, ps)
+    if args.coefficients is not None and target != "opencv":
+        raise CliError("--coefficients applies to --model opencv")
+    if args.model in ("colmap", "opencv", "metashape", "australis") and args.coefficients is None:
+        try:  # the smallest model of the family that holds the calibration exactly
+            target = smallest_exact(cal, args.model).model
+        except DataError:
+            pass
+    conv = convert_camera_model(cal, target, free=args.coefficients)
+    if args.output:
+        fmt = _calibration_format(args.output, args.format)
+        from distortion.camera import format_calibration
+
+        _write(args.output, format_calibration(conv.camera, fmt), args)
+    _emit(args, format_conversion(conv), {"conversion": conversion_to_dict(conv)})
+    return 0
+
+
+def _cmd_variation(args, cal1: str, cal2: str) -> int:
+    from distortion.camera import calibrated_models_by_distance, read_calibration
+
+    from ..report.camera import format_model_table, model_table_csv, model_table_to_dict
+    from .common import CliError, length
+
+    args._inputs = [cal1, cal2]
+    _check_out(args.output, args, "-o")
+    if args.calibrated_at is None or args.focal_length is None or args.focus is None:
+        raise CliError("variation needs --calibrated-at S1,S2, --focal-length F and --focus S")
+    at = [s.strip() for s in str(args.calibrated_at).split(",") if s.strip()]
+    if len(at) != 2:
+        raise CliError("--calibrated-at: give the two focus distances S1,S2 of the calibrations")
+    if args.object_distances is None:
+        raise CliError("give --object-distances D1,D2,... (distances from the lens)")
+    objs = [s.strip() for s in str(args.object_distances).split(",") if s.strip()]
+    c1, c2 = read_calibration(cal1), read_calibration(cal2)
+    ps = c1.pixel_size_mm or c2.pixel_size_mm
+    if args.sensor is not None or args.pitch is not None or args.camera:
+        ps = _sensor(args, c1).pixel_size_mm
+    if ps is None:
+        raise CliError("give the sensor size (--sensor WxH mm) or --pitch UM: profiles are in mm")
+    table = calibrated_models_by_distance(
+        c1,
+        at[0],
+        c2,
+        at[1],
+        focal_length_mm=length(args.focal_length, "--focal-length"),
+        focus=args.focus,
+        object_distances=objs,
+        method=args.method,
+        g=args.g,
+        pixel_size_mm=ps,
+        name=f"{cal1} and {cal2}",
+    )
+    if args.output:
+        from ..report.jsonout import dumps
+
+        suffix = str(args.output).lower().rsplit(".", 1)[-1]
+        if suffix not in ("csv", "json"):
+            raise CliError(f"-o {args.output}: a table of models is written as .csv or .json")
+        data = (
+            model_table_csv(table)
+            if suffix == "csv"
+            else dumps({"models_by_distance": model_table_to_dict(table)}) + "\n"
+        )
+        _write(args.output, data, args)
+    _emit(
+        args,
+        format_model_table(table),
+        {"models_by_distance": model_table_to_dict(table)},
+        model_table_csv(table),
+    )
+    return 0
+
+
+def cmd_camera(args) -> int:
+    from .common import CliError
+
+    words = list(args.words)
+    head = words[0]
+    if head == "compare":
+        if len(words) != 3:
+            raise CliError("usage: orthoscope camera compare LENS CALIBRATION [flags]")
+        return _cmd_compare(args, words[1], words[2])
+    if head == "convert":
+        if len(words) != 2:
+            raise CliError("usage: orthoscope camera convert CALIBRATION --model TARGET [-o FILE]")
+        return _cmd_convert(args, words[1])
+    if head == "variation":
+        if len(words) != 3:
+            raise CliError(
+                "usage: orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 "
+                "--focal-length F --focus S --object-distances D1,D2,..."
+            )
+        return _cmd_variation(args, words[1], words[2])
+    if len(words) != 1:
+        raise CliError(
+            f"orthoscope camera takes one LENS (or: {', '.join(ACTIONS)} ...); got "
+            + " ".join(words)
+        )
+    return _cmd_lens(args, head)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from .common import OBJECT_HELP, add_object_args, add_wavelength_arg
+    from .distortion import add_force_arg
+
+    q = sub.add_parser(
+        "camera",
+        help="Camera models (OpenCV, fisheye, COLMAP, Metashape, Australis) from a lens; "
+        "compare, convert, vary with distance.",
+        usage=(
+            "orthoscope camera LENS --sensor WxH --pixels CxR [--model M] [flags]\n"
+            "       orthoscope camera compare LENS CALIBRATION --sensor WxH [flags]\n"
+            "       orthoscope camera convert CALIBRATION --model M [-o FILE]\n"
+            "       orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 --focal-length F "
+            "--focus S --object-distances D1,D2,..."
+        ),
+        description=(
+            "Real chief rays (through the centre of the real stop) traced onto a sensor give "
+            "the correspondences ideal direction <-> image point that a camera model is fitted "
+            "to by least squares, with its residual in pixels. The ideal direction is the "
+            "object-space chief ray's (object at infinity) or the direction from the projection "
+            "centre - the paraxial entrance pupil at the reference wavelength - to the object "
+            "point; the image point is the chief ray's intercept with the sensor plane, in the "
+            "sensor's pixels (OpenCV: pixel centres at integers). The focus setting puts the "
+            "sensor in the Gaussian image plane of the focused object (unit focusing, at the "
+            "reference wavelength); default: focused on the object. 'compare' fits the "
+            "calibration's own model to the traced lens and compares distortion profiles and "
+            "the difference over the sensor; 'convert' turns one model into another (exact "
+            "algebra or a refit with its residual); 'variation' predicts models per object "
+            "distance from two calibrations (Brown Eqs. 1-4; Fraser & Shortis Eq. 6)."
+        ),
+        epilog=(
+            "Examples:\n"
+            "  orthoscope camera cooke-triplet-f4 --sensor 24x16 --pixels 3000x2000 "
+            "--model colmap -o cameras.txt\n"
+            "  orthoscope camera topogon-like-pestrecov --sensor 200x200 --pixels 2000x2000 "
+            "--model fisheye --grid 13x13\n"
+            "  orthoscope camera cooke-triplet-f4 --sensor 24x16 --pixels 1200x800 --focus 2m "
+            "--object-distances 1m,2m,5m,inf --grid 13x9\n"
+            "  orthoscope camera compare cooke-triplet-f4 tests/data/camera/cooke-measured-2m.yml "
+            "--sensor 24x16 --focus 2m --object-distance 2m --plot compare.png\n"
+            "  orthoscope camera convert tests/data/camera/cooke-measured-2m.yml --model "
+            "metashape -o cooke.xml"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument(
+        "words",
+        nargs="+",
+        metavar="LENS",
+        help="A lens (file or bundled name); or 'compare LENS CALIBRATION', 'convert "
+        "CALIBRATION', 'variation CAL1 CAL2'.",
+    )
+    g = q.add_argument_group(
+        "sensor",
+        "Two of --sensor, --pixels and --pitch (all three: checked); with a calibration its "
+        "pixel count and one of --sensor / --pitch. --camera reads a TOML camera spec "
+        "(docs/design.md, 'Camera models from a prescription'): sensor flags replace its "
+        "sensor, the other flags what they name.",
+    )
+    g.add_argument("--sensor", metavar="WxH", help="Sensor size in mm, e.g. 36x24.")
+    g.add_argument("--pixels", metavar="CxR", help="Pixel count, columns x rows, e.g. 6000x4000.")
+    g.add_argument("--pitch", metavar="UM", help="Pixel pitch in micrometres (or '0.006mm').")
+    g.add_argument(
+        "--principal-point",
+        metavar="DX,DY",
+        help="Where the lens axis meets the sensor, mm from its centre, x right, y up.",
+    )
+    g.add_argument("--camera", metavar="SPEC.toml", help="A TOML camera spec (sensor, focus...).")
+    m = q.add_argument_group("model")
+    m.add_argument(
+        "--model",
+        default="opencv",
+        metavar="M",
+        help="opencv, fisheye (OpenCV fisheye / Kannala-Brandt), colmap, colmap-fisheye, "
+        "metashape, australis - as many terms as the stated criterion needs - or one model name "
+        "such as colmap:OPENCV.",
+    )
+    m.add_argument(
+        "--coefficients",
+        type=int,
+        metavar="N",
+        help="Fix the number of coefficients: OpenCV 4, 5, 8, 12 or 14; fisheye 1-4.",
+    )
+    m.add_argument(
+        "--grid", metavar="CxR", help="Chief rays over the sensor, columns x rows (default 25x17)."
+    )
+    m.add_argument(
+        "--no-clip", action="store_true", help="Ignore the lens's semi-diameters (no vignetting)."
+    )
+    add_object_args(q)
+    f = q.add_argument_group(
+        "focus (give at most one; default: focused on the object)",
+        "The focused object in the words of the object plane ("
+        + OBJECT_HELP.split(",")[0]
+        + ") - the sensor sits in its Gaussian image plane - or the sensor plane itself.",
+    )
+    f.add_argument(
+        "--focus",
+        metavar="D",
+        help="Focused object: mm from the first vertex (or 2m, inf, 12x). 'variation': the "
+        "focus distance from the lens.",
+    )
+    f.add_argument("--focus-s", metavar="S", help="Focused object: Pestrecov's s (mm from H).")
+    f.add_argument("--focus-scale", metavar="N", help="Focused object: image scale N (Nx).")
+    f.add_argument("--s-prime", metavar="S'", help="Sensor plane: mm from H'.")
+    f.add_argument("--from-last-vertex", metavar="D", help="Sensor plane: mm from the last vertex.")
+    f.add_argument(
+        "--defocus", metavar="DZ", help="Sensor plane: mm from the object's Gaussian plane."
+    )
+    f.add_argument("--gaussian", action="store_true", help="Focused on the object (the default).")
+    add_wavelength_arg(q)
+    t = q.add_argument_group("per object distance")
+    t.add_argument(
+        "--object-distances",
+        metavar="D1,D2,...",
+        help="A table of models, one per object distance (mm from the first vertex; 2m, inf, "
+        "12x); 'variation': distances from the lens.",
+    )
+    v = q.add_argument_group("variation (two measured calibrations)")
+    v.add_argument(
+        "--calibrated-at",
+        metavar="S1,S2",
+        help="Focus distances of the two calibrations, from the lens (mm, or 1m).",
+    )
+    v.add_argument("--focal-length", metavar="F", help="f of Brown's formulas (mm).")
+    v.add_argument(
+        "--method",
+        choices=("brown", "fraser-shortis"),
+        default="brown",
+        help="Brown's Eq. 1, or Fraser & Shortis' Eq. 6 with --g.",
+    )
+    v.add_argument("--g", type=float, metavar="G", help="g_ss' of Fraser & Shortis' Eq. 6.")
+    o = q.add_argument_group("outputs")
+    o.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE",
+        help="Calibration file (.yml/.yaml/.json OpenCV, cameras.txt COLMAP, .xml Metashape, "
+        ".aus Australis); a table of models: .csv or .json; compare: .json or .csv.",
+    )
+    o.add_argument("--format", metavar="FMT", help="The calibration file format, when the name "
+                   "does not say (opencv-yaml, opencv-json, colmap, metashape, photoscan, "
+                   "australis).")  # fmt: skip
+    o.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="A chart (.png/.svg/.pdf): the fit residual over the sensor; compare: radial curves "
+        "beside the difference map.",
+    )
+    o.add_argument(
+        "--picture",
+        metavar="FILE.png",
+        help="A grid of the ideal image as the lens records it, at true scale (needs OpenCV).",
+    )
+    o.add_argument("--pattern", choices=PATTERNS, default="grid", help="Pattern of --picture.")
+    o.add_argument(
+        "--maps",
+        metavar="FILE.npz",
+        help="cv2.remap maps (map1, map2 float32, camera_matrix) of the full image.",
+    )
+    o.add_argument(
+        "--maps-direction",
+        choices=("undistort", "distort"),
+        default="undistort",
+        help="undistort: the ideal image from the camera's; distort: the camera's from an "
+        "ideal one.",
+    )
+    o.add_argument(
+        "--strict", action="store_true", help="Exit with status 2 when a chief ray fails."
+    )
+    add_force_arg(q)
+    og = q.add_mutually_exclusive_group()
+    og.add_argument("--json", action="store_true", help="Print JSON (keys carry units; README).")
+    og.add_argument(
+        "--csv",
+        action="store_true",
+        help="Print CSV: the traced points with the residual, the table, or the radial profiles.",
+    )
+    q.set_defaults(func=cmd_camera)

@@ -1,0 +1,160 @@
+"""``orthoscope report``: the calibration certificate of a design — calibrated focal length, PPA and
+PPBS, radial distortion along the four semi-diagonals, decentering profile — as text, JSON and a
+one-page PDF (:mod:`distortion.certificate`)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import add_object_args, add_output_args, add_plane_args, add_wavelength_arg
+
+#: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
+#: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
+SAMPLES = [
+    ["report", "cooke-triplet-f4", "--sensor", "24x16"],
+    ["report", "topogon-us2031792-fig1", "--field-step", "10", "--json"],
+]
+#: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
+OUTPUTS = [("-o", ".pdf")]
+
+METHOD_HELP = (
+    "Criterion of the calibrated focal length: 'minimax' (equal largest positive and negative "
+    "mean radial distortion over the format: the ASPRS definition; default) or 'least-squares'."
+)
+REFERENCE_POINT_HELP = (
+    "Point the radial distortion is measured from: 'ppbs' (point of best symmetry; default), "
+    "'ppa' (principal point of autocollimation), 'axial' (image of the axial object point)."
+)
+
+
+def cmd_report(args) -> int:
+    from distortion.certificate import calibration_certificate
+
+    from ..report.certificate import certificate_to_dict, format_certificate
+    from .common import CliError, load, print_json, resolve_object, resolve_planes
+    from .distortion import check_plot_path
+
+    lens = load(args.lens)
+    args._inputs = [lens.path] if lens.path else []
+    check_plot_path(args.output, "-o", args)
+    if args.sensor is not None and args.max_field is not None:
+        raise CliError("give --sensor or --max-field, not both")
+    od = resolve_object(lens, args)
+    planes = resolve_planes(lens, args)
+    if len(planes) != 1:
+        raise CliError("a certificate is for one image plane: give one value")
+    cert = calibration_certificate(
+        lens,
+        sensor=args.sensor,
+        object_distance=od,
+        plane=planes,
+        wavelength=args.wavelength,
+        reference_point=args.reference_point,
+        method=args.method,
+        field_step_deg=args.field_step,
+        max_field_deg=args.max_field,
+        date=args.date,
+    )
+    d = certificate_to_dict(cert)
+    if args.json:
+        print_json({"certificate": d})
+    else:
+        print(format_certificate(d))
+    if args.output:
+        from ..plots.certificate import plot_certificate
+        from ..plots.common import offscreen_figures
+        from ..plots.save import save_figure
+
+        with offscreen_figures():
+            fig = plot_certificate(d)
+        save_figure(fig, args.output, overwrite=args.force, inputs=args._inputs)
+    return 0
+
+
+def _date(text: str) -> str:
+    import datetime
+
+    try:
+        return datetime.date.fromisoformat(text).isoformat()
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a date; write it as YYYY-MM-DD, e.g. 2026-01-31"
+        ) from None
+
+
+def _step(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of degrees") from None
+    if not 0.0 < v < 90.0:
+        raise argparse.ArgumentTypeError(f"{text}: give a step between 0 and 90 degrees")
+    return v
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from .distortion import add_force_arg
+
+    q = sub.add_parser(
+        "report",
+        help="Calibration certificate of the design: calibrated focal length, PPA/PPBS, radial "
+        "distortion along the semi-diagonals, decentering (text, JSON, one-page PDF).",
+        description=(
+            "The calibration certificate a laboratory would issue for a camera built exactly to "
+            "the prescription (the USGS / ASPRS aerial-camera form), predicted by real chief rays "
+            "at the stated object distance, wavelength, image plane and reference point: the "
+            "calibrated focal length with its criterion, the principal points of autocollimation "
+            "and of best symmetry, radial distortion in um along the four semi-diagonals of the "
+            "format at regular field steps and their mean, the decentering profile J r^2 and its "
+            "axis, and radial coefficients of the mean curve. -o writes it as a one-page PDF "
+            "with its plots (or .png / .svg)."
+        ),
+        epilog=(
+            "Examples:\n"
+            "  orthoscope report topogon-like-pestrecov -o certificate.pdf\n"
+            "  orthoscope report cooke-triplet-f4 --sensor 36x24 --object-distance 2m --json"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_object_args(q)
+    add_plane_args(q)
+    add_wavelength_arg(q)
+    g = q.add_argument_group("format and form")
+    g.add_argument(
+        "--sensor",
+        metavar="WxH",
+        help="The format, W x H mm: the semi-diagonals run from the lens axis to its corners "
+        "(default: the lens's field, semi-diagonals at 45, 135, 225, 315 deg).",
+    )
+    g.add_argument(
+        "--max-field", type=float, metavar="DEG", help="The field without --sensor (deg)."
+    )
+    g.add_argument(
+        "--field-step",
+        type=_step,
+        default=7.5,
+        metavar="DEG",
+        help="Step of the tabulated field angles.",
+    )
+    g.add_argument(
+        "--reference-point",
+        choices=["ppbs", "ppa", "axial"],
+        default="ppbs",
+        help=REFERENCE_POINT_HELP,
+    )
+    g.add_argument(
+        "--method", choices=["minimax", "least-squares"], default="minimax", help=METHOD_HELP
+    )
+    g.add_argument(
+        "--date", type=_date, metavar="YYYY-MM-DD", help="Date printed (default: today)."
+    )
+    q.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE",
+        help="Write the one-page certificate: .pdf (A4), or .png / .svg of the same page.",
+    )
+    add_force_arg(q)
+    add_output_args(q, csv=False)
+    q.set_defaults(func=cmd_report)
