@@ -179,7 +179,11 @@ def rayoptics_grid(path, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray
 
     opm, scale = rayoptics_open(path)
     sm = opm["seq_model"]
-    wvl = lens.wavelength
+    # the referee's own number for our wavelength (µm in a .zmx file → nm may round)
+    wvls = list(opm["optical_spec"]["wvls"].wavelengths)
+    wvl = min(wvls, key=lambda w: abs(w - lens.wavelength))
+    if abs(wvl - lens.wavelength) > 1e-6:
+        raise ValueError(f"ray-optics has no wavelength {lens.wavelength} nm (it has {wvls})")
     path_ = [list(e) for e in sm.path(wvl)]
     infinite = math.isinf(lens.object_distance)
     if infinite:
@@ -217,12 +221,14 @@ def rayoptics_grid(path, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray
         worst = max(worst, float(np.max(np.abs(f(u)))) * scale)
         ray = run(u)
         if image_tab:
-            # ray-optics has no image-surface tilt: move its final ray into our image frame
+            # ray-optics has no image-surface tilt: take its ray after the last interface that
+            # acts (not a coordinate break) into our image frame
             from rayoptics.elem.transform import compute_global_coords
 
-            R, t = compute_global_coords(sm, glo=1)[last]
-            p = (R @ ray[-1][mc.p] + t) * scale
-            d = R @ ray[-1][mc.d]
+            k = max(j for j in range(1, last) if sm.ifcs[j].interact_mode != "phantom")
+            R, t = compute_global_coords(sm, glo=1)[k]
+            p = (R @ ray[k][mc.p] + t) * scale
+            d = R @ ray[k][mc.d]
             out[i] = _to_image_frame(lens, p, d)
         else:
             out[i] = np.asarray(ray[-1][mc.p][:2], dtype=float) * scale
@@ -289,8 +295,11 @@ def optiland_grid(op, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, f
         u = _newton_polish(f, u)
         worst = max(worst, float(np.max(np.abs(f(u)))))
         g = run(u)
-        p = np.array([float(g.x[-1][0]), float(g.y[-1][0]), float(g.z[-1][0])])
-        d = np.array([float(g.L[-1][0]), float(g.M[-1][0]), float(g.N[-1][0])])
+        # the ray after the last surface before the image (global), moved into our image frame:
+        # no grazing intersection where optiland's image plane is not tilted like the file's
+        k = -2
+        p = np.array([float(g.x[k][0]), float(g.y[k][0]), float(g.z[k][0])])
+        d = np.array([float(g.L[k][0]), float(g.M[k][0]), float(g.N[k][0])])
         out[i] = _to_image_frame(lens, p, d)
     return out, worst
 

@@ -64,6 +64,10 @@ Decentering
     axis of maximum tangential distortion, is ψ − 90°. Below ``DECENTERING_FLOOR_MM`` at the edge
     of the format (a centred design) the axis is undefined and given as NaN with a note.
 
+A decentered or tilted lens (``Lens.is_centred`` false) takes its first-order data — Pestrecov's
+constants, the Gaussian plane, the field's nominal angles — from its centred lens
+(``Lens.nominal()``); its chief rays are traced through the lens as it is.
+
 Radial coefficients (USGS form)
     A least-squares fit of the mean Δr on the dense fields: ``Δr = k0 r + k1 r³ + k2 r⁵ + k3 r⁷``
     (r = c_c tan θ, mm), with its RMS residual.
@@ -387,14 +391,17 @@ def calibration_certificate(
             wl = wavelength_nm(wavelength)
         except UnitError as e:
             raise TraceError(str(e)) from None
+    # a decentered or tilted lens: first-order data (Pestrecov's constants, the planes) of its
+    # centred lens; the chief rays through the lens as it is
+    centred = lens if lens.is_centred else lens.nominal()
     od = resolve_object_distance(
-        lens,
+        centred,
         object_distance=object_distance,
         object_s=object_s,
         object_scale=object_scale,
         wavelength=wl,
     )
-    par = paraxial(lens, object_distance=od, wavelength=wl)
+    par = paraxial(centred, object_distance=od, wavelength=wl)
     planes = image_planes(
         plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus
     )

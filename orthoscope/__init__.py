@@ -110,6 +110,21 @@ _API: dict[str, str] = {
     "convert_camera_model": "distortion.camera",
     "read_calibration": "distortion.camera",
     "write_calibration": "distortion.camera",
+    # camera models from a prescription, and back
+    "CameraSetup": "distortion.camera",
+    "read_camera_setup": "distortion.camera",
+    "camera_model": "distortion.camera",
+    "opencv_coefficients": "distortion.camera",
+    "TracedCamera": "distortion.camera",
+    "trace_camera_points": "distortion.camera",
+    "compare_calibration": "distortion.camera",
+    "compare_cameras": "distortion.camera",
+    "CameraComparison": "distortion.camera",
+    "traced_models_by_distance": "distortion.camera",
+    "calibrated_models_by_distance": "distortion.camera",
+    "ModelTable": "distortion.camera",
+    "remap_maps": "distortion.camera",
+    "distortion_picture": "distortion.camera",
     # design
     "read_spec": "raytrace.optimize",
     "optimize": "raytrace.optimize",
@@ -132,6 +147,11 @@ _API: dict[str, str] = {
     "plot_radial_by_azimuth": "orthoscope.plots.grid",
     "plot_certificate": "orthoscope.plots.certificate",
     "plot_spot": "orthoscope.plots.rays",
+    "plot_camera_residuals": "orthoscope.plots.camera",
+    "plot_distortion_picture": "orthoscope.plots.camera",
+    "plot_calibration_comparison": "orthoscope.plots.camera",
+    "plot_radial_comparison": "orthoscope.plots.camera",
+    "plot_difference_map": "orthoscope.plots.camera",
     "save_figure": "orthoscope.plots.save",
     "plot_glass_map": "orthoscope.plots.glassmap",
     "plot_pupils": "orthoscope.plots.telecentricity",
@@ -183,14 +203,28 @@ def __dir__() -> list[str]:
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from distortion.calibration import CalibrationResult, calibrate
     from distortion.camera import (
+        CameraComparison,
         CameraFit,
         CameraModel,
+        CameraSetup,
+        ModelTable,
         Sensor,
+        TracedCamera,
+        calibrated_models_by_distance,
         camera_from_sensor,
+        camera_model,
+        compare_calibration,
+        compare_cameras,
         convert_camera_model,
+        distortion_picture,
         fit_camera_model,
+        opencv_coefficients,
         read_calibration,
+        read_camera_setup,
+        remap_maps,
         select_camera_model,
+        trace_camera_points,
+        traced_models_by_distance,
         write_calibration,
     )
     from distortion.certificate import CalibrationCertificate, calibration_certificate
@@ -246,6 +280,13 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         trace_rays,
     )
 
+    from .plots.camera import (
+        plot_calibration_comparison,
+        plot_camera_residuals,
+        plot_difference_map,
+        plot_distortion_picture,
+        plot_radial_comparison,
+    )
     from .plots.certificate import plot_certificate
     from .plots.colour import (
         plot_distortion_by_wavelength,

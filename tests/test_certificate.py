@@ -195,6 +195,45 @@ def test_calibrated_focal_length_is_the_brute_force_minimax(decentered):
         assert worst(k0) < worst(k0 + dk) and worst(k0) < worst(k0 - dk)
 
 
+# ---------------------------------------------------------------- a decentered element, traced
+def _decentered(lens, dy):
+    """The lens with its third element (surfaces 5, 6) decentered by ``dy`` mm along +y, each
+    surface in the frame it arrives in (raytrace.frames.Placement, after="return")."""
+    from raytrace.frames import Placement
+
+    ss = list(lens.surfaces)
+    for j in (4, 5):
+        ss[j] = dataclasses.replace(
+            ss[j], placement=Placement(decenter=(0.0, dy, 0.0)), after="return"
+        )
+    return dataclasses.replace(lens, surfaces=tuple(ss))
+
+
+def test_decentered_element_symmetries():
+    """Exact by symmetry: the lens decentered along y is mirror-symmetric in x → −x, so P1 = 0
+    (the decentering axis is ±90°), the principal points lie on x = 0 and the +x and −x
+    semi-diagonals are equal; y → −y maps d onto −d: J is even in d, the axis turns by 180°,
+    and the +y and −y semi-diagonals swap. To first order J is linear in d (1 %)."""
+    cooke = load_lens("cooke-triplet-f4")
+    c = {d: calibration_certificate(_decentered(cooke, d)) for d in (0.05, -0.05, 0.1)}
+    for d, cert in c.items():
+        dec = cert.decentering
+        edge = cert.radius_mm[-1] ** 2
+        assert abs(dec["P1"]) * edge < 1e-13 and abs(dec["S1"]) * edge < 1e-13
+        assert dec["axis_deg"] == pytest.approx(90.0 if d > 0 else -90.0, abs=1e-9)
+        for p in (cert.ppa_mm, cert.ppbs_mm, cert.axial_mm):
+            assert abs(p[0]) < 1e-12 and np.sign(p[1]) == np.sign(d)
+        # azimuths 45, 135, 225, 315: (+x +y) = (-x +y), (-x -y) = (+x -y)
+        np.testing.assert_allclose(cert.radial_um[0], cert.radial_um[1], rtol=0, atol=1e-8)
+        np.testing.assert_allclose(cert.radial_um[2], cert.radial_um[3], rtol=0, atol=1e-8)
+        assert np.max(np.abs(cert.radial_um[0] - cert.radial_um[3])) > 1.0  # a real asymmetry
+    assert c[0.05].decentering["J"] == pytest.approx(c[-0.05].decentering["J"], rel=1e-9)
+    np.testing.assert_allclose(c[0.05].radial_um[0], c[-0.05].radial_um[3], rtol=0, atol=1e-8)
+    assert c[0.1].decentering["J"] == pytest.approx(2 * c[0.05].decentering["J"], rel=0.01)
+    assert c[0.05].decentering["J"] > 1e-6  # 0.05 mm gives J r^2 of ~1 um at the edge
+    assert not c[0.05].notes
+
+
 # ---------------------------------------------------------------- the page carries the JSON
 def _page_texts(fig):
     from matplotlib.text import Text

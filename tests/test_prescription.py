@@ -329,7 +329,8 @@ def test_two_aperture_kinds() -> None:
     text = COOKE.replace("{ fnumber = 4.0 }", "{ fnumber = 4.0, epd = 12.5 }")
     err = _fails(text)
     assert err.line == _line_of(text, "aperture =")
-    assert "exactly one of fnumber / epd / na (got: fnumber, epd)" in str(err)
+    assert "exactly one of fnumber / epd / na / float / working_fnumber / cone_angle " in str(err)
+    assert "(got: fnumber, epd)" in str(err)
 
 
 def test_units_other_than_mm() -> None:

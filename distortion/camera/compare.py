@@ -4,7 +4,7 @@ prediction (Fraser & Shortis 1992 compare measured and predicted distortion prof
 
 The distortion part of a model (any model of :mod:`distortion.camera`)
     Near the axis every model is a pinhole: ``u ≈ u0 + J x`` with ``u0`` the image of the axis
-    direction and ``J`` the Jacobian there (OpenCV pixels; fx, skew, fy — what
+    direction and ``J`` the model's Jacobian there (OpenCV pixels; fx, skew, fy — what
     ``cv2.undistort`` maps to). The *distortion* at a measured image point u is the rest:
     ``d(u) = u − (u0 + J x(u))`` with ``x(u)`` the model's ideal direction of u (its inverse
     map) — distortion at the **measured** position, positive outward for pincushion, as the
@@ -33,10 +33,8 @@ import numpy as np
 
 from ..errors import DataError
 from .convert import sensor_grid
-from .models import OK, CameraModel, project, unproject
+from .models import OK, CameraModel, native_to_frame, project, project_jacobian, unproject
 
-#: step (normalised coordinates) of the central differences of the pinhole part
-_H = 1e-6
 #: azimuths of a radial profile
 N_AZIMUTHS = 72
 DEFAULT_GRID = (41, 31)
@@ -44,16 +42,15 @@ DEFAULT_RADII = 40
 
 
 def pinhole_part(camera: CameraModel) -> tuple[np.ndarray, np.ndarray]:
-    """(u0, J): the image of the axis direction (2,) and the 2 × 2 Jacobian d(u, v)/d(x, y) there,
-    OpenCV pixels (central differences of the model's projection; the distortion terms are at
-    least quadratic, so their contribution cancels to O(h²))."""
-    pts = np.array([[0.0, 0.0], [_H, 0.0], [-_H, 0.0], [0.0, _H], [0.0, -_H]])
-    m = project(camera, pts, pixels="opencv")
-    if not np.all(m.status == OK):
+    """(u0, J): the image of the axis direction (2,) and the 2 × 2 Jacobian d(u, v)/d(x, y) there
+    (OpenCV pixels; the model's analytic Jacobian carried from its native frame)."""
+    m = project(camera, np.zeros((1, 2)), pixels="opencv")
+    jn = project_jacobian(camera, np.zeros((1, 2)))[0]
+    if not (np.all(m.status == OK) and np.all(np.isfinite(jn))):
         raise DataError(f"{camera.model}: the model cannot project directions near its axis")
-    p = m.points
-    j = np.column_stack([(p[1] - p[2]) / (2 * _H), (p[3] - p[4]) / (2 * _H)])
-    return p[0].copy(), j
+    e = native_to_frame(camera, np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), "opencv")
+    lin = np.column_stack([e[1] - e[0], e[2] - e[0]])  # native -> OpenCV pixels (affine)
+    return m.points[0].copy(), lin @ jn
 
 
 def distortion_at(camera: CameraModel, image_px) -> np.ndarray:

@@ -150,7 +150,8 @@ def traced_models_by_distance(
         ``clip`` (an object keyword here is refused: the distances are the table's rows).
         Default focus: the first object distance.
     """
-    from .traced import _as_setup, camera_residual, fit_points, trace_camera_points
+    from .setup import make_setup
+    from .traced import camera_residual, fit_points, trace_camera_points
 
     objs = list(object_distances)
     if not objs:
@@ -158,7 +159,7 @@ def traced_models_by_distance(
     bad = [k for k in ("object_distance", "object_s", "object_scale") if setup.get(k) is not None]
     if bad:
         raise DataError(f"the object distances are the table's rows: do not give {bad[0]}")
-    base = _as_setup(sensor, setup)
+    base = make_setup(sensor, setup)
     focus_keys = ("focus", "focus_s", "focus_scale", "s_prime", "from_last_vertex", "defocus")
     if all(getattr(base, k) is None for k in focus_keys):
         base = base.replace(focus=objs[0])

@@ -296,12 +296,24 @@ def _resolve_object(lens, distance, s, scale, wavelength, prefix: str) -> float:
         raise DataError(f"{lens.name}: {msg}") from None
 
 
+def nominal_lens(lens):
+    """The centred lens whose first-order data a decentered or tilted lens is designed around
+    (``Lens.nominal()`` where the lens has surface placements; the lens itself otherwise)."""
+    centred = getattr(lens, "is_centred", True)
+    if callable(centred):
+        centred = centred()
+    return lens if centred else lens.nominal()
+
+
 def resolve_setup(lens, setup: CameraSetup) -> CameraGeometry:
     """Resolve ``setup`` for ``lens`` (module docstring): object plane, sensor plane (unit
     focusing at the reference wavelength), projection centre and the paraxial camera constant.
-    Raises DataError for a focus or object the lens cannot image."""
+    Raises DataError for a focus or object the lens cannot image. A decentered or tilted lens
+    takes these first-order quantities from its centred design (:func:`nominal_lens`)."""
     from raytrace.paraxial import paraxial, pestrecov_constants
     from raytrace.units import UnitError, wavelength_nm
+
+    lens = nominal_lens(lens)
 
     wl_ref = float(lens.wavelength)
     try:
@@ -446,6 +458,23 @@ def read_camera_setup(path: str | os.PathLike) -> CameraSetup:
     except tomllib.TOMLDecodeError as e:
         raise DataError(f"{p}: not valid TOML: {e}") from None
     return camera_setup_from_dict(doc, str(p))
+
+
+def make_setup(sensor, setup_kw: dict | None = None) -> CameraSetup:
+    """A :class:`CameraSetup` from a Sensor, a CameraSetup or a TOML camera spec path, with the
+    keywords of ``setup_kw`` that are not None applied (they replace what a setup holds)."""
+    kw = {k: v for k, v in (setup_kw or {}).items() if v is not None}
+    if isinstance(sensor, CameraSetup):
+        return sensor.replace(**kw) if kw else sensor
+    if isinstance(sensor, str | os.PathLike) and str(sensor).lower().endswith(".toml"):
+        base = read_camera_setup(sensor)
+        return base.replace(**kw) if kw else base
+    if isinstance(sensor, Sensor):
+        return CameraSetup(sensor, **kw)
+    raise DataError(
+        "sensor: give a Sensor (Sensor.from_spec(size='36x24', pixels='6000x4000')), a "
+        f"CameraSetup or a camera spec .toml path, not {type(sensor).__name__}"
+    )
 
 
 def setup_fields() -> tuple[str, ...]:

@@ -45,7 +45,6 @@ single-centre camera model cannot represent when the object distance changes.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -56,7 +55,7 @@ from .convert import convert_camera_model, sensor_grid
 from .fit import FAMILIES, CameraFit, ModelSelection, initial_camera, select_camera_model
 from .models import OK, OPENCV_ORDERS, CameraModel, model_name, model_spec, project
 from .sensor import Sensor
-from .setup import CameraGeometry, CameraSetup, read_camera_setup
+from .setup import CameraGeometry, CameraSetup, make_setup
 
 #: placement iterations of the field grid (module docstring)
 PLACEMENT_ITERATIONS = 4
@@ -185,22 +184,6 @@ class CameraPoints:
 
 def _object_words(g: CameraGeometry) -> str:
     return "at infinity" if g.infinite else f"{g.object_distance:g} mm from the first vertex"
-
-
-def _as_setup(sensor, setup_kw: dict) -> CameraSetup:
-    """A CameraSetup from a Sensor, a CameraSetup or a TOML spec path, with keywords applied."""
-    kw = {k: v for k, v in setup_kw.items() if v is not None}
-    if isinstance(sensor, CameraSetup):
-        return sensor.replace(**kw) if kw else sensor
-    if isinstance(sensor, str | os.PathLike) and str(sensor).lower().endswith(".toml"):
-        base = read_camera_setup(sensor)
-        return base.replace(**kw) if kw else base
-    if isinstance(sensor, Sensor):
-        return CameraSetup(sensor, **kw)
-    raise DataError(
-        "sensor: give a Sensor (Sensor.from_spec(size='36x24', pixels='6000x4000')), a "
-        f"CameraSetup or a camera spec .toml path, not {type(sensor).__name__}"
-    )
 
 
 def trace_camera_points(
@@ -607,7 +590,7 @@ def camera_model(
         ``.camera`` (the model), ``.rms_px``/``.max_px`` (residual against the traced points),
         ``.criterion``, ``.points`` (the correspondences, the geometry and the pupils).
     """
-    setup = _as_setup(
+    setup = make_setup(
         sensor,
         {
             "object_distance": object_distance,
@@ -752,7 +735,7 @@ def compare_calibration(lens, calibration: CameraModel, sensor, *, label: str = 
 
     from .compare import compare_cameras
 
-    setup = _as_setup(sensor, kw)
+    setup = make_setup(sensor, kw)
     points = trace_camera_points(lens, setup)
     pred = prediction_like(calibration, points)
     g = points.geometry

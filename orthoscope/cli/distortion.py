@@ -38,6 +38,7 @@ TABLE_LAYOUT_HELP = (
 SAMPLES = [
     ["distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--calibrate", "minimax"],
     ["distortion", "cooke-triplet-f4", "--grid", "5x5"],
+    ["distortion", "cooke-triplet-f4", "--sensor", "24x16", "--grid", "7x5", "--sensor-metrics"],
 ]
 #: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
 OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png"), ("--layout", ".png")]

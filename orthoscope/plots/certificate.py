@@ -239,8 +239,7 @@ def _radial_table(pg: _Page, d: dict) -> None:
         if last:
             pg.rule(lw=0.5, dy=0.75)
         colour = COLOURS[i - 1] if 1 <= i <= 4 else "black"
-        lab = pretty(lab) if i else pretty(lab)
-        pg.text(LEFT, lab, size=7.5, weight="bold" if last else "normal", color=colour)
+        pg.text(LEFT, pretty(lab), size=7.5, weight="bold" if last else "normal", color=colour)
         for x, c in zip(xs, cells, strict=True):
             pg.text(
                 x, c.text, size=7.5, ha="right", gid=c.path, weight="bold" if last else "normal"

@@ -18,12 +18,17 @@ _LINE_LABEL = {
 }
 
 
+def _signed(v: float, digits: int) -> str:
+    """``v`` with a sign and ``digits`` decimals, never "-0.000"."""
+    return f"{round(v, digits) + 0.0:+.{digits}f}"
+
+
 def _pct(v: float, digits: int = 4) -> str:
-    return f"{100.0 * v:+.{digits}f} %" if math.isfinite(v) else "-"
+    return f"{_signed(100.0 * v, digits)} %" if math.isfinite(v) else "-"
 
 
 def _um(v: float) -> str:
-    return f"{1000.0 * v:+.3f} um" if math.isfinite(v) else "-"
+    return f"{_signed(1000.0 * v, 3)} um" if math.isfinite(v) else "-"
 
 
 def format_sensor_metrics(metrics: SensorMetrics | Sequence[SensorMetrics]) -> str:

@@ -818,6 +818,8 @@ class _ZmxParser:
             notes = "\n".join(plain_notes)
         solve = meta.get("image_solve")
         solve = solve if solve == "gaussian" else None
+        if meta.get("field_points") == [] and image_field is None:
+            fld = replace(fld, points=())
         if self.unknown:
             listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
             self.warn(f"unknown commands skipped: {listing}")
@@ -939,6 +941,8 @@ def dumps_zmx(lens: Lens) -> str:
     meta["notes"] = lens.notes
     if lens.image_solve:
         meta["image_solve"] = lens.image_solve
+    if not lens.field.points and lens.field.given is None:
+        meta["field_points"] = []  # the fields written below are a default fan, not the lens's
     for k, v in meta.items():
         out.append(f"NOTE 0 orthoscope.{k}: {json.dumps(v, ensure_ascii=True)}")
     out.append("UNIT MM X W X CM MR CPMM")
