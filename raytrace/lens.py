@@ -143,6 +143,14 @@ class Surface:
     aperture: ClearAperture | None = None
 
     def __post_init__(self) -> None:
+        if (
+            self.placement is None
+            and self.after == "stay"
+            and self.aperture is None
+            and self.mirror is False
+            and self.coordinate_break is False
+        ):
+            return  # a surface on the axis (the common case): nothing to check
         p = self.placement
         if p is not None and not isinstance(p, Placement):
             raise ValueError(f"placement must be a Placement or None, got {type(p).__name__}")

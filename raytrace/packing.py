@@ -40,6 +40,7 @@ from .kernels.codes import (
     G_RELT,
     G_ZV,
     KIND_PLANE,
+    L_COAXIAL,
     L_SYMMETRIC,
     NGEO,
 )
@@ -55,7 +56,7 @@ def coaxial_geo(zv: np.ndarray, symmetric: bool = True) -> np.ndarray:
     geo[:, G_REL : G_REL + 9] = eye
     geo[:, G_ABS : G_ABS + 9] = eye
     if n:
-        geo[0, G_LENS] = float(L_SYMMETRIC) if symmetric else 0.0
+        geo[0, G_LENS] = float(L_COAXIAL | (L_SYMMETRIC if symmetric else 0))
     return geo
 
 
@@ -255,5 +256,8 @@ def placement_table(lens: Lens) -> tuple[np.ndarray, bool]:
         row[G_FLAGS] = float(F_SKIP | F_FRAME)
         rows.append(row)
     geo = np.ascontiguousarray(np.array(rows))
-    geo[0, G_LENS] = float(L_SYMMETRIC) if lens.is_centred else 0.0
+    lens_flags = L_SYMMETRIC if lens.is_centred else 0
+    if not np.any(geo[:, G_FLAGS] != 0.0):
+        lens_flags |= L_COAXIAL
+    geo[0, G_LENS] = float(lens_flags)
     return geo, extra

@@ -484,15 +484,10 @@ def test_decentered_element_signs_in_every_format_with_optiland_rays(cooke, tmp_
 
 def _decentered_lens(lens, surfaces, dy):
     """``lens`` with the given surfaces (1-based) decentered by ``dy`` mm along +y, each
-    returning to the arrival frame after itself (the element moves as a whole). Raises
-    NotImplementedError while raytrace.lens.Surface has no placement."""
+    returning to the arrival frame after itself (``after="return"``): the element moves as a
+    whole, as optiland's ``dy`` places it."""
     import dataclasses
 
-    from raytrace.lens import Surface
-
-    names = {f.name for f in dataclasses.fields(Surface)}
-    if "placement" not in names:
-        raise NotImplementedError("raytrace.lens.Surface has no placement (decenters) yet")
     from raytrace.frames import Placement
 
     ss = list(lens.surfaces)
@@ -503,11 +498,6 @@ def _decentered_lens(lens, surfaces, dy):
     return dataclasses.replace(lens, surfaces=tuple(ss))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=NotImplementedError,
-    reason="needs surface decenters (raytrace.lens.Surface.placement, raytrace/frames.py)",
-)
 @pytest.mark.filterwarnings("ignore")
 def test_decentered_element_signs_in_every_format_with_our_decenters(cooke, tmp_path):
     """The same lens built with our own surface decenters and traced by our kernels: the traced
@@ -715,3 +705,25 @@ def test_distortion_at_is_zero_for_a_pinhole():
     cam = CameraModel.create("opencv", 640, 480, fx=500.0, fy=510.0, cx=320.0, cy=240.0)
     d = distortion_at(cam, np.array([[0.0, 0.0], [639.0, 479.0], [100.0, 400.0]]))
     assert np.abs(d).max() < 1e-9
+
+
+def test_distortion_at_a_corner_of_a_nearly_degenerate_rational_model():
+    """A FULL_OPENCV fit of the Topogon-like on a 216 mm frame (our own run: its rational
+    numerator and denominator nearly cancel, so its evaluation noise is above the models' 1e-12 px
+    Newton floor at the corner): the distortion is still found there, projects back onto the
+    pixel, and is mirror-symmetric about the principal point as the centred model is."""
+    cam = CameraModel.create(
+        "colmap:FULL_OPENCV", 10800, 10800, fx=7683.989137211588, fy=7683.989137211587,
+        cx=5400.0, cy=5400.0, k1=21.348351770203557, k2=-36.122475707019895,
+        k3=37.548966344664095, k4=21.306963244930948, k5=-36.13663324029227,
+        k6=37.55842641931741,
+    )  # fmt: skip
+    corners = np.array([[0.0, 0.0], [10799.0, 10799.0], [10799.0, 0.0]])
+    d = distortion_at(cam, corners)
+    assert np.all(np.isfinite(d))
+    np.testing.assert_allclose(d[0], -d[1], atol=1e-6)
+    np.testing.assert_allclose(d[2], [-d[0][0], d[0][1]], atol=1e-6)
+    from distortion.camera.compare import ideal_of
+
+    back = project(cam, ideal_of(cam, corners), pixels="opencv").points
+    assert np.abs(back - corners).max() < 1e-8

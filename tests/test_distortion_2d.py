@@ -419,26 +419,18 @@ def test_decentered_element_with_optiland_follows_the_derivation(cooke):
 
 def _decentered(lens, element: int, dy: float):
     """``lens`` with its ``element``-th element (1-based; its two surfaces) decentered by ``dy``
-    mm along +y.
+    mm along +y: each of the two surfaces moved by dy with the axis returning after it (CODE V's
+    decenter-and-return, raytrace.frames), the same lens optiland gets from ``_optiland_decentered``
+    (each surface's coordinate system moved by dy)."""
+    from raytrace.frames import Placement
 
-    Raises NotImplementedError while :class:`raytrace.lens.Surface` holds no decenter (issue 15
-    items 1–3). As soon as it does, this helper raises RuntimeError instead: the test below then
-    FAILS (its xfail only accepts NotImplementedError), and whoever added decenters writes this
-    helper against the new API and removes the xfail marker."""
-    from raytrace.lens import Surface
-
-    names = {f.name for f in dataclasses.fields(Surface)}
-    if not any("decent" in n or n in ("dx", "dy", "placement", "frame", "tilt") for n in names):
-        raise NotImplementedError("raytrace.lens.Surface has no decenter yet (issue 15 items 1-3)")
-    raise RuntimeError(
-        "raytrace.lens.Surface can now be decentered: write tests/test_distortion_2d._decentered "
-        f"against its API (fields: {', '.join(sorted(names))}) and remove the xfail marker"
-    )
+    j = 2 * (element - 1)
+    ss = list(lens.surfaces)
+    for k in (j, j + 1):
+        ss[k] = dataclasses.replace(ss[k], placement=Placement((0.0, dy, 0.0)), after="return")
+    return dataclasses.replace(lens, surfaces=tuple(ss))
 
 
-@pytest.mark.xfail(
-    strict=True, raises=NotImplementedError, reason="needs surface decenters (issue 15 items 1-3)"
-)
 @pytest.mark.filterwarnings("ignore")
 def test_decentered_element_gives_decentering_on_the_y_side_only(cooke):
     """One element decentered along +y: P1 = S1 = 0 (OpenCV p2 = 0, Brown P1 = 0) to round-off,

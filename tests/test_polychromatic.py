@@ -196,18 +196,16 @@ def test_negative_image_distance_round_trips_through_toml():
 
 # ----------------------------------------------------------------------------- real-file fixes
 def test_wfno_line_is_not_an_aperture_type():
-    # rayoptics US05831776-1.zmx: OBNA aperture and a "WFNO 0 0 ..." line (line 502); the file
-    # is now refused for its real-image-height field (FTYP 3), not for WFNO
-    with pytest.raises(PrescriptionError) as e:
-        read(CORPUS / "rayoptics" / "US05831776-1.zmx")
-    assert "FTYP 3" in str(e.value) and "WFNO" not in str(e.value)
+    # rayoptics US05831776-1.zmx: OBNA aperture and a "WFNO 0 0 ..." line (line 502): the
+    # aperture is the object-space NA of its OBNA line
+    assert read(CORPUS / "rayoptics" / "US05831776-1.zmx").aperture == Aperture("na", 0.15)
     text = dumps_zmx(singlet()).replace("ENPD", "WFNO 0 0 0 0 0 0 0 0 0 0\r\nENPD")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert loads_zmx(text).aperture == Aperture("epd", 10.0)
-    # a paraxial working F/# (FNUM with flag 1) is what is refused
-    with pytest.raises(PrescriptionError, match="paraxial working F/#"):
-        loads_zmx(dumps_zmx(singlet()).replace("ENPD 10.0", "FNUM 4.0 1"))
+    # a paraxial working F/# is FNUM with flag 1 (OpticStudio "Paraxial Working F/#")
+    lens = loads_zmx(dumps_zmx(singlet()).replace("ENPD 10.0", "FNUM 4.0 1"))
+    assert lens.aperture == Aperture("working_fnumber", 4.0)
 
 
 def test_fixed_diam_zero_on_a_dummy_surface_reads():

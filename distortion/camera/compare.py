@@ -33,12 +33,24 @@ import numpy as np
 
 from ..errors import DataError
 from .convert import sensor_grid
-from .models import OK, CameraModel, native_to_frame, project, project_jacobian, unproject
+from .models import (
+    NOT_CONVERGED,
+    OK,
+    CameraModel,
+    native_to_frame,
+    project,
+    project_jacobian,
+    unproject,
+)
 
 #: azimuths of a radial profile
 N_AZIMUTHS = 72
 DEFAULT_GRID = (41, 31)
 DEFAULT_RADII = 40
+#: Newton tolerance (px) of a second try of the inverse map for points that did not converge to
+#: the models' own 1e-12 px (or 16 ulp): the evaluation noise of a model whose rational terms
+#: nearly cancel can exceed that floor; 1e-9 px is still far below any distortion compared
+INVERSE_TOL_PX = 1e-9
 
 
 def pinhole_part(camera: CameraModel) -> tuple[np.ndarray, np.ndarray]:
@@ -58,9 +70,22 @@ def distortion_at(camera: CameraModel, image_px) -> np.ndarray:
     the model cannot unproject u) — module docstring."""
     u = np.asarray(image_px, dtype=float).reshape(-1, 2)
     u0, j = pinhole_part(camera)
+    x = ideal_of(camera, u)
+    return u - (u0 + x @ j.T)
+
+
+def ideal_of(camera: CameraModel, image_px: np.ndarray) -> np.ndarray:
+    """(N, 2) ideal directions of OpenCV pixels (NaN where the model cannot invert them): the
+    model's inverse to its own tolerance, and a second try to INVERSE_TOL_PX for the points that
+    did not converge to it."""
+    u = np.asarray(image_px, dtype=float).reshape(-1, 2)
     back = unproject(camera, u, pixels="opencv")
     x = np.where((back.status == OK)[:, None], back.points, np.nan)
-    return u - (u0 + x @ j.T)
+    again = back.status == NOT_CONVERGED
+    if np.any(again):
+        m = unproject(camera, u[again], pixels="opencv", tol_px=INVERSE_TOL_PX)
+        x[again] = np.where((m.status == OK)[:, None], m.points, np.nan)
+    return x
 
 
 @dataclass(frozen=True, eq=False)
@@ -251,11 +276,11 @@ def compare_cameras(
     dp = distortion_at(predicted, g)
     dm = distortion_at(measured, u0m + q)
     diff = (dp - dm).reshape(grid[1], grid[0], 2)
-    back = unproject(measured, g, pixels="opencv")
-    ok = back.status == OK
+    xm = ideal_of(measured, g)
+    ok = np.all(np.isfinite(xm), axis=1)
     proj = np.full(g.shape, np.nan)
     if np.any(ok):
-        pp = project(predicted, back.points[ok], pixels="opencv")
+        pp = project(predicted, xm[ok], pixels="opencv")
         v = pp.points - g[ok]
         v[pp.status != OK] = np.nan
         proj[ok] = v

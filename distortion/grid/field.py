@@ -314,7 +314,9 @@ def distortion_grid(
         object_scale=object_scale,
         wavelength=wl,
     )
-    par = paraxial(lens, object_distance=od, wavelength=wl)
+    # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
+    # centred lens (raytrace.paraxial refuses a lens that is not centred)
+    par = paraxial(lens.nominal(), object_distance=od, wavelength=wl)
     angles = fields_x_deg is not None or fields_y_deg is not None
     heights = object_x_mm is not None or object_y_mm is not None
     if angles and heights:
@@ -615,7 +617,9 @@ def radial_by_azimuth(
         object_scale=object_scale,
         wavelength=wl,
     )
-    par = paraxial(lens, object_distance=od, wavelength=wl)
+    # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
+    # centred lens (raytrace.paraxial refuses a lens that is not centred)
+    par = paraxial(lens.nominal(), object_distance=od, wavelength=wl)
     if fields_deg is not None and object_radii_mm is not None:
         raise TraceError("give fields_deg or object_radii_mm, not both")
     if object_radii_mm is not None:

@@ -180,13 +180,19 @@ def _calibration_format(path: str, fmt: str | None) -> str:
     return detect_format(path)
 
 
-def _emit(args, text: str, data: dict, csv: str | None = None) -> None:
+def _emit(args, text: str, data: dict, csv: str | None = None, note: str | None = None) -> None:
+    """Text, JSON or CSV on stdout; with CSV (which has no room for it) ``note`` — the
+    projection centre — goes to stderr, so that every output states it."""
+    import sys
+
     from .common import print_json
 
     if args.json:
         print_json(data)
     elif getattr(args, "csv", False) and csv is not None:
         print(csv, end="" if csv.endswith("\n") else "\n")
+        if note:
+            print(f"orthoscope camera: note: {note}", file=sys.stderr)
     else:
         print(text)
 
@@ -256,13 +262,15 @@ def _cmd_lens(args, lens_name: str) -> int:
             format_model_table(table),
             {"models_by_distance": model_table_to_dict(table)},
             model_table_csv(table),
+            setup.resolve(lens).projection_centre,
         )
         return 0
     tc = camera_model(lens, setup, args.model, n_coefficients=n)
     if args.output:
         fmt = _calibration_format(args.output, args.format)
         _write(args.output, tc.calibration_text(fmt), args)
-    _emit(args, format_traced_camera(tc), traced_camera_to_dict(tc), points_csv(tc))
+    _emit(args, format_traced_camera(tc), traced_camera_to_dict(tc), points_csv(tc),
+          tc.geometry.projection_centre)  # fmt: skip
     if args.plot:
         from ..plots.camera import plot_camera_residuals
 
@@ -332,7 +340,7 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
         )
         _write(args.output, data, args)
     _emit(args, format_comparison(cmp), {"comparison": comparison_to_dict(cmp)},
-          comparison_csv(cmp))  # fmt: skip
+          comparison_csv(cmp), cmp.prediction.geometry.projection_centre)  # fmt: skip
     if args.plot:
         from ..plots.camera import plot_calibration_comparison
 

@@ -23,6 +23,8 @@ ARROWS = "tab:red"
 MEASURED = "tab:blue"
 PREDICTED = "tab:red"
 FIGSIZE_IMAGE = (7.2, 5.2)
+#: arrows per row of a map (a denser comparison grid is thinned for the arrows)
+ARROWS_PER_ROW = 14
 
 
 def _key_length(vmax: float) -> float:
@@ -90,13 +92,15 @@ def plot_distortion_picture(
     picture: DistortionPicture | CameraModel,
     *,
     pattern: str = "grid",
+    reference: bool = False,
     ax=None,
     title: str | None = None,
 ):
     """A grid (or checkerboard) of the ideal image as the camera records it, at true scale
     (:func:`distortion.camera.distortion_picture`; warped by ``cv2.remap``). Axes in full-size
-    pixels."""
-    from distortion.camera import distortion_picture
+    pixels. ``reference``: draw the grid's lines where a distortion-free camera would record
+    them (thin red lines) — zoom in (``ax.set_xlim``) to see the recorded lines leave them."""
+    from distortion.camera import distortion_picture, pinhole_part
 
     pic = picture if isinstance(picture, DistortionPicture) else distortion_picture(
         picture, pattern
@@ -107,6 +111,16 @@ def plot_distortion_picture(
         pic.image, cmap="gray", vmin=0, vmax=255, interpolation="antialiased",
         extent=(-0.5, cam.width - 0.5, cam.height - 0.5, -0.5),
     )  # fmt: skip
+    if reference:
+        u0, j = pinhole_part(cam)
+        if pic.pattern != "grid" or abs(j[0, 1]) > 1e-9 * abs(j[0, 0]):
+            raise DataError("reference lines are drawn for a grid pattern of a camera without skew")
+        sp = pic.spacing_px
+        for axis, n in ((0, cam.width), (1, cam.height)):
+            c0 = float(u0[axis])
+            line = ax.axvline if axis == 0 else ax.axhline
+            for k in range(math.floor(-c0 / sp), math.ceil((n - c0) / sp) + 1):
+                line(c0 + k * sp, color=ARROWS, lw=0.6, zorder=2)
     _image_axes(ax, cam.width, cam.height)
     set_title(
         ax,
@@ -160,7 +174,9 @@ def plot_difference_map(c: CameraComparison, *, ax=None, title: str | None = Non
                          zorder=0)  # fmt: skip
     fig.colorbar(mesh, ax=ax, label="|predicted - measured| (px)", shrink=0.85)
     w, h = c.measured.width, c.measured.height
-    _arrows(ax, img.reshape(-1, 2), d.reshape(-1, 2), w)
+    step = max(1, round(img.shape[1] / ARROWS_PER_ROW))
+    sub = (slice(None, None, step), slice(None, None, step))
+    _arrows(ax, img[sub].reshape(-1, 2), d[sub].reshape(-1, 2), w)
     _image_axes(ax, w, h)
     set_title(
         ax,

@@ -1,5 +1,9 @@
 """Lens layout drawing: elements, stop, image plane(s) and real rays per field (meridional section).
 
+Centred lenses, mirrors on the axis included (a mirror is a heavy line hatched on its back); a
+lens that is not centred (decenters, tilts, folds) has no paraxial data and is refused in one line
+(``raytrace.paraxial.require_centred``).
+
 :func:`layout_rays` computes everything the drawing shows (no matplotlib: usable in tests and
 other drawings); :func:`plot_layout` draws it to scale (equal axes, mm, light from left to right).
 
@@ -301,7 +305,8 @@ def layout_rays(
                 plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus
             ),
         )
-    z_img = float(zp.max())
+    # the farthest plane along the light (toward −z after an odd number of mirrors)
+    z_img = float(zp.max() if lens.image_direction > 0 else zp.min())
     r_stop = float(par.stop_radius)
     from_file = np.array([math.isfinite(s.semi_diameter) for s in lens.surfaces])
     free = ~from_file
@@ -423,7 +428,12 @@ def _draw_lens(ax, L: LayoutRays) -> None:
                     zorder=3,
                     gid="edge",
                 )
+    arriving = 1.0  # direction of the light along z before each surface (mirrors flip it)
     for j, s in enumerate(lens.surfaces):
+        if s.mirror:
+            _draw_mirror(ax, *profile(j), arriving)
+            arriving = -arriving
+            continue
         if j == st and s.curvature == 0.0 and j not in glassy:
             continue  # a plane stop in air is drawn as the stop only
         z, r = profile(j)
@@ -442,6 +452,17 @@ def _draw_lens(ax, L: LayoutRays) -> None:
     outer = _stop_outer(L)
     for sgn in (1.0, -1.0):
         ax.plot([zs, zs], [sgn * rs, sgn * outer], color="k", lw=2.4, zorder=3, gid="stop")
+
+
+def _draw_mirror(ax, z: np.ndarray, r: np.ndarray, arriving: float) -> None:
+    """A mirror: its profile as a heavy line, hatched on the side the light does not reach
+    (behind it along the arriving direction)."""
+    ax.plot(z, r, color="k", lw=2.0, zorder=3, gid="mirror")
+    span = float(np.ptp(r)) if r.size else 0.0
+    h = 0.04 * span
+    for k in range(0, r.size, max(1, r.size // 12)):
+        ax.plot([z[k], z[k] + arriving * h], [r[k], r[k] + h], color="k", lw=0.6, zorder=3,
+                gid="mirror back")  # fmt: skip
 
 
 def _stop_outer(L: LayoutRays) -> float:
@@ -500,8 +521,8 @@ def plot_layout(
     sdmax = float(L.semi_diameters.max())
     planes = [(z, _segment(_heights_at(L, z), 0.05 * sdmax)) for z in sorted(L.z_planes)]
     obj = _segment(L.y[:, 0], 0.05 * sdmax) if L.object_drawn else None
-    zlo = min(L.z_start, _front(L))
-    zhi = float(L.z_planes.max())
+    zlo = min(L.z_start, _front(L), float(L.z_planes.min()))
+    zhi = max(float(L.z_planes.max()), _back(L))
     outer = _stop_outer(L)
     ylo = min(-sdmax, -outer, *(seg[0] for _, seg in planes), obj[0] if obj else 0.0)
     yhi = max(sdmax, outer, *(seg[1] for _, seg in planes), obj[1] if obj else 0.0)
@@ -568,6 +589,15 @@ def plot_layout(
     )
     set_title(ax, title or lens.name)
     return fig
+
+
+def _back(L: LayoutRays) -> float:
+    """Largest z of the drawn lens (a mirror system may lie right of its image planes)."""
+    zv = L.lens.vertex_z
+    return max(
+        float(np.nanmax(zv[j] + s.sag(np.linspace(0.0, L.semi_diameters[j], 33))))
+        for j, s in enumerate(L.lens.surfaces)
+    )
 
 
 def _front(L: LayoutRays) -> float:

@@ -38,6 +38,8 @@ _AUSTRALIS_UNITS = {
     "b2": "",
 }
 _PIXEL_PARAMS = ("f", "fx", "fy", "cx", "cy")
+#: a fit whose (column-scaled) Jacobian is worse conditioned than this gets a note
+CONDITION_NOTE = 1e5
 _RADIAN_PARAMS = ("tau_x", "tau_y", "omega")
 
 
@@ -177,6 +179,12 @@ def format_traced_camera(tc: TracedCamera) -> str:
         f"fit residual against the traced image points: RMS {_g(tc.rms_px, 3)} px, max "
         f"{_g(tc.max_px, 3)} px (placement of the grid: within {_g(pts.placement_px, 2)} px)"
     )
+    if fit.condition > CONDITION_NOTE:
+        lines.append(
+            f"condition number of the fit {_g(fit.condition, 3)}: the coefficients are strongly "
+            "correlated (e.g. a rational numerator and denominator that nearly cancel) - the "
+            "projection is determined, the individual coefficients are not"
+        )
     try:
         lines.append("COLMAP cameras.txt: " + tc.colmap_line())
     except DataError:  # not every model has an exact COLMAP form
@@ -252,6 +260,7 @@ def traced_camera_to_dict(tc: TracedCamera) -> dict:
             "max_px": tc.max_px,
             "n_points": fit.n_points,
             "n_failed": pts.n_failed,
+            "condition": fit.condition,
             "std_errors": dict(zip(fit.free, fit.std_errors, strict=True)),
             "candidates": [
                 {

@@ -1,6 +1,7 @@
 """Lens files: the native TOML format (:mod:`.native`), Zemax ``.zmx`` (:mod:`.zemax`, read and
-write), CODE V ``.seq`` (:mod:`.codev`, read), the bundled library (:mod:`.library`) and the one
-atomic writer (:mod:`.output`). The format is chosen by the file suffix.
+write), CODE V ``.seq`` (:mod:`.codev`, read), OSLO ``.len`` (:mod:`.oslo`, read), the bundled
+library (:mod:`.library`) and the one atomic writer (:mod:`.output`). The format is chosen by the
+file suffix.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from typing import Any
 from ..errors import PrescriptionError
 from ..lens import Lens
 
-READ_SUFFIXES = (".toml", ".zmx", ".seq")
+READ_SUFFIXES = (".toml", ".zmx", ".seq", ".len")
 WRITE_SUFFIXES = (".toml", ".zmx")
 
 
@@ -27,6 +28,10 @@ def read_lens_file(path: str | Path) -> Lens:
         from .codev import read_seq
 
         return read_seq(path)
+    if suffix == ".len":
+        from .oslo import read_len
+
+        return read_len(path)
     from .native import read_lens
 
     return read_lens(path)

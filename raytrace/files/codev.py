@@ -288,7 +288,10 @@ class _SeqParser:
                 if args:
                     cur.r = self.num(args, 0, cmd, line)
                 if len(args) >= 2:
-                    cur.t = self.num(args, 1, cmd, line)
+                    if kind == "SO":  # CODE V writes 1e10 or more; "inf" is accepted too
+                        cur.t = number(args[1], cmd, self.fail, line, allow_inf=True)
+                    else:
+                        cur.t = self.num(args, 1, cmd, line)
                     if kind == "SO" and cur.t >= CODEV_INFINITY:
                         cur.t = math.inf
                 rest = [a for a in args[2:] if a.upper() not in ("REFL", "REFLECT")]

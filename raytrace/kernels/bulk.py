@@ -23,8 +23,10 @@ from .codes import (
     F_FRAME,
     F_SKIP,
     G_FLAGS,
+    G_LENS,
     G_ZV,
     KIND_ASPHERE,
+    L_COAXIAL,
     STATUS_CLIPPED,
     STATUS_MISSED,
     STATUS_OK,
@@ -293,9 +295,10 @@ def _trace_block(kind, c, k, asph, geo, n_in, n_out, sd, clip, i0, i1, x, y, z, 
         buf[_RN + i] = N[ii] / nrm
         buf[_RS + i] = 0.0 if good else float(STATUS_MISSED)
         buf[_RF + i] = 0.0 if good else 1.0
+    coaxial = (int(geo[0, G_LENS]) & L_COAXIAL) != 0
     for j in range(c.shape[0]):
         mu = n_in[j] / n_out[j]
-        if geo[j, G_FLAGS] != 0.0:
+        if not coaxial and geo[j, G_FLAGS] != 0.0:
             _general_rows(buf, nb, kind[j], c[j], k[j], asph, geo, j, mu, sd[j], clip)
             continue
         zvj = geo[j, G_ZV]

@@ -48,3 +48,4 @@ F_APERTURE = 8  #: clip with the clear aperture of columns G_AP..G_AP+4 too
 F_GENERAL = 16  #: rays may meet the surface travelling toward -z (mirrors, tilts)
 
 L_SYMMETRIC = 1  #: rotationally symmetric lens: a negative meridional field mirrors a positive one
+L_COAXIAL = 2  #: no surface has a flag: the kernels run the coaxial code only

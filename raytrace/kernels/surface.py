@@ -68,9 +68,11 @@ from .codes import (
     G_FLAGS,
     G_REL,
     G_RELT,
+    G_LENS,
     G_ZV,
     KIND_PLANE,
     KIND_QUADRIC,
+    L_COAXIAL,
     STATUS_CLIPPED,
     STATUS_MISSED,
     STATUS_OK,
@@ -161,18 +163,22 @@ def outside_aperture(geo, j, x, y):
 
 
 @kernel(error_model="numpy", inline="always")
-def surface_step(kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N):
+def surface_step(kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N, coaxial=False):
     """Intersect surface j and refract (or reflect). The ray is in surface j's axis frame
     (module docstring). Returns (status, x, y, z, L, M, N) with the point on the surface (axis
-    frame) and the direction after it; status != 0 leaves the values meaningless."""
-    fl = int(geo[j, G_FLAGS])
+    frame) and the direction after it; status != 0 leaves the values meaningless.
+
+    ``coaxial=True`` (a literal at the call site, for a lens without any flag: lens flag
+    ``L_COAXIAL``) skips reading the surface's flags; after inlining the branches it leaves are
+    compiled away, so the coaxial path costs what it did before placements existed."""
+    fl = 0 if coaxial else int(geo[j, G_FLAGS])
     zvj = geo[j, G_ZV]
     if (fl & F_GENERAL) != 0:
         if N == 0.0 or not math.isfinite(N):
             return STATUS_MISSED, x, y, z, L, M, N
     elif not (N > 0.0):
         return STATUS_MISSED, x, y, z, L, M, N
-    sg = 1.0 if N > 0.0 else -1.0
+    sg = 1.0 if (coaxial or N > 0.0) else -1.0
     t0 = (zvj - z) / N
     x = x + t0 * L
     y = y + t0 * M
@@ -264,6 +270,15 @@ def trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L,
     """Trace surfaces j0 .. j1-1 (0-based) of the packed lens; the ray comes in the axis frame of
     the last traced surface before j0 (global for j0 = 0) and leaves in that of the last one
     traced (for j1 = n: the image frame). Returns (status, surface_1based, x, y, z, L, M, N)."""
+    if (int(geo[0, G_LENS]) & L_COAXIAL) != 0:  # a centred refracting lens: no flags to read
+        for j in range(j0, j1):
+            st, x, y, z, L, M, N = surface_step(
+                kind[j], c[j], k[j], asph, geo, j, n_in[j] / n_out[j], sd[j], clip,
+                x, y, z, L, M, N, True,
+            )  # fmt: skip
+            if st != STATUS_OK:
+                return st, j + 1, x, y, z, L, M, N
+        return STATUS_OK, 0, x, y, z, L, M, N
     for j in range(j0, j1):
         fl = int(geo[j, G_FLAGS])
         if (fl & F_FRAME) != 0:

@@ -131,11 +131,14 @@ def image_planes(
 
 
 def plane_z(par: ParaxialResult, planes: list[ImagePlane]) -> np.ndarray:
-    """Absolute z of ``planes``; refuses a plane on or before the last vertex."""
+    """Absolute z of ``planes``; refuses a plane on or before the last vertex (along the light:
+    after an odd number of mirrors the image space runs toward −z, ``n_image < 0``; every
+    distance stays signed along +z, as the thicknesses of Zemax and CODE V)."""
     z = np.array([p.z(par) for p in planes], dtype=float)
     if not np.all(np.isfinite(z)):
         raise TraceError("the Gaussian image is at infinity; give the image plane explicitly")
-    bad = np.nonzero(z <= par.z_last)[0]
+    direction = -1.0 if par.n_image < 0.0 else 1.0
+    bad = np.nonzero((z - par.z_last) * direction <= 0.0)[0]
     if bad.size:
         i = int(bad[0])
         raise TraceError(

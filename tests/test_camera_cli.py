@@ -1,0 +1,267 @@
+"""``orthoscope camera``: the command line gives what the API gives (same words, same numbers),
+writes the files the real libraries read, states the projection centre in every output, and
+refuses what a person can get wrong in one line (exit 2).
+
+Referees: the API (distortion.camera) for the numbers, cv2.FileStorage / cv2.imread and numpy
+for the files written; the synthetic calibrations of tests/data/camera (make_measured.py).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import orthoscope as osc
+from distortion.camera import (
+    CameraSetup,
+    Sensor,
+    calibrated_models_by_distance,
+    camera_model,
+    compare_calibration,
+    project,
+    read_calibration,
+    traced_models_by_distance,
+)
+from orthoscope.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "tests" / "data" / "camera"
+BASE = ["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pixels", "1200x800", "--grid", "9x7"]
+
+
+def run(argv, cwd=None, monkeypatch=None):
+    if cwd is not None:
+        monkeypatch.chdir(cwd)
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main(argv)
+    return rc, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def cooke():
+    return osc.load_lens("cooke-triplet-f4")
+
+
+@pytest.fixture(scope="module")
+def sensor():
+    return Sensor.from_spec(size="24x16", pixels="1200x800")
+
+
+def test_cli_equals_api_and_states_the_projection_centre(cooke, sensor):
+    rc, out, err = run([*BASE, "--focus", "2m", "--object-distance", "5m", "--json"])
+    assert rc == 0, err
+    d = json.loads(out)
+    api = camera_model(cooke, sensor, "opencv", focus="2m", object_distance="5m", grid=(9, 7))
+    assert d["camera"]["model"] == api.camera.model
+    for k, v in api.camera.as_dict().items():
+        assert d["camera"]["parameters"][k] == pytest.approx(v, rel=1e-12, abs=1e-15)
+    assert d["camera"]["rms_px"] == pytest.approx(api.rms_px, rel=1e-9)
+    g = d["geometry"]
+    assert g["object_distance_mm"] == 5000.0
+    assert g["focus_object_distance_mm"] == 2000.0
+    assert "paraxial entrance pupil" in g["projection_centre"]
+    assert g["projection_centre_z_mm"] == pytest.approx(osc.paraxial(cooke).z_E0, abs=1e-12)
+    assert d["pupils"]["max_entrance_pupil_shift_mm"] > 0
+    rc, text, err = run([*BASE, "--focus", "2m", "--object-distance", "5m"])
+    assert rc == 0 and "projection centre: paraxial entrance pupil E0" in text
+    assert "model chosen by" in text and "COLMAP cameras.txt: 1 " in text
+
+
+def test_calibration_file_written_is_what_cv2_reads(tmp_path, monkeypatch, cooke, sensor):
+    cv2 = pytest.importorskip("cv2")
+    rc, _, err = run([*BASE, "-o", "cam.yml"], tmp_path, monkeypatch)
+    assert rc == 0, err
+    api = camera_model(cooke, sensor, "opencv", grid=(9, 7))
+    ours = read_calibration(tmp_path / "cam.yml")
+    np.testing.assert_allclose(ours.params, api.camera.params, rtol=1e-15, atol=1e-300)
+    fs = cv2.FileStorage(str(tmp_path / "cam.yml"), cv2.FILE_STORAGE_READ)
+    k = fs.getNode("camera_matrix").mat()
+    fs.release()
+    np.testing.assert_allclose(k, api.camera_matrix, rtol=1e-15)
+    # COLMAP from the name, the smallest COLMAP model that holds the camera
+    rc, _, err = run([*BASE, "--model", "colmap", "-o", "cameras.txt"], tmp_path, monkeypatch)
+    assert rc == 0, err
+    written = read_calibration(tmp_path / "cameras.txt")
+    api = camera_model(cooke, sensor, "colmap", grid=(9, 7))
+    assert written.model == api.camera.model
+    # FULL_OPENCV's rational terms are nearly degenerate here (parameters move with round-off):
+    # the projections must agree, not the digits
+    ideal, _ = api.points.valid()
+    a = project(written, ideal, pixels="opencv").points
+    b = project(api.camera, ideal, pixels="opencv").points
+    assert np.abs(a - b).max() < 1e-6
+    # an existing file needs --force; a model the format cannot hold is refused with the fix
+    rc, _, err = run([*BASE, "-o", "cam.yml"], tmp_path, monkeypatch)
+    assert rc == 2 and "--force" in err and len(err.strip().splitlines()) == 1
+    rc, _, err = run([*BASE, "--model", "fisheye", "-o", "m.xml"], tmp_path, monkeypatch)
+    assert rc == 2 and "convert" in err and not (tmp_path / "m.xml").exists()
+
+
+def test_camera_spec_toml_and_flags(tmp_path, monkeypatch, cooke):
+    spec = tmp_path / "cam.toml"
+    spec.write_text(
+        '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[focus]\ndistance = "2m"\n'
+        "[trace]\ngrid = [9, 7]\n",
+        encoding="utf-8",
+    )
+    rc, out, err = run(["camera", "cooke-triplet-f4", "--camera", str(spec), "--json",
+                        "--object-distance", "1m"], tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    d = json.loads(out)
+    api = camera_model(cooke, spec, "opencv", object_distance="1m")
+    assert d["camera"]["parameters"]["k1"] == pytest.approx(api.camera["k1"], rel=1e-12)
+    assert d["geometry"]["focus_object_distance_mm"] == 2000.0
+    assert d["sensor"]["width_px"] == 1200 and d["trace"]["grid"] == [9, 7]
+
+
+def test_table_per_object_distance(tmp_path, monkeypatch, cooke, sensor):
+    argv = [*BASE, "--focus", "2m", "--object-distances", "1m,2m,inf"]
+    rc, out, err = run([*argv, "--csv"])
+    assert rc == 0, err
+    assert "projection centre: paraxial entrance pupil" in err  # CSV has no room: stderr
+    rows = [ln.split(",") for ln in out.strip().splitlines()]
+    t = traced_models_by_distance(cooke, sensor, ["1m", "2m", "inf"], focus="2m", grid=(9, 7))
+    head, ref = t.rows()
+    assert rows[0] == head
+    for got, want in zip(rows[1:], ref, strict=True):
+        np.testing.assert_allclose([float(v) for v in got], want, rtol=1e-12, atol=1e-15)
+    rc, _, err = run([*argv, "-o", "table.json"], tmp_path, monkeypatch)
+    assert rc == 0, err
+    d = json.loads((tmp_path / "table.json").read_text())["models_by_distance"]
+    assert d["columns"] == head and len(d["rows"]) == 3 and d["method"] == "traced"
+    rc, _, err = run([*argv, "-o", "table.yml"], tmp_path, monkeypatch)
+    assert rc == 2 and ".csv or .json" in err
+
+
+def test_compare_convert_and_variation(tmp_path, monkeypatch, cooke):
+    cal = str(DATA / "cooke-measured-2m.yml")
+    argv = ["camera", "compare", "cooke-triplet-f4", cal, "--sensor", "24x16", "--focus", "2m",
+            "--object-distance", "2m", "--grid", "9x7"]  # fmt: skip
+    rc, out, err = run([*argv, "--json"])
+    assert rc == 0, err
+    d = json.loads(out)["comparison"]
+    api = compare_calibration(cooke, read_calibration(cal),
+                              Sensor.from_spec(size="24x16", pixels="3000x2000"),
+                              focus="2m", object_distance="2m", grid=(9, 7))  # fmt: skip
+    assert d["distortion_difference_rms_px"] == pytest.approx(api.rms_px, rel=1e-9)
+    assert any("paraxial entrance pupil" in n for n in d["notes"])
+    rc, _, err = run([*argv, "--plot", "cmp.png"], tmp_path, monkeypatch)
+    assert rc == 0 and (tmp_path / "cmp.png").read_bytes()[:4] == b"\x89PNG"
+    rc, _, err = run([*argv, "--pixels", "1000x1000"])
+    assert rc == 2 and "3000x2000" in err
+    # convert: exact into Metashape, a refit into Australis with its residual
+    rc, out, err = run(["camera", "convert", cal, "--model", "metashape", "--json"])
+    assert rc == 0, err
+    conv = json.loads(out)["conversion"]
+    assert conv["method"] == "exact" and conv["rms_px"] < 1e-9
+    rc, out, err = run(["camera", "convert", cal, "--model", "australis", "--sensor", "24x16"])
+    assert rc == 0 and "refit" in out and "RMS" in out
+    rc, _, err = run(["camera", "convert", cal, "--model", "australis"])
+    assert rc == 2 and "pixel_size_mm" in err
+    # variation: the table equals the API's
+    c1, c5 = DATA / "cooke-measured-1m.yml", DATA / "cooke-measured-5m.yml"
+    rc, out, err = run(["camera", "variation", str(c1), str(c5), "--calibrated-at", "1m,5m",
+                        "--focal-length", "50", "--focus", "2m", "--object-distances",
+                        "1m,2m,5m", "--sensor", "24x16", "--method", "fraser-shortis",
+                        "--g", "0.45", "--json"])  # fmt: skip
+    assert rc == 0, err
+    d = json.loads(out)["models_by_distance"]
+    api = calibrated_models_by_distance(
+        read_calibration(c1), "1m", read_calibration(c5), "5m", focal_length_mm=50,
+        focus="2m", object_distances=["1m", "2m", "5m"], method="fraser-shortis", g=0.45,
+        pixel_size_mm=(0.008, 0.008),
+    )  # fmt: skip
+    head, rows = api.rows()
+    for got, want in zip(d["rows"], rows, strict=True):
+        np.testing.assert_allclose([got[h] for h in head], want, rtol=1e-12)
+
+
+def test_picture_and_maps(tmp_path, monkeypatch):
+    cv2 = pytest.importorskip("cv2")
+    rc, _, err = run([*BASE, "--picture", "pic.png", "--maps", "maps.npz", "--pattern",
+                      "checkerboard"], tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    img = cv2.imread(str(tmp_path / "pic.png"), cv2.IMREAD_GRAYSCALE)
+    assert img.shape == (800, 1200)
+    with np.load(tmp_path / "maps.npz") as z:
+        assert z["map1"].shape == (800, 1200) and z["map1"].dtype == np.float32
+        assert str(z["direction"]) == "undistort" and z["camera_matrix"].shape == (3, 3)
+    rc, _, err = run([*BASE, "--picture", "pic.jpg"], tmp_path, monkeypatch)
+    assert rc == 2 and ".png" in err
+
+
+@pytest.mark.parametrize(
+    "argv,words",
+    [
+        (["camera", "cooke-triplet-f4"], "give the sensor"),
+        (["camera", "cooke-triplet-f4", "--sensor", "24x16"], "two of"),
+        ([*BASE, "--model", "opencvv"], "did you mean"),
+        ([*BASE, "--focus", "2m", "--defocus", "0.1"], "focus one way"),
+        ([*BASE, "--grid", "9"], "--grid"),
+        (["camera", "compare", "cooke-triplet-f4"], "usage"),
+        (["camera", "cooke-triplet-f4", "extra"], "one LENS"),
+        ([*BASE, "--coefficients", "6"], "n_coefficients"),
+        (["camera", "variation", "a.yml", "b.yml"], "--calibrated-at"),
+    ],
+)
+def test_errors_are_one_line(argv, words):
+    rc, _, err = run(argv)
+    assert rc == 2, err
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert len(lines) == 1 and words in lines[0], err
+
+
+def test_setup_flags_reach_the_setup(cooke, sensor):
+    """The same plane through the CLI words and the API keywords gives the same camera."""
+    g = CameraSetup(sensor, from_last_vertex=43.5).resolve(cooke)
+    rc, out, err = run([*BASE, "--from-last-vertex", "43.5", "--json"])
+    assert rc == 0, err
+    got = json.loads(out)["geometry"]["from_last_vertex_mm"]
+    assert got == pytest.approx(g.from_last_vertex, abs=1e-12)
+
+
+def test_plots_keep_the_ax_convention(cooke, sensor):
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    from orthoscope.plots.camera import (
+        plot_calibration_comparison,
+        plot_camera_residuals,
+        plot_difference_map,
+        plot_distortion_picture,
+        plot_radial_comparison,
+    )
+
+    tc = camera_model(cooke, sensor, "opencv", grid=(9, 7))
+    measured = tc.camera.replace(k1=1.1 * tc.camera["k1"], cx=tc.camera["cx"] + 2.0)
+    cmp = compare_calibration(cooke, measured, sensor, grid=(9, 7))
+    makers = [
+        lambda ax: plot_camera_residuals(tc, ax=ax),
+        lambda ax: plot_radial_comparison(cmp, ax=ax),
+        lambda ax: plot_difference_map(cmp, ax=ax),
+    ]
+    try:
+        import cv2  # noqa: F401
+
+        makers.append(lambda ax: plot_distortion_picture(tc.camera, reference=True, ax=ax))
+    except ImportError:
+        pass
+    for make in makers:
+        fig = Figure()
+        ax = fig.subplots()
+        assert make(ax) is fig
+        new = make(None)
+        assert new in [plt.figure(n) for n in plt.get_fignums()]
+        plt.close("all")
+    two = plot_calibration_comparison(cmp)
+    assert len([a for a in two.axes if a.get_label() != "<colorbar>"]) == 2
+    plt.close("all")
