@@ -93,6 +93,7 @@ class ClearAperture:
             return f"circle r {self.half_x:g}{off}"
         return f"{self.shape} {self.half_x:g} x {self.half_y:g}{off}"
 
+
 @dataclass(frozen=True)
 class Surface:
     """One refracting surface.
@@ -446,9 +447,7 @@ class Lens:
                 s,
                 placement=None,
                 after="stay",
-                aperture=None
-                if s.aperture is None
-                else replace(s.aperture, x0=0.0, y0=0.0),
+                aperture=None if s.aperture is None else replace(s.aperture, x0=0.0, y0=0.0),
             )
             for s in self.surfaces
         )

@@ -206,10 +206,12 @@ def placement_table(lens: Lens) -> tuple[np.ndarray, bool]:
     """(geo, extra): the placement table of ``lens`` (module docstring) and whether it holds the
     image-frame pseudo-surface as its last row."""
     ss = lens.surfaces
-    n = len(ss)
     zv = np.asarray(lens.vertex_z, dtype=np.float64)
-    if lens.is_centred and not lens.has_mirrors and all(s.aperture is None for s in ss) and not any(
-        s.coordinate_break for s in ss
+    if (
+        lens.is_centred
+        and not lens.has_mirrors
+        and all(s.aperture is None for s in ss)
+        and not any(s.coordinate_break for s in ss)
     ):
         return coaxial_geo(zv), False
     fr = surface_frames(lens)

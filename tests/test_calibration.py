@@ -108,7 +108,8 @@ def test_calibration_changes_nothing_physical(paper_cal):
 
 def test_report_text_contains_table2(paper_cal):
     text = format_calibration(paper_cal, layout="paper")
-    assert "154.059" in text
+    assert "154.059" in text  # Table II heading: F_c = 154.059 mm
+    # Table II as printed: Y_c' at 10 deg, D_c at 10 and 20 deg, Y_c' and D_c at 37.5 deg
     for v in ("27.165", "-0.045", "-0.041", "118.214", "+0.081"):
         assert v in text
 
@@ -323,6 +324,7 @@ def test_table_reader_infers_constant_and_roundtrips(tmp_path, table1):
     )  # 100 tan 10° = 17.633, 100 tan 20° = 36.397
     assert c.field_kind == "angle" and not c.finite
     inferred = read_distortion_table(DATA / "pestrecov_table1.csv")
+    # Table I heading F0 = 153.706 mm, to half a unit of its last digit (measured: 1.1e-4 mm)
     assert abs(inferred.constant - F0_TABLE1) <= 0.0005
     # CSV writer -> reader round trip, and the finite (height) table kind
     from distortion.tablefile import dumps_table
@@ -341,4 +343,5 @@ def test_table_reader_infers_constant_and_roundtrips(tmp_path, table1):
     assert d["F0"] == F0_TABLE1 and len(d["D0_mm"]) == 10
     paper = format_curve(table1, layout="paper")
     rows = format_curve(table1, layout="rows")
+    # Table I as printed: F0 = 153.706 mm, D0 = +0.355 mm at 40 deg
     assert "153.706" in paper and "+0.355" in paper and len(rows.splitlines()) == 14

@@ -85,7 +85,7 @@ def test_prescription_mode_csv_and_roundtrip(capsys, tmp_path):
     # the written profiles read back in data mode give the same g (same radii: no resampling)
     rc, out2, _ = run(capsys, "variation", prof, "--csv")
     g2 = [float(r.split(",")[3]) for r in out2.strip().splitlines()[1:]]
-    np.testing.assert_allclose(g2, g, rtol=1e-6)
+    np.testing.assert_allclose(g2, g, rtol=1e-8)  # measured 6.8e-10 (the CSV's printed digits)
 
 
 def test_prescription_mode_text_json_and_plots(capsys, tmp_path):
@@ -186,8 +186,10 @@ def test_coefficients_from_csv_recovers_polynomial(capsys, tmp_path):
     )
     d = json.loads(out)
     assert rc == 0
-    assert d["gaussian_fit"]["K1"] == pytest.approx(k1, rel=1e-8)
-    assert d["gaussian_fit"]["K2"] == pytest.approx(k2, rel=1e-6)
+    # measured: K1 to 2.2e-16, K2 to 1.6e-15 relative, K3 5e-27; bounds ~10x that
+    assert d["gaussian_fit"]["K1"] == pytest.approx(k1, rel=1e-14)
+    assert d["gaussian_fit"]["K2"] == pytest.approx(k2, rel=2e-14)
+    assert abs(d["gaussian_fit"]["K3"]) < 1e-25
     cv = d["opencv"]
     assert cv["fx_px"] == pytest.approx(70 / 0.005)
     assert len(cv["dist_coeffs"]) == 5 and cv["dist_coeffs"][2:4] == [0.0, 0.0]
@@ -210,8 +212,9 @@ def test_coefficients_traced(capsys):
     assert rc == 0
     c = d["profile"]["principal_distance_mm"]
     # Gaussian plane of 12x: principal distance F0 = p0'/m_e = m0 p0 ≈ f (1 + 1/12) = 70.4 mm
-    # when the pupils are near the principal planes (Super-Angulon: nearly symmetric).
-    assert c == pytest.approx(65 * 13 / 12, rel=0.05)
+    # when the pupils are near the principal planes (Super-Angulon: nearly symmetric). Measured:
+    # c = 70.598 mm, 0.26 % above f (1 + 1/12); tolerance 3 %, ~10x that.
+    assert c == pytest.approx(65 * 13 / 12, rel=0.03)
     assert d["opencv"]["pixel_pitch_um"] == pytest.approx(c / 10000 * 1000)
     assert d["gaussian_fit"]["rms_um"] < 1.0
     rc, out, _ = run(capsys, "coefficients", *S65, "--focus", "12x", "--max-field", "40")

@@ -25,7 +25,7 @@ M2 = -2.5  # made-up printer magnification (negative -> print)
 
 @pytest.fixture(scope="module")
 def camera():
-    return read_distortion_table(DATA / "pestrecov_table1.csv", 153.706)
+    return read_distortion_table(DATA / "pestrecov_table1.csv", 153.706)  # Table I: F0 = 153.706
 
 
 def matched_printer(camera: DistortionCurve, D2, M2: float = M2) -> DistortionCurve:
@@ -56,7 +56,8 @@ def test_identical_curves_compensate(camera):
 
 
 def test_residual_is_eq16_and_print_is_invariant_under_recalibration(camera):
-    # a printer that compensates only the cubic part of the camera's curve
+    # a printer that compensates only the cubic part of the camera's curve (a synthetic curve
+    # through Table I's D0 = 0.272 mm at y0' = F0 = 153.706 mm, 45 deg; not a reference value)
     y = camera.yp
     printer = matched_printer(camera, 0.272 * (y / 153.706) ** 3)
     base = compensate(camera, printer, method="given", magnification=M2 * 1.001)
@@ -67,6 +68,7 @@ def test_residual_is_eq16_and_print_is_invariant_under_recalibration(camera):
     assert base.max_abs > 1e-3
     # recalibrate both curves with arbitrary F1', M2' (Eq. 11); the print's ideal size M F1 tan α
     # is fixed (y'' = M F1 tan α = M' F1' tan α) -> M' = M F1 / F1'
+    # arbitrary constants (154.059 = Table II's F_c, the others made up)
     for F1p, M2p in ((154.059, -2.49), (153.0, -2.6), (155.5, -2.5)):
         cam2 = recalibrated(camera, F1p)
         # printer recalibrated in its own space: print heights fixed, new M2'

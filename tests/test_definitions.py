@@ -9,7 +9,7 @@ y_ideal)/y_ideal). optiland aims the chief ray at the PARAXIAL entrance pupil by
 through the centre of the real stop. For the agreement test optiland's iterative aimer is set
 (tolerance 1e-14 mm at the stop), so both programs trace the same ray; the default paraxial aim is
 reproduced separately (test_optilands_default_paraxial_aim_is_reproduced), which bounds the
-difference: e.g. 0.039 % of Dr at 20° for the Cooke triplet, 0.14 % at 45° for the Topogon-like.
+difference: e.g. 0.039 % of Dr at 20° for the Cooke triplet, 0.11 % at 45° for the Topogon-like.
 """
 
 from __future__ import annotations
@@ -55,7 +55,10 @@ REAL = (
     "rayoptics/US00583336-2-scaled.zmx",
 )
 N_POINTS = 11
-REL_TOL = 1e-9  # the issue's agreement target (relative to the largest |Dr|)
+# agreement with optiland relative to the largest |Dr|: the issue's target was 1e-9; measured
+# today (optiland 0.6.3) at most 3.8e-12 over every lens, definition and wavelength below, so the
+# bound is ~10x that
+REL_TOL = 4e-11
 
 
 def _lens(name: str) -> Lens:
@@ -154,8 +157,8 @@ def test_optilands_default_paraxial_aim_is_reproduced(name):
     assert np.max(np.abs(dr_paraxial_aim - ref)) <= REL_TOL * np.max(np.abs(ref))
     real = 100.0 * projection_distortion(lens, theta, plane="file", clip=False).Dr[0, 0]
     aim_effect = np.max(np.abs(real - ref))
-    # measured: 0.039 % (Cooke, 20°), 0.14 % (Topogon-like, 45°): the reason the agreement test
-    # sets optiland's iterative (real-stop) aim
+    # measured: 0.039 % (Cooke, 20°), 0.114 % (Topogon-like, 45°) of Dr, absolute: the reason
+    # the agreement test sets optiland's iterative (real-stop) aim
     assert 1e-4 < aim_effect < 0.5
 
 

@@ -88,3 +88,36 @@ def test_readme_python_blocks_run(monkeypatch, tmp_path):
     matplotlib.use("Agg")
     for block in _readme_blocks("python"):
         exec(compile(block, "README.md", "exec"), {})
+
+
+def _task_table() -> list[tuple[str, list[str]]]:
+    """(task, Python snippets) of the README's task table (the column after the command line)."""
+    text = README.read_text(encoding="utf-8")
+    head = "| task | command line | Python (`import orthoscope as osc`) |"
+    rows = text.split(head, 1)[1].split("\n\n", 1)[0].strip().splitlines()[1:]
+    out = []
+    for row in rows:
+        cells = [c.strip() for c in row.strip("|").split(" | ")]
+        out.append((cells[0], re.findall(r"`([^`]+)`", cells[-1])))
+    return out
+
+
+def test_readme_task_table_runs(monkeypatch, tmp_path):
+    """Every Python cell of the task table runs, in order, in one namespace (each task in at most
+    three statements after ``import orthoscope as osc``)."""
+    monkeypatch.chdir(tmp_path)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tasks = _task_table()
+    assert len(tasks) >= 10
+    ns: dict = {}
+    exec("import orthoscope as osc\nimport matplotlib.pyplot as plt", ns)
+    for task, snippets in tasks:
+        statements = [s for snip in snippets for s in snip.split("; ")]
+        assert 1 <= len(statements) <= 3, task
+        for snip in snippets:
+            exec(compile(snip, f"README task {task!r}", "exec"), ns)
+    plt.close("all")

@@ -131,7 +131,11 @@ def test_after_modes():
     base = dict(curvature=0.0, thickness=t)
 
     def frames(after):
-        ss = (Surface(**base, stop=True), Surface(**base, placement=p, after=after), Surface(**base))
+        ss = (
+            Surface(**base, stop=True),
+            Surface(**base, placement=p, after=after),
+            Surface(**base),
+        )
         from raytrace.lens import Aperture, Field, Lens
 
         return surface_frames(Lens("t", ss, Aperture("epd", 1.0), Field("angle", 0.0)))
@@ -174,7 +178,6 @@ def test_codev_frames_equal_rayoptics(rel):
     pytest.importorskip("rayoptics")
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import referees
-
     from rayoptics.elem.transform import compute_global_coords
 
     lens = _read(rel)
@@ -299,3 +302,31 @@ def test_invalid_placements_are_refused():
         Surface(0.0, 1.0, after="dar")
     # a zero move is no move (equal lenses, one hash)
     assert Surface(0.0, 1.0, placement=Placement()) == Surface(0.0, 1.0)
+
+
+def test_meridional_aim_of_a_lens_symmetric_about_its_y_z_plane():
+    # the Cooke triplet with its last element decentered in y: the meridional aim (1-D) reaches
+    # the stop centre for signed fields (no mirror symmetry y -> -y any more) and agrees with the
+    # 2-D aim; decentered in x, the stop centre is off the meridional plane: AIM_FAILED, never a
+    # silent number
+    from raytrace.kernels.codes import STATUS_AIM_FAILED
+    from raytrace.trace import chief_rays
+    from raytrace.trace.chief2d import chief_rays_2d
+
+    lens = load_lens("cooke-triplet-f4")
+    ss = list(lens.surfaces)
+    for k in (4, 5):
+        ss[k] = replace(ss[k], placement=Placement((0.0, 0.1, 0.0)), after="return")
+    dy = replace(lens, surfaces=tuple(ss))
+    f = np.array([-15.0, -5.0, 0.0, 5.0, 15.0])
+    one = chief_rays(dy, f, clip=False)
+    two = chief_rays_2d(dy, np.zeros_like(f), f, clip=False)
+    assert np.all(one.ok)
+    assert np.max(np.abs(one.heights_at(dy.image_z) - two.positions_at(dy.image_z)[:, 1])) <= 1e-9
+    assert abs(one.heights_at(dy.image_z)[0] + one.heights_at(dy.image_z)[-1]) > 1e-6  # asymmetric
+    ss = list(lens.surfaces)
+    for k in (0, 1):  # the first element, before the stop
+        ss[k] = replace(ss[k], placement=Placement((0.1, 0.0, 0.0)), after="return")
+    dx = replace(lens, surfaces=tuple(ss))
+    cr = chief_rays(dx, [5.0], clip=False)
+    assert cr.status[0] == STATUS_AIM_FAILED and np.isnan(cr.y_last[0])

@@ -73,9 +73,17 @@ def test_corpus_chief_rays_agree_with_optiland(rel):
 #: per surface (0-based): (dx, dy, tilt about x, tilt about y), degrees; one tilt per surface so
 #: that optiland's Rz Ry Rx and our Rx Ry Rz coincide
 MOVES = {
-    "tessar-fr1066698": {2: (0.0, 0.08, 0.3, 0.0), 3: (0.0, 0.08, 0.0, 0.0), 5: (-0.05, 0.0, 0.0, 0.4)},
-    "topogon-us2031792-fig1": {0: (0.06, 0.0, 0.0, -0.3), 1: (0.06, 0.0, 0.0, 0.0), 6: (0.0, -0.04, 0.5, 0.0)},
-}  # fmt: skip
+    "tessar-fr1066698": {
+        2: (0.0, 0.08, 0.3, 0.0),
+        3: (0.0, 0.08, 0.0, 0.0),
+        5: (-0.05, 0.0, 0.0, 0.4),
+    },
+    "topogon-us2031792-fig1": {
+        0: (0.06, 0.0, 0.0, -0.3),
+        1: (0.06, 0.0, 0.0, 0.0),
+        6: (0.0, -0.04, 0.5, 0.0),
+    },
+}
 
 
 def _moved(name):

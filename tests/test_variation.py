@@ -303,21 +303,26 @@ def test_pentax_table1_one_focus_setting():
     assert len(ps.profiles) == 4
     a = analyze_variation(ps)
     assert a.focus_summaries == () and a.brown == ()
-    # image scales N = s/f − 1: the paper's "approximately 33x, 45x, 56x, 75x" and "175x"
+    # image scales N = s/f − 1 (thin lens, unit focusing): 1500/45 − 1 = 32.3, 2100/45 − 1 =
+    # 45.7, 2600/45 − 1 = 56.8, 3400/45 − 1 = 74.6 — analytic; the paper's text rounds them to
+    # "approximately 33x, 45x, 56x, and 75x" (and 8000/45 − 1 = 176.8 to "175x"), i.e. the
+    # expected list below is our formula, within ±1 of the paper's approximate values
     scales = [g.scale_object for g in a.gammas]
     assert [round(s) for s in scales] == [32, 46, 57, 75]
+    assert max(abs(s - p) for s, p in zip(scales, (33, 45, 56, 75), strict=True)) < 1.0
     assert a.gammas[0].scale_focus == pytest.approx(8000 / 45 - 1)
     assert all(1.0 < g.gamma < 1.03 for g in a.gammas)
     # within-field variation: Table 1 at r = 28 mm, 369.5 (2.1 m) − 362.3 (3.4 m) = 7.2 µm
     fv = a.field_variation[0]
     assert fv.r_mm[-1] == 28.0
     assert fv.spread_um[-1] == pytest.approx(369.5 - 362.3)
-    assert fv.spread_um[0] == pytest.approx(2.5 - 2.4)
+    assert fv.spread_um[0] == pytest.approx(2.5 - 2.4)  # Table 1 at r = 4 mm: 2.5 (2.1 m) − 2.4
     text = " ".join(a.messages)
     assert "one focus setting only (8 m)" in text
     assert "g_ss' needs profiles at two focus settings" in text
     assert "no g_ss' could be determined" in text
     implied = brown_implied_gaussian(a)
+    # Table 1, r = 28 mm, object plane 1.5 m: 368.8 um
     assert implied["1.5 m (8 m)"][-1] == pytest.approx(368.8 * a.gammas[0].gamma)
     json.dumps(variation_to_dict(a), allow_nan=False)
 

@@ -102,13 +102,14 @@ def test_non_gaussian_plane_is_the_focus_plane(s65_study):
 
 def test_common_grid_interpolation_error_is_small(s65):
     # The spline of the 121-field trace, evaluated at the radii of the fields halfway between
-    # its samples, against a trace at those fields (the module docstring's claim: < 1e-4 µm).
+    # its samples, against a trace at those fields (the module docstring's claim: < 1e-4 µm;
+    # measured 2.1e-6 µm, bound ~10x that).
     dense = np.linspace(0, 45, 241)
     st = trace_setting(s65, Conjugate.scale(12), Conjugate.scale(8), dense[::2])
     mid = trace_setting(s65, Conjugate.scale(12), Conjugate.scale(8), dense[1::2])
     r, d = st.valid()
     pred = CubicSpline(r, d)(mid.r_mm[1:-1])
-    assert np.max(np.abs(pred - mid.dr_um[1:-1])) < 1e-4
+    assert np.max(np.abs(pred - mid.dr_um[1:-1])) < 2e-5
 
 
 def test_s65_prediction_g_between_0_and_1(s65_study):
@@ -141,7 +142,8 @@ def test_s65_brown_eq1_worse_than_eq6(s65_study):
 def test_brown_eq3_4_on_traced_profiles_converges_quadratically(s65):
     # Brown's Eq. (3)-(4) is linear interpolation in t = 1/N (variation.py docstring), exact
     # for δr = A(r) + B(r) t. For a smooth δr(t) the error is f''(t)/2 (t - t1)(t - t2): halving
-    # a symmetric bracket t ± h must divide it by 4 (Taylor; tolerance 10 % for the h^4 term).
+    # a symmetric bracket t ± h must divide it by 4 (Taylor; the h^4 term makes it 4.011 here,
+    # measured; tolerance 3 %, ~10x that).
     fields = np.linspace(0, 40, 81)
     grid = np.linspace(3, 55, 20)
 
@@ -157,7 +159,7 @@ def test_brown_eq3_4_on_traced_profiles_converges_quadratically(s65):
         n1, n2 = 1 / (t + h), 1 / (t - h)
         a = brown_alpha_scales(12, n1, n2)
         errs.append(np.max(np.abs(a * gauss(n1) + (1 - a) * gauss(n2) - truth)))
-    assert errs[0] / errs[1] == pytest.approx(4.0, rel=0.1)
+    assert errs[0] / errs[1] == pytest.approx(4.0, rel=0.03)
 
 
 def test_s65_interpolation_checks_reported(s65_study):

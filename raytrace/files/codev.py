@@ -300,7 +300,8 @@ class _SeqParser:
                     raise self.err(f"REFL on {cmd}: only a lens surface (S) can be a mirror", line)
                 if cur.refl and rest:
                     raise self.err(
-                        f"REFL with a glass ({rest[0]}): a mirror returns the light into the medium "
+                        f"REFL with a glass ({rest[0]}): a mirror returns the light into the "
+                        "medium "
                         "before it; write the glass on the surfaces around the mirror",
                         line,
                         len(surfs),
@@ -315,8 +316,10 @@ class _SeqParser:
                 if cur is None or cur.kind != "S":
                     raise self.err("STO must follow a surface line (S r t glass)", line)
                 cur.stop = True
-            elif cmd in ("SLB", "ASP", "CON", "SPH", "K", "PIM") or cmd in _APERTURES or (
-                cmd in _ASPH_LETTERS and len(cmd) == 1
+            elif (
+                cmd in ("SLB", "ASP", "CON", "SPH", "K", "PIM")
+                or cmd in _APERTURES
+                or (cmd in _ASPH_LETTERS and len(cmd) == 1)
             ):
                 if cur is None:
                     raise self.err(f"{cmd} before the first surface line", line)
@@ -490,7 +493,9 @@ class _SeqParser:
         rect = "REX" in a or "REY" in a
         ell = "ELX" in a or "ELY" in a
         if rect and ell:
-            raise self.err("REX/REY and ELX/ELY on one surface: give one aperture shape", s.line, no)
+            raise self.err(
+                "REX/REY and ELX/ELY on one surface: give one aperture shape", s.line, no
+            )
         if rect or ell:
             kx, ky = ("REX", "REY") if rect else ("ELX", "ELY")
             hx = a.get(kx, a.get(ky))

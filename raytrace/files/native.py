@@ -654,7 +654,9 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
         try:
             lens = replace(lens, field=field_for_image_height(lens, height, kind))
         except (LensError, TraceError, ValueError) as e:
-            raise src.error(f"field {kind} = {height!r}: {e}", src.key_line("field", kind))
+            raise src.error(
+                f"field {kind} = {height!r}: {e}", src.key_line("field", kind)
+            ) from None
     return lens
 
 
@@ -670,7 +672,9 @@ def _field(src: _Source, data: dict[str, Any], finite: bool) -> tuple[Field, Any
     given = [k for k in _FIELD_KEYS if k in t]
     if len(given) != 1:
         got = ", ".join(given) if given else "none"
-        raise src.error(f"[field] needs exactly one of {wanted} (got: {got})", src.key_line("field"))
+        raise src.error(
+            f"[field] needs exactly one of {wanted} (got: {got})", src.key_line("field")
+        )
     kind = given[0]
     line = src.key_line("field", kind)
     value = _number(src, t[kind], f"field {kind}", line)
@@ -811,8 +815,11 @@ def _surfaces(src: _Source, data: dict[str, Any], object_material: Material = AI
                 line,
                 no,
             )
-        if srf.material.is_air and t * direction < 0.0 and not placed and not any(
-            x.mirror for x in out
+        if (
+            srf.material.is_air
+            and t * direction < 0.0
+            and not placed
+            and not any(x.mirror for x in out)
         ):
             raise src.error(f"air thickness must not be negative, got t = {t!r}", line, no)
 
@@ -925,7 +932,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
             after = a
         else:
             raise src.error(
-                f'after must be one of {", ".join(AFTER_MODES)} or {{ decenter = [...], tilt = '
+                f"after must be one of {', '.join(AFTER_MODES)} or {{ decenter = [...], tilt = "
                 f"[...], order = ... }}, got {a!r}",
                 line,
                 no,
@@ -935,9 +942,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
         raise src.error(f"mirror must be true or false, got {mirror!r}", line, no)
     kind = e.get("type", "surface")
     if kind not in ("surface", "coordinate_break"):
-        raise src.error(
-            f'type must be "surface" or "coordinate_break", got {kind!r}', line, no
-        )
+        raise src.error(f'type must be "surface" or "coordinate_break", got {kind!r}', line, no)
     cb = kind == "coordinate_break"
     if cb and (curvature != 0.0 or mirror or stop or conic or asph or math.isfinite(sd)):
         raise src.error(
@@ -1203,11 +1208,7 @@ def _geometry_cells(s: Surface) -> list[tuple[str, str] | None]:
     if ap is None:
         cells.append(None)
     else:
-        size = (
-            repr(ap.half_x)
-            if ap.shape == "circle"
-            else _list((ap.half_x, ap.half_y))
-        )
+        size = repr(ap.half_x) if ap.shape == "circle" else _list((ap.half_x, ap.half_y))
         body = f"{ap.shape} = {size}"
         if ap.x0 or ap.y0:
             body += f", center = {_list((ap.x0, ap.y0))}"

@@ -169,7 +169,7 @@ class _LenParser:
                 k = 1 if cmd == "WV" else int(cmd[2:]) if cmd[2:].isdigit() else 0
                 if k == 0:
                     raise self.err(f"{cmd}: expected WV or WVn", lineno)
-                for j, a in enumerate(args):
+                for j in range(len(args)):
                     wvs[k + j] = (self.num(args, j, cmd, lineno), lineno)
                 continue
             if cmd == "WW":

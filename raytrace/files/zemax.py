@@ -538,16 +538,14 @@ class _ZmxParser:
             return z.parm.get(i, (0.0, 0))[0]
 
         order = ORDERS[0] if parm(6) == 0.0 else ORDERS[1]
-        for i, (v, line) in z.parm.items():
+        for i, (_v, line) in z.parm.items():
             if not 1 <= i <= 6:
                 raise self.err(f"COORDBRK PARM {i}: a coordinate break has PARM 1 to 6", line)
         if z.stop:
             raise self.err("STOP on a coordinate break: the stop must be a lens surface", z.line)
         if z.mirror or z.glas is not None:
             self.warn(f"line {z.line}: GLAS on a coordinate break (surface {z.number}) ignored")
-        p = Placement(
-            (parm(1) * scale, parm(2) * scale, 0.0), (parm(3), parm(4), parm(5)), order
-        )
+        p = Placement((parm(1) * scale, parm(2) * scale, 0.0), (parm(3), parm(4), parm(5)), order)
         return Surface(
             curvature=0.0,
             thickness=z.disz * scale,
@@ -854,7 +852,9 @@ class _ZmxParser:
             try:
                 lens = replace(lens, field=field_for_image_height(lens, height, kind))
             except (LensError, TraceError, ValueError) as e:
-                raise self.err(f"FTYP {ft} ({kind.replace('_', ' ')} {height:g} mm): {e}", line)
+                raise self.err(
+                    f"FTYP {ft} ({kind.replace('_', ' ')} {height:g} mm): {e}", line
+                ) from None
         return ImportResult(lens, tuple(self.warnings))
 
 
@@ -1002,7 +1002,7 @@ def dumps_zmx(lens: Lens) -> str:
     def coordbrk(p: Placement, thickness: float) -> None:
         surf()
         out.append("  TYPE COORDBRK")
-        out.append('  CURV 0.0 0 0.0 0.0 0')
+        out.append("  CURV 0.0 0 0.0 0.0 0")
         order = 0 if p.order == "decenter-tilt" else 1
         vals = (p.decenter[0], p.decenter[1], *p.tilt, order)
         for j, v in enumerate(vals, start=1):

@@ -7,8 +7,10 @@ decentered or tilted stop is aimed at its centre. A rotationally symmetric lens 
 ``L_SYMMETRIC``) aims |field| and mirrors negative fields, with the zero field on the axis; any
 other lens aims each signed field by continuation from the zero field, which is solved too. A
 meridional ray can only reach the stop centre of a lens symmetric about the y-z plane (decenters
-in y, tilts about x): where the aimed ray meets the stop off the y axis by more than the
-tolerance, the field is AIM_FAILED (use the 2-D aim of :mod:`.aim2d`).
+in y, tilts about x) up to the stop: where the aimed ray meets the stop off the y axis by more
+than the tolerance, the field is AIM_FAILED (use the 2-D aim of :mod:`.aim2d`). The outputs keep
+y, z, M, N of the rays; behind the stop of a lens that is not symmetric about its y-z plane the
+ray also has x and L components, which the 2-D aim reports.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from .surface import trace_span
 AIM_MAXIT = 60
 AIM_MAX_HALVINGS = 40
 AIM_MAX_EVALS = 1500
+
 
 @kernel(error_model="numpy", inline="always")
 def _start_ray(finite, z_obj, f, u):

@@ -370,4 +370,3 @@ def transfer_to_plane(x, y, z, L, M, N, z_plane):
         ox[i] = x[i] + t * L[i]
         oy[i] = y[i] + t * M[i]
     return ox, oy
-

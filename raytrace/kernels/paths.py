@@ -50,8 +50,14 @@ def trace_paths(kind, c, k, asph, geo, n_in, n_out, sd, clip, x, y, z, L, M, N, 
                 a = G_ABS
                 px[i, j] = geo[j, a] * xi + geo[j, a + 1] * yi + geo[j, a + 2] * zi + geo[j, G_ABST]
                 py[i, j] = (
-                    geo[j, a + 3] * xi + geo[j, a + 4] * yi + geo[j, a + 5] * zi + geo[j, G_ABST + 1]
+                    geo[j, a + 3] * xi
+                    + geo[j, a + 4] * yi
+                    + geo[j, a + 5] * zi
+                    + geo[j, G_ABST + 1]
                 )
                 pz[i, j] = (
-                    geo[j, a + 6] * xi + geo[j, a + 7] * yi + geo[j, a + 8] * zi + geo[j, G_ABST + 2]
+                    geo[j, a + 6] * xi
+                    + geo[j, a + 7] * yi
+                    + geo[j, a + 8] * zi
+                    + geo[j, G_ABST + 2]
                 )

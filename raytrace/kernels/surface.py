@@ -49,10 +49,9 @@ Clear apertures (``F_APERTURE``, clipping on): circle / rectangle / ellipse of h
 (hx, hy) about (x0, y0) in the surface frame, besides the semi-diameter about the vertex.
 
 Status codes: OK 0, MISSED 1, TIR 2, CLIPPED 3 (outside the semi-diameter or clear aperture, when
-clipping is on), AIM_FAILED 4. A failed ray carries the 1-based number of the surface where it failed and NaN
-coordinates; every ray gets a status.
+clipping is on), AIM_FAILED 4. A failed ray carries the 1-based number of the surface where it
+failed and NaN coordinates; every ray gets a status.
 """
-
 
 from __future__ import annotations
 
@@ -66,9 +65,9 @@ from .codes import (
     F_SKIP,
     G_AP,
     G_FLAGS,
+    G_LENS,
     G_REL,
     G_RELT,
-    G_LENS,
     G_ZV,
     KIND_PLANE,
     KIND_QUADRIC,

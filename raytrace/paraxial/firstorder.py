@@ -26,7 +26,6 @@ the light) has a positive focal length. A lens that is not centred (decenters, t
 ``lens.nominal()`` gives the centred lens without its moves.
 """
 
-
 from __future__ import annotations
 
 import math

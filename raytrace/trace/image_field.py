@@ -64,10 +64,10 @@ def real_image_height(lens: Lens, field: float, kind: str) -> float:
     """Height (mm, y in the image frame) of the real chief ray of the meridional ``field``
     (degrees for ``kind="angle"``, mm for ``"height"``) on the lens's image surface; NaN when it
     cannot be traced."""
+    import numpy as np
+
     from .chief import aim
     from .chief2d import aim_2d
-
-    import numpy as np
 
     od = lens.object_distance
     if _symmetric_in_x(lens):
