@@ -155,7 +155,9 @@ def main() -> None:
         trees = {"A": a, "B": b}
         try:
             for t in trees.values():  # compile once, byte-compile the sources: warm caches
-                pkgs = [str(t / p) for p in ("raytrace", "distortion", "orthoscope") if (t / p).is_dir()]
+                pkgs = [
+                    str(t / p) for p in ("raytrace", "distortion", "orthoscope") if (t / p).is_dir()
+                ]
                 subprocess.run([sys.executable, "-m", "compileall", "-q", *pkgs], check=False)
                 _run_child(t, tmp)
             cli_cmds = {

@@ -24,8 +24,8 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from raytrace.kernels import bulk as K
 from raytrace.files.library import load_lens
+from raytrace.kernels import bulk as K
 from raytrace.packing import pack
 from raytrace.trace import chief_rays, trace_rays
 

@@ -46,8 +46,8 @@ CORPUS = ROOT / "tests" / "data" / "corpus"
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-#: file suffixes counted as lens files (lower case); OSLO .len is in the corpus on purpose: it is
-#: a real format orthoscope does not read, and must be refused with a PrescriptionError.
+#: file suffixes counted as lens files (lower case): Zemax, CODE V, OSLO (.len) and Zemax
+#: archives (.zar, refused with a PrescriptionError that says to unpack them).
 LENS_SUFFIXES = (".zmx", ".seq", ".len", ".zar")
 
 #: refusal groups, in the order they are tried on the PrescriptionError message (case-insensitive)

@@ -45,6 +45,7 @@ if TYPE_CHECKING:
 METHODS = ("two-point", "minimax", "least-squares", "zero-at", "given")
 CRITERIA = METHODS  # the paper's word; same tuple
 
+
 def match_fields(fields: np.ndarray, at, what: str) -> list[int]:
     """Indices of the ``at`` field values among ``fields`` (CalibrationError naming ``what``)."""
     lo, hi = float(np.min(fields)), float(np.max(fields))

@@ -56,7 +56,15 @@ from raytrace.paraxial import (
     pestrecov_constants,
 )
 
-from .curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
+from .curve import (
+    ANGLE,
+    HEIGHT,
+    DistortionCurve,
+    FieldKindMixin,
+    fields_and_abscissa,
+    plane_label,
+    relative_distortion,
+)
 
 REFERENCES = ("characteristic", "distortion-focal-length", "real-chief-transport")
 DFL_EPSILON = 1e-3  # near-axis reference field as a fraction of the largest |field|
@@ -66,7 +74,7 @@ SCALES = ("reference", "own")
 
 
 @dataclass(frozen=True, eq=False)
-class CharacteristicDistortion:
+class CharacteristicDistortion(FieldKindMixin):
     """Distortion of one lens and object distance in several image planes (arrays: planes × fields).
 
     name: lens name; reference: one of ``REFERENCES``; field_kind: ``"angle"``, ``"height"`` or
@@ -113,25 +121,11 @@ class CharacteristicDistortion:
     scale_basis: str = ""
 
     @property
-    def finite(self) -> bool:
-        return self.field_kind != ANGLE
-
-    @property
-    def symbol(self) -> str:
-        return "M" if self.finite else "F"
-
-    @property
     def n_planes(self) -> int:
         return int(self.z_planes.size)
 
     def plane_label(self, i: int) -> str:
-        d = self.defocus[i]
-        g = (
-            "Gaussian plane"
-            if abs(d) <= 1e-9 * max(1.0, abs(self.s_prime[i]))
-            else f"defocus {d:+.4f} mm"
-        )
-        return f"s' = {self.s_prime[i]:.4f} mm ({g})"
+        return plane_label(self.s_prime[i], self.defocus[i])
 
     def __repr__(self) -> str:
         unit = "mm" if self.field_kind == HEIGHT else "deg"
@@ -258,7 +252,13 @@ def characteristic_distortion(
         For impossible requests (a plane before the last vertex, heights with an object at
         infinity, an unknown reference, ...).
     """
-    from raytrace.paraxial import image_planes, paraxial, plane_z, resolve_object_distance
+    from raytrace.paraxial import (
+        checked_wavelength,
+        image_planes,
+        paraxial,
+        plane_z,
+        resolve_paraxial,
+    )
     from raytrace.trace import aim
 
     if reference not in REFERENCES:
@@ -270,33 +270,9 @@ def characteristic_distortion(
     chromatic = wavelengths is not None
     if chromatic and wavelength is not None:
         raise TraceError("give wavelength= or wavelengths=, not both")
-    wl = None if chromatic else _wavelength(wavelength)
-    od = resolve_object_distance(
-        lens,
-        object_distance=object_distance,
-        object_s=object_s,
-        object_scale=object_scale,
-        wavelength=wl,
-    )
-    par = paraxial(lens, object_distance=od, wavelength=wl)
-    if fields_deg is not None and object_heights_mm is not None:
-        raise TraceError("give fields_deg or object_heights_mm, not both")
-    if object_heights_mm is not None:
-        fk = "height"
-        f = np.atleast_1d(np.asarray(object_heights_mm, dtype=float)).ravel()
-    elif fields_deg is not None:
-        fk = "angle"
-        f = np.atleast_1d(np.asarray(fields_deg, dtype=float)).ravel()
-    else:
-        fk = lens.field.kind if not (par.infinite and lens.field.kind == "height") else "angle"
-        f = np.linspace(0.0, lens.field.value, 11)
-    if f.size == 0:
-        raise TraceError("no fields given")
-    infinite = par.infinite
-    if fk == "height" and infinite:
-        raise TraceError("object heights need a finite object distance")
-    kind = ANGLE if infinite else (HEIGHT if fk == "height" else NOMINAL_ANGLE)
-    x = orthoscopy_abscissa(par, f, fk)
+    wl = None if chromatic else checked_wavelength(wavelength)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wl)
+    fk, f, kind, x = fields_and_abscissa(lens, par, fields_deg, object_heights_mm)
     planes = image_planes(
         plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus
     )
@@ -339,18 +315,6 @@ def characteristic_distortion(
     )
 
 
-def _wavelength(value) -> float | None:
-    """A wavelength keyword (nm) through the one check, :func:`raytrace.units.wavelength_nm`."""
-    if value is None:
-        return None
-    from raytrace.units import UnitError, wavelength_nm
-
-    try:
-        return wavelength_nm(value)
-    except UnitError as e:
-        raise TraceError(str(e)) from None
-
-
 def _build(
     *, lens, par, cr, cr_scale, basis, reference, fk, kind, f, x, z, extra, clip
 ) -> CharacteristicDistortion:
@@ -391,9 +355,7 @@ def _build(
         y0p = KG * x[None, :] + dz[:, None] * tan_u[None, :]
         scale = KG + dz / par.m_e if infinite else KG + dz / (par.m_e * par.p0)
     D0 = yp - y0p
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Dr = np.where(x[None, :] != 0.0, D0 / np.where(y0p != 0.0, y0p, 1.0), 0.0)
-    Dr = np.where(np.isfinite(yp), Dr, np.nan)
+    Dr = relative_distortion(D0, y0p, off_axis=x[None, :] != 0.0, valid=np.isfinite(yp))
     return CharacteristicDistortion(
         name=lens.name,
         reference=reference,
@@ -486,9 +448,7 @@ class ChromaticDistortion:
         """Plane ``i`` described with the reference wavelength's H' and Gaussian plane."""
         par = self.reference_paraxial
         z = float(self.z_planes[i])
-        sp, d = z - par.z_Hp, z - par.z_gauss
-        g = "Gaussian plane" if abs(d) <= 1e-9 * max(1.0, abs(sp)) else f"defocus {d:+.4f} mm"
-        return f"s' = {sp:.4f} mm ({g} at {self.reference_wavelength:g} nm)"
+        return plane_label(z - par.z_Hp, z - par.z_gauss, f" at {self.reference_wavelength:g} nm")
 
     @property
     def scale_description(self) -> str:

@@ -45,6 +45,7 @@ from raytrace.lens import Lens
 from raytrace.materials import LAMBDA_C, LAMBDA_F
 
 from .characteristic import ChromaticDistortion, characteristic_distortion
+from .curve import relative_distortion
 
 FOCUS_KINDS = ("paraxial", "best-focus")
 #: default sampling of the focal-shift curve when the lens has fewer than three wavelengths (nm)
@@ -165,9 +166,7 @@ def lateral_colour(
     )
     yp = cd.yp  # (3, p, n)
     lin = yp[0] - yp[1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = np.where(yp[2] != 0.0, lin / np.where(yp[2] != 0.0, yp[2], 1.0), 0.0)
-    rel = np.where(np.isfinite(lin), rel, np.nan)
+    rel = relative_distortion(lin, yp[2], valid=np.isfinite(lin))
     r0 = cd[2]
     return LateralColour(
         name=lens.name,

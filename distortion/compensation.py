@@ -111,8 +111,8 @@ def compensate(
     camera: object at infinity (field angles, constant F1 in mm, D1 in the negative).
     printer: finite conjugates with the negative as its object (object heights in mm, constant M2,
         D0 in the print plane).
-    method: how M is chosen: ``given`` (``magnification``, default M2 — the paper's compensation condition
-        for characteristic curves) or any calibration method over the camera's fields
+    method: how M is chosen: ``given`` (``magnification``, default M2 — the paper's compensation
+        condition for characteristic curves) or any calibration method over the camera's fields
         (``two-point`` / ``zero-at`` with ``at`` angles, ``minimax``, ``least-squares``).
     """
     if camera.finite:

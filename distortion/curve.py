@@ -11,8 +11,16 @@ in the paper. Curves come from a trace (:mod:`distortion.characteristic`) or fro
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
+
+from raytrace.errors import TraceError
+
+if TYPE_CHECKING:
+    from raytrace.lens import Lens
+    from raytrace.paraxial import ParaxialResult
 
 ANGLE = "angle"
 HEIGHT = "height"
@@ -20,8 +28,181 @@ NOMINAL_ANGLE = "nominal-angle"
 FIELD_KINDS = (ANGLE, HEIGHT, NOMINAL_ANGLE)
 
 
+def relative_distortion(
+    D: npt.ArrayLike,
+    reference: npt.ArrayLike,
+    *,
+    off_axis: npt.ArrayLike | None = None,
+    valid: npt.ArrayLike | None = None,
+) -> np.ndarray:
+    """Relative distortion ``Dr = D / reference`` as a fraction (Pestrecov's ``D0 / y0'``).
+
+    Parameters
+    ----------
+    D : array_like
+        Linear distortion (mm).
+    reference : array_like
+        The height it is relative to (mm), e.g. the ideal image size y0'.
+    off_axis : array_like of bool, optional
+        Where to divide; elsewhere (the axis) ``Dr = 0``. Default ``reference != 0``.
+    valid : array_like of bool, optional
+        Where the result holds; elsewhere NaN (e.g. ``isfinite(y')``). Default everywhere.
+
+    Returns
+    -------
+    ndarray
+        ``Dr`` (fraction, dimensionless), the broadcast shape of the inputs.
+    """
+    D = np.asarray(D, dtype=float)
+    ref = np.asarray(reference, dtype=float)
+    nz = ref != 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(nz if off_axis is None else off_axis, D / np.where(nz, ref, 1.0), 0.0)
+    return r if valid is None else np.where(valid, r, np.nan)
+
+
+def plane_label(s_prime: float, defocus: float, note: str = "") -> str:
+    """A plane described in words: ``s' = … mm (Gaussian plane)`` or ``(defocus ±… mm)``.
+
+    Parameters
+    ----------
+    s_prime : float
+        mm from H' (Pestrecov's s').
+    defocus : float
+        mm from the Gaussian image plane (+ away from the lens); within ``1e-9 × max(1, |s'|)``
+        of zero the plane is called the Gaussian plane.
+    note : str
+        Text appended inside the parentheses (e.g. ``" at 587.6 nm"``).
+    """
+    g = (
+        "Gaussian plane"
+        if abs(defocus) <= 1e-9 * max(1.0, abs(s_prime))
+        else f"defocus {defocus:+.4f} mm"
+    )
+    return f"s' = {s_prime:.4f} mm ({g}{note})"
+
+
+def requested_fields(
+    lens: Lens,
+    infinite: bool,
+    fields_deg: npt.ArrayLike | None,
+    heights_mm: npt.ArrayLike | None,
+    heights_name: str = "object_heights_mm",
+) -> tuple[str, np.ndarray]:
+    """The fields of a 1-D analysis as ``(kind, values)`` for :func:`raytrace.trace.aim`.
+
+    Parameters
+    ----------
+    lens : Lens
+        Gives the default: 11 fields from 0 to the lens file's field (as angles when the file
+        gives a height but the object is at infinity).
+    infinite : bool
+        Whether the object is at infinity.
+    fields_deg : array_like or None
+        Field angles in degrees (nominal angles with a finite object): kind ``"angle"``.
+    heights_mm : array_like or None
+        Object heights (or radii) in mm: kind ``"height"``. Give at most one of the two.
+    heights_name : str
+        The keyword the heights came as, for the error message.
+
+    Returns
+    -------
+    kind : str
+        ``"angle"`` or ``"height"``.
+    values : ndarray
+        (n,) degrees or mm.
+
+    Raises
+    ------
+    TraceError
+        Both ``fields_deg`` and ``heights_mm`` given.
+    """
+    if fields_deg is not None and heights_mm is not None:
+        raise TraceError(f"give fields_deg or {heights_name}, not both")
+    if heights_mm is not None:
+        return "height", np.atleast_1d(np.asarray(heights_mm, dtype=float)).ravel()
+    if fields_deg is not None:
+        return "angle", np.atleast_1d(np.asarray(fields_deg, dtype=float)).ravel()
+    fk = lens.field.kind if not (infinite and lens.field.kind == "height") else "angle"
+    return fk, np.linspace(0.0, lens.field.value, 11)
+
+
+def fields_and_abscissa(
+    lens: Lens,
+    par: ParaxialResult,
+    fields_deg: npt.ArrayLike | None,
+    object_heights_mm: npt.ArrayLike | None,
+) -> tuple[str, np.ndarray, str, np.ndarray]:
+    """The fields of a 1-D traced analysis and Pestrecov's abscissa of orthoscopy.
+
+    Parameters
+    ----------
+    lens : Lens
+    par : ParaxialResult
+        The object and wavelength of the analysis.
+    fields_deg, object_heights_mm : array_like or None
+        As :func:`requested_fields` (default: 11 fields from 0 to the lens file's field).
+
+    Returns
+    -------
+    aim_kind : str
+        ``"angle"`` or ``"height"`` (for :func:`raytrace.trace.aim`).
+    fields : ndarray
+        (n,) degrees or mm.
+    kind : str
+        The result's field kind (:func:`curve_field_kind`).
+    x : ndarray
+        (n,) ``tan α`` (object at infinity) or the object height y (mm)
+        (:func:`raytrace.paraxial.orthoscopy_abscissa`).
+
+    Raises
+    ------
+    TraceError
+        No fields, both kinds given, or object heights with an object at infinity.
+    """
+    from raytrace.paraxial import orthoscopy_abscissa
+
+    fk, f = requested_fields(lens, par.infinite, fields_deg, object_heights_mm)
+    if f.size == 0:
+        raise TraceError("no fields given")
+    kind = curve_field_kind(fk, par.infinite)
+    return fk, f, kind, orthoscopy_abscissa(par, f, fk)
+
+
+def curve_field_kind(field_kind: str, infinite: bool) -> str:
+    """The field kind of a result (``ANGLE``, ``HEIGHT`` or ``NOMINAL_ANGLE``) from the kind the
+    fields were given as (``"angle"`` | ``"height"``) and whether the object is at infinity.
+
+    Raises
+    ------
+    TraceError
+        Object heights with an object at infinity.
+    """
+    if field_kind == "height" and infinite:
+        raise TraceError("object heights need a finite object distance")
+    return ANGLE if infinite else (HEIGHT if field_kind == "height" else NOMINAL_ANGLE)
+
+
+class FieldKindMixin:
+    """``finite`` and ``symbol`` of a result with a ``field_kind`` attribute (``ANGLE``,
+    ``HEIGHT`` or ``NOMINAL_ANGLE``)."""
+
+    __slots__ = ()
+    field_kind: str
+
+    @property
+    def finite(self) -> bool:
+        """True for finite conjugates (constant M0), False for an object at infinity (F0)."""
+        return self.field_kind != ANGLE
+
+    @property
+    def symbol(self) -> str:
+        """``"F"`` (object at infinity) or ``"M"`` (finite conjugates)."""
+        return "M" if self.finite else "F"
+
+
 @dataclass(frozen=True, eq=False)
-class DistortionCurve:
+class DistortionCurve(FieldKindMixin):
     """Characteristic (or any reference) distortion curve in one image plane.
 
     fields:     field values as given: angles in degrees (``field_kind="angle"`` or
@@ -49,16 +230,6 @@ class DistortionCurve:
     extra: dict = field(default_factory=dict, compare=False)
 
     @property
-    def finite(self) -> bool:
-        """True for finite conjugates (constant M0), False for an object at infinity (F0)."""
-        return self.field_kind != ANGLE
-
-    @property
-    def symbol(self) -> str:
-        """``"F"`` (object at infinity) or ``"M"`` (finite conjugates)."""
-        return "M" if self.finite else "F"
-
-    @property
     def yp(self) -> np.ndarray:
         """Actual image size ``y' = y0' + D0`` (mm)."""
         return self.y0p + self.D0
@@ -66,9 +237,7 @@ class DistortionCurve:
     @property
     def Dr(self) -> np.ndarray:
         """Characteristic relative distortion ``D0 / y0'`` as a fraction; 0 on the axis."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.where(self.y0p != 0.0, self.D0 / np.where(self.y0p != 0.0, self.y0p, 1.0), 0.0)
-        return r
+        return relative_distortion(self.D0, self.y0p)
 
     @property
     def field_label(self) -> str:

@@ -59,6 +59,8 @@ from raytrace.errors import TraceError
 from raytrace.lens import Lens
 from raytrace.paraxial import ImagePlane
 
+from .curve import plane_label, relative_distortion
+
 FOCALS = ("paraxial", "least-squares")
 
 
@@ -182,9 +184,7 @@ def linear_and_relative(yp: npt.ArrayLike, y_ref: npt.ArrayLike) -> tuple[np.nda
     yp = np.asarray(yp, dtype=float)
     yr = np.asarray(y_ref, dtype=float)
     D = yp - yr
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Dr = np.where(yr != 0.0, D / np.where(yr != 0.0, yr, 1.0), 0.0)
-    return D, np.where(np.isfinite(yp), Dr, np.nan)
+    return D, relative_distortion(D, yr, valid=np.isfinite(yp))
 
 
 # ------------------------------------------------------------------ the traced result
@@ -259,13 +259,7 @@ class ProjectionDistortion:
         return f"{self.title}: y_ref = {self.formula}, {self.focal_description}"
 
     def plane_label(self, i: int) -> str:
-        d = self.defocus[i]
-        g = (
-            "Gaussian plane"
-            if abs(d) <= 1e-9 * max(1.0, abs(self.s_prime[i]))
-            else f"defocus {d:+.4f} mm"
-        )
-        return f"s' = {self.s_prime[i]:.4f} mm ({g})"
+        return plane_label(self.s_prime[i], self.defocus[i])
 
     def __repr__(self) -> str:
         with np.errstate(invalid="ignore"):

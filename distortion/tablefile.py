@@ -241,7 +241,6 @@ def read_distortion_table(
     )
 
 
-
 def dumps_table(curve: DistortionCurve, *, decimals: int | None = None) -> str:
     """CSV text readable by :func:`read_distortion_table` (a '#' line records name, plane, K0)."""
     dec = curve.decimals if decimals is None else decimals

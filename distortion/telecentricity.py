@@ -35,15 +35,14 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from raytrace.errors import TraceError
 from raytrace.lens import Lens
 from raytrace.paraxial import ParaxialResult
 
-from .curve import ANGLE, HEIGHT, NOMINAL_ANGLE
+from .curve import HEIGHT, FieldKindMixin, fields_and_abscissa
 
 
 @dataclass(frozen=True, eq=False)
-class PupilAnalysis:
+class PupilAnalysis(FieldKindMixin):
     """Chief-ray angles, pupils and the distortion slope of one lens and object, per field.
 
     name: lens name; field_kind: ``"angle"``, ``"height"`` or ``"nominal-angle"``; fields (n,):
@@ -80,10 +79,6 @@ class PupilAnalysis:
     viewpoint_offset: np.ndarray
     status: np.ndarray
     paraxial: ParaxialResult
-
-    @property
-    def finite(self) -> bool:
-        return self.field_kind != ANGLE
 
     @property
     def max_abs_cra_deg(self) -> float:
@@ -140,38 +135,16 @@ def pupil_analysis(
     PupilAnalysis
     """
     from raytrace.paraxial import (
+        checked_wavelength,
         distortion_slope,
-        orthoscopy_abscissa,
         orthoscopy_constant_slope,
-        paraxial,
-        resolve_object_distance,
+        resolve_paraxial,
     )
     from raytrace.trace import STATUS_OK, aim
 
-    wl = _wavelength_nm(wavelength)
-    od = resolve_object_distance(
-        lens,
-        object_distance=object_distance,
-        object_s=object_s,
-        object_scale=object_scale,
-        wavelength=wl,
-    )
-    par = paraxial(lens, object_distance=od, wavelength=wl)
-    if fields_deg is not None and object_heights_mm is not None:
-        raise TraceError("give fields_deg or object_heights_mm, not both")
-    if object_heights_mm is not None:
-        fk, f = "height", np.atleast_1d(np.asarray(object_heights_mm, dtype=float)).ravel()
-    elif fields_deg is not None:
-        fk, f = "angle", np.atleast_1d(np.asarray(fields_deg, dtype=float)).ravel()
-    else:
-        fk = lens.field.kind if not (par.infinite and lens.field.kind == "height") else "angle"
-        f = np.linspace(0.0, lens.field.value, 11)
-    if f.size == 0:
-        raise TraceError("no fields given")
-    if fk == "height" and par.infinite:
-        raise TraceError("object heights need a finite object distance")
-    kind = ANGLE if par.infinite else (HEIGHT if fk == "height" else NOMINAL_ANGLE)
-    x = orthoscopy_abscissa(par, f, fk)
+    wl = checked_wavelength(wavelength)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wl)
+    fk, f, kind, x = fields_and_abscissa(lens, par, fields_deg, object_heights_mm)
     cr = aim(lens, f, fk, par.object_distance, wl, clip)
     ok = cr.status == STATUS_OK
 
@@ -216,15 +189,3 @@ def pupil_analysis(
         status=cr.status.copy(),
         paraxial=par,
     )
-
-
-def _wavelength_nm(value) -> float | None:
-    """A wavelength keyword (nm, or a string with a unit) through the one check."""
-    if value is None:
-        return None
-    from raytrace.units import UnitError, wavelength_nm
-
-    try:
-        return wavelength_nm(value)
-    except UnitError as e:
-        raise TraceError(str(e)) from None

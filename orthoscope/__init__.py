@@ -98,6 +98,18 @@ _API: dict[str, str] = {
     "analyze_variation": "distortion.variation",
     "analyze_csv": "distortion.variation",
     "Conjugate": "distortion.variation",
+    # focus positions / configurations that change thicknesses (Brown's model tested on them)
+    "read_configured": "raytrace.files.configurations",
+    "read_configurations": "raytrace.files.configurations",
+    "apply_configuration": "raytrace.files.configurations",
+    "write_lens_with_configurations": "raytrace.files.configurations",
+    "Configuration": "raytrace.files.configurations",
+    "Configurations": "raytrace.files.configurations",
+    "focus_study": "distortion.variation.focus",
+    "FocusStudy": "distortion.variation.focus",
+    "solve_focus": "distortion.variation.focus",
+    "focus_configurations": "distortion.variation.focus",
+    "unit_focus_configurations": "distortion.variation.focus",
     "fit_radial": "distortion.coefficients",
     "opencv_model": "distortion.coefficients",
     # camera models (OpenCV, COLMAP, Metashape, Australis) and sensors
@@ -129,6 +141,12 @@ _API: dict[str, str] = {
     "read_spec": "raytrace.optimize",
     "optimize": "raytrace.optimize",
     "global_optimize": "raytrace.optimize",
+    # tolerancing (docs/tolerance.md)
+    "read_tolerance_spec": "raytrace.tolerance",
+    "ToleranceSpec": "raytrace.tolerance",
+    "SensitivityResult": "distortion.tolerance",
+    "MonteCarloResult": "distortion.tolerance",
+    "ToleranceOutputs": "distortion.tolerance",
     # plots (matplotlib loads with the first of these)
     "plot_distortion": "orthoscope.plots.distortion",
     "plot_characteristic": "orthoscope.plots.distortion",
@@ -158,6 +176,9 @@ _API: dict[str, str] = {
     "plot_chief_ray_angle": "orthoscope.plots.telecentricity",
     "plot_distortion_slope": "orthoscope.plots.telecentricity",
     "plot_entrance_pupil": "orthoscope.plots.telecentricity",
+    "plot_tolerance": "orthoscope.plots.tolerance",
+    "plot_envelope": "orthoscope.plots.tolerance",
+    "plot_sensitivity": "orthoscope.plots.tolerance",
     # errors
     "OrthoscopeError": "raytrace.errors",
     "PrescriptionError": "raytrace.errors",
@@ -251,7 +272,15 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from distortion.sensor_metrics import SensorMetrics, sensor_metrics
     from distortion.tablefile import read_distortion_table
     from distortion.telecentricity import PupilAnalysis, pupil_analysis
+    from distortion.tolerance import MonteCarloResult, SensitivityResult, ToleranceOutputs
     from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
+    from distortion.variation.focus import (
+        FocusStudy,
+        focus_configurations,
+        focus_study,
+        solve_focus,
+        unit_focus_configurations,
+    )
     from raytrace.errors import (
         LensError,
         OrthoscopeError,
@@ -260,12 +289,21 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         TraceError,
     )
     from raytrace.files import convert, save_lens
+    from raytrace.files.configurations import (
+        Configuration,
+        Configurations,
+        apply_configuration,
+        read_configurations,
+        read_configured,
+        write_lens_with_configurations,
+    )
     from raytrace.files.library import list_lenses, load_lens
     from raytrace.glass import lookup_glass, search_glass
     from raytrace.lens import Aperture, Field, Lens, Surface
     from raytrace.materials import Material, fixed_index, model_glass
     from raytrace.optimize import global_optimize, optimize, read_spec
     from raytrace.paraxial import ImagePlane, ParaxialResult, paraxial, pestrecov_constants
+    from raytrace.tolerance import ToleranceSpec, read_tolerance_spec
     from raytrace.trace import (
         ChiefRays,
         ChiefRays2D,
@@ -311,4 +349,5 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         plot_entrance_pupil,
         plot_pupils,
     )
+    from .plots.tolerance import plot_envelope, plot_sensitivity, plot_tolerance
     from .plots.variation import plot_g, plot_profiles

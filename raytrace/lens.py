@@ -1,10 +1,10 @@
 """The validated, immutable lens model (packed into arrays for the kernels by :mod:`.packing`).
 
-Conventions (docs/design.md, "Conventions"): millimetres; light travels toward +z; a radius is positive when its
-centre of curvature lies after the vertex; ``thickness`` is the axial distance from a surface's
-vertex to the next vertex (for the last surface: to the image plane the file defines). The first
-vertex is at z = 0. ``Surface.material`` is the medium *after* the surface; the object space is
-air unless ``Lens.object_material`` says otherwise.
+Conventions (docs/design.md, "Conventions"): millimetres; light travels toward +z; a radius is
+positive when its centre of curvature lies after the vertex; ``thickness`` is the axial distance
+from a surface's vertex to the next vertex (for the last surface: to the image plane the file
+defines). The first vertex is at z = 0. ``Surface.material`` is the medium *after* the surface;
+the object space is air unless ``Lens.object_material`` says otherwise.
 
 Surface sag (even asphere, which contains the plane, sphere and conic as special cases)::
 

@@ -100,3 +100,20 @@ def test_workloads_toy_size(run, tmp_path):
     res["targets"] = run.targets(res)
     text = "\n".join(run.summarize(res))
     assert "through-focus map" in text and "VOID" not in text
+
+
+def test_tolerance_benchmark_toy_size(tmp_path, capsys):
+    """benchmarks/tolerance.py --quick (64 instances, no optiland, no Dask): runs, every chief
+    ray of every instance traced, the JSON written."""
+    import json
+
+    spec = importlib.util.spec_from_file_location("bench_tolerance", BENCH / "tolerance.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = tmp_path / "tolerance.json"
+    assert mod.main(["--quick", "--no-optiland", "--no-dask", "--out", str(out)]) == 0
+    res = json.loads(out.read_text())
+    assert res["orthoscope"]["instances"] == 64
+    assert res["orthoscope"]["ok_fraction"] == 1.0
+    assert res["orthoscope"]["instances_per_s_per_core"] > 0
+    assert "instances/s/core" in capsys.readouterr().out

@@ -18,6 +18,7 @@ import dataclasses
 import io
 import json
 import math
+import re
 from collections import Counter
 from pathlib import Path
 
@@ -317,7 +318,13 @@ def test_pdf_page_is_a4(tmp_path, topogon_cert):
         fig = plot_certificate(topogon_cert)
     assert tuple(fig.get_size_inches()) == pytest.approx((8.27, 11.69))
     p = save_figure(fig, tmp_path / "c.pdf")
-    assert p.read_bytes().startswith(b"%PDF")
+    data = p.read_bytes()
+    assert data.startswith(b"%PDF")
+    # the page itself: ISO 216 A4 is 210 x 297 mm = 595.3 x 841.9 pt (MediaBox in points)
+    box = re.search(rb"/MediaBox\s*\[\s*([\d.\s]+)\]", data).group(1).split()
+    w_pt, h_pt = (float(v) for v in box[2:4])
+    assert w_pt * 25.4 / 72 == pytest.approx(210.0, abs=0.5)
+    assert h_pt * 25.4 / 72 == pytest.approx(297.0, abs=0.5)
 
 
 # ---------------------------------------------------------------- inputs

@@ -5,7 +5,8 @@ Sources of the expected facts:
 - Classical orthoscopy (symmetry principle): a lens symmetric about its stop used at −1× has zero
   distortion — the chief ray crosses the stop centre, and by symmetry leaves at the angle it came
   in with, at the mirror height, so y' = −y exactly.
-- docs/design.md, "Equations": the named reference definitions agree in the Gaussian plane and differ away from it.
+- docs/design.md, "Equations": the named reference definitions agree in the Gaussian plane and
+  differ away from it.
 """
 
 from __future__ import annotations
@@ -154,7 +155,9 @@ def test_nominal_angle_fields_for_finite_object(triplet):
     od = 400.0
     a = characteristic_distortion(triplet, [0.0, 5.0, 10.0], object_distance=od)
     par = a.paraxial
-    y = par.p0 * np.tan(np.radians([0.0, 5.0, 10.0]))  # y = p0 tan α (docs/design.md, "Conventions")
+    y = par.p0 * np.tan(
+        np.radians([0.0, 5.0, 10.0])
+    )  # y = p0 tan α (docs/design.md, "Conventions")
     h = characteristic_distortion(triplet, object_heights_mm=y, object_distance=od)
     assert a.field_kind == "nominal-angle"
     np.testing.assert_allclose(a.x, y, rtol=1e-15)

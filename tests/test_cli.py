@@ -90,9 +90,7 @@ def test_trace_field_beyond_lens_gets_a_status(capsys):
 def test_calibrate_prints_table_II(capsys):
     # Acceptance (issue 3): Table I with two-point calibration at 37.5 and 45 deg prints Table II
     # (Pestrecov 1958): Fc = 154.059, Yc' and Dc per field.
-    rc, out, _ = run(
-        capsys, "calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,45"
-    )
+    rc, out, _ = run(capsys, "calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,45")
     assert rc == 0
     assert "F_c = 154.059 mm" in out
     assert "27.165" in out and "154.059" in out  # Yc' at 10 and 45 deg
@@ -257,3 +255,15 @@ def test_cli_choices_equal_the_science_constants():
     from orthoscope.cli import common
 
     assert common.METHODS == METHODS and common.REFERENCES == REFERENCES
+
+
+def test_strict_turns_a_failed_field_into_exit_2(capsys):
+    # 85 deg is beyond what the Cooke triplet (20 deg half-field) can trace: by default the table
+    # shows the field's status and the run succeeds; --strict makes it an error (README, "--strict")
+    rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", "--fields", "0,10,85")
+    assert rc == 0 and "85" in out
+    rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", "--fields", "0,10,85", "--strict")
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert rc == 2 and len(lines) == 1 and "--strict" in lines[0]
+    rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--strict")
+    assert rc == 0

@@ -181,3 +181,14 @@ def test_glass_codes_and_unknown_name_suggestions():
     if catalog_available():
         with pytest.raises(PrescriptionError, match=r"similar catalog names: N-BK7 \(Schott\)"):
             loads_seq(TRIPLET.replace("1.61659:36.63", "BK7"))
+
+
+def test_a_fractional_ref_is_an_error_not_truncated():
+    # REF names a wavelength by its 1-based position in WL: REF 1.9 is not REF 1 (issue 13)
+    text = TRIPLET.replace("WL 587.5618", "WL 656.3 587.6 486.1\nREF 1.9")
+    with pytest.raises(PrescriptionError, match=r"REF 1\.9: expected the whole number") as e:
+        loads_seq(text, path="user.seq")
+    assert e.value.path == "user.seq"
+    assert (
+        loads_seq(TRIPLET.replace("WL 587.5618", "WL 656.3 587.6 486.1\nREF 2")).wavelength == 587.6
+    )

@@ -7,6 +7,11 @@ Table I at the nine angles; the two-point calibration at 37.5 and 45 deg gives F
 0.002 mm of Table II's 154.059 mm and D_c within 0.002 mm of Table II. Table I / II numbers:
 tests/data/pestrecov_table1.csv and pestrecov_table2.csv (source: K. Pestrecov,
 Photogrammetric Engineering 1958, Tables I and II).
+
+The second library entry ``topogon-like-spherical`` (issue 19, item 4) is the same construction
+with spherical surfaces only and catalog glasses; it misses the 3 µm target at six of the nine
+angles (max 6.54 µm), and the tests below hold each Table I entry to its measured error with the
+reason (section "all-spherical lens").
 """
 
 from __future__ import annotations
@@ -95,3 +100,111 @@ def test_optimizer_converges_back_from_a_perturbed_start(lens):
     assert merit(evaluate(start, spec.operands)) > 10 * shipped
     res = optimize(start, replace(spec, max_evaluations=400, merit_goal=None))
     assert res.merit <= 1.05 * shipped
+
+
+# --------------------------------------------------------------------------- all-spherical lens
+# lenses/topogon-like-spherical.toml (issue 19, item 4): four spherical menisci in catalog glass.
+# It misses the issue's 3 µm target at six of Table I's nine angles. The per-angle bounds below
+# are the shipped lens's measured errors (our own design run, 2026-11-23: regression pins, not
+# published numbers) rounded up by 0.05 µm, each with its reason; the entries that meet 3 µm are
+# held to 3 µm.
+SPHERICAL_TABLE1_ERR_UM = {  # angle: (bound on |D0 - Table I| in µm, measured D0 - Table I)
+    10.0: (6.1, -6.04),  # known miss: Table I's slow rise at 10-20 deg (see the lens notes)
+    20.0: (6.6, -6.54),  # known miss: idem
+    25.0: (3.0, +0.86),
+    30.0: (6.1, +6.07),  # known miss: the t^3..t^9 minimax floor peaks here too (+6.70)
+    35.0: (3.4, -3.31),  # known miss: the turn-over between 37.5 and 45 deg
+    37.5: (3.6, -3.54),  # known miss: idem
+    40.0: (3.1, +3.09),  # known miss: idem
+    42.5: (3.0, -0.98),
+    45.0: (3.0, -1.63),
+}
+
+
+@pytest.fixture(scope="module")
+def spherical():
+    return load_lens("topogon-like-spherical")
+
+
+@pytest.fixture(scope="module")
+def spherical_traced(spherical, table1):
+    return characteristic_distortion(spherical, table1.fields).curve(0)
+
+
+def test_spherical_lens_is_four_spherical_menisci_in_catalog_glass(spherical):
+    from raytrace.glass import lookup_glass
+
+    s = spherical.surfaces
+    assert len(s) == 9 and s[4].stop and s[4].curvature == 0.0
+    glass = [i for i, x in enumerate(s) if not x.material.is_air]
+    assert glass == [0, 2, 5, 7]
+    for x in s:  # spherical: no conic, no aspheric terms
+        assert x.conic == 0.0 and not any(x.aspheric)
+    for i in glass:
+        m = s[i].material
+        # a real catalog glass, the vendor's formula (not an nd/vd model glass)
+        assert m.kind == "catalog"
+        assert m == lookup_glass(m.name, [m.catalog]).material
+    assert [s[i].material.name for i in glass] == ["N-SK11", "F2", "N-LAK12", "N-SF14"]
+    # the Topogon construction (US 2,031,792): menisci concave toward the stop (front group
+    # c > 0, rear group c < 0), outer elements positive, inner elements negative and thin
+    n = [s[i].material.index(spherical.wavelength) for i in glass]
+    for k, i in enumerate(glass):
+        c1, c2, t = s[i].curvature, s[i + 1].curvature, s[i].thickness
+        assert c1 * c2 > 0 and (c1 > 0) == (i < 4)
+        power = (n[k] - 1) * (c1 - c2) + (n[k] - 1) ** 2 * t * c1 * c2 / n[k]
+        assert (power > 0) == (k in (0, 3))
+        assert t >= 1.2 - 1e-9  # shop rule of the design: negative elements >= 1.2 mm
+        if k in (1, 2):
+            assert t <= 3.0
+    for i in (1, 6):  # the outer air spaces: thin, as in the patent
+        assert 0.05 <= s[i].thickness <= 5.0
+
+
+def test_spherical_efl_is_table1_f0(spherical):
+    assert paraxial(spherical).efl == pytest.approx(F0, abs=1e-3)
+
+
+@pytest.mark.parametrize("angle", sorted(SPHERICAL_TABLE1_ERR_UM))
+def test_spherical_d0_per_table1_entry(spherical_traced, table1, angle):
+    i = int(np.flatnonzero(np.isclose(table1.fields, angle))[0])
+    err_um = 1e3 * (spherical_traced.D0[i] - table1.D0[i])
+    bound, measured = SPHERICAL_TABLE1_ERR_UM[angle]
+    assert abs(err_um) <= bound, f"D0 - Table I at {angle} deg: {err_um:+.2f} um"
+    assert err_um == pytest.approx(measured, abs=0.05)  # regression pin of the shipped design
+
+
+def test_spherical_two_point_calibration_near_table2(spherical_traced, table2):
+    # Table II follows Table I: F_c within 3 µm of 154.059; D_c within the Table I misses
+    # (measured: F_c = 154.0562 mm, max |D_c - Table II| = 7.9 µm at 30 deg)
+    cal = calibrate(spherical_traced, "two-point", at=(37.5, 45))
+    assert cal.Kc == pytest.approx(FC, abs=0.003)
+    err = cal.Dc - table2[:, 2]
+    assert np.max(np.abs(err)) <= 0.008, f"D_c - Table II (mm): {np.round(err, 4)}"
+
+
+def test_table1_polynomial_floor_quoted_in_the_notes(spherical, table1):
+    """The evidence the lens notes give for the miss, recomputed from Table I alone: the minimax
+    fit of D0 by a3 t^3 + ... + a9 t^9 (t = tan alpha) leaves 6.70 µm, with t^11 4.25 µm, with
+    t^13 1.39 µm (linear programme over the nine published points)."""
+    from scipy.optimize import linprog
+
+    keep = table1.fields > 0  # the nine non-zero angles of Table I
+    a, y = table1.fields[keep], table1.D0[keep]
+    assert a.size == 9
+    t = np.tan(np.radians(a))
+    floors = []
+    for top in (9, 11, 13):
+        A = np.stack([t**k for k in range(3, top + 1, 2)], axis=1)
+        m = A.shape[1]
+        ones = np.ones((len(t), 1))
+        res = linprog(
+            np.r_[np.zeros(m), 1.0],
+            A_ub=np.r_[np.c_[A, -ones], np.c_[-A, -ones]],
+            b_ub=np.r_[y, -y],
+            bounds=[(None, None)] * m + [(0.0, None)],
+        )
+        assert res.success
+        floors.append(1e3 * res.x[-1])
+    np.testing.assert_allclose(floors, [6.70, 4.25, 1.39], atol=0.01)
+    assert "6.70 um" in spherical.notes and "5.19 um" in spherical.notes

@@ -58,3 +58,21 @@ def test_cache_stamp_covers_every_kernel_module():
 
     names = {n for n, *_ in KERNEL_STAMP}
     assert names == {p.name for p in (ROOT / "raytrace" / "kernels").glob("*.py")}
+
+
+def test_compile_notice_only_when_no_tracing_kernel_is_cached(monkeypatch, capsys):
+    """The "compiling" line means a first run: once any tracing command has cached its kernels,
+    a command that compiles one more kernel stays quiet (a warm `distortion` run, whose aim
+    kernel is cached, printed the notice on every run because the bulk kernel was not)."""
+    import raytrace.kernels.jit as jit
+    from orthoscope import cli
+    from raytrace.kernels import aim
+
+    for warm, expect in (({"aim_chief"}, False), (set(), True), ({"aim_chief", "x"}, False)):
+        monkeypatch.setattr(
+            jit, "cache_is_warm", lambda *ds, w=warm: all(d.__name__ in w for d in ds)
+        )
+        cli._compile_notice()
+        err = capsys.readouterr().err
+        assert ("compiling the ray-tracing kernels" in err) is expect, (warm, err)
+    assert aim.aim_chief.__name__ == "aim_chief"

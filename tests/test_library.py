@@ -31,6 +31,8 @@ PUBLISHED = {
     "cooke-triplet-f4": (50.000, 0.0005, 43.080, 0.0005),
     # FR 1.066.698 Example 1: f = 99.89, back focal distance 80.55.
     "tessar-fr1066698": (99.89, 0.005, 80.55, 0.005),
+    # the same patent lens; its infinity configuration (the base lens) is Example 1 unchanged
+    "tessar-fr1066698-inner-focus": (99.89, 0.005, 80.55, 0.005),
     # US 2,518,719 Example 2: EF = 100 (stated as a round figure), BFD = 89.01.
     "wide-field-ektar-us2518719": (100.0, 0.5, 89.01, 0.005),
     # DE 975 637: f' = 100 (round figure), s' = 73.4.
@@ -47,7 +49,7 @@ def test_library_holds_the_bundled_files() -> None:
     assert set(bundled_names()) - set(PUBLISHED) <= DESIGNED
 
 
-DESIGNED = {"topogon-like-pestrecov", "twinplex-like-55-525"}
+DESIGNED = {"topogon-like-pestrecov", "topogon-like-spherical", "twinplex-like-55-525"}
 
 
 @pytest.mark.parametrize("name", sorted(PUBLISHED))

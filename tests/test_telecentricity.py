@@ -27,7 +27,9 @@ def _hyperbolic_telecentric(n: float = 1.5, R: float = 20.0, k: float | None = N
     k = -n * n if k is None else k
     s = (
         Surface(0.0, R / (n - 1.0), AIR, stop=True),
-        Surface(1.0 / R, 5.0, fixed_index(n), conic=k),
+        # 10 mm thick: the hyperboloid's sag at the 20-degree chief ray (h = 16.3 mm) is 5.6 mm,
+        # so a thinner lens would have a negative edge there (the ray "backward", status 5)
+        Surface(1.0 / R, 10.0, fixed_index(n), conic=k),
         Surface(0.0, 30.0, AIR),
     )
     return Lens("hyperbolic, stop at F", s, Aperture("fnumber", 8.0), Field("angle", 20.0))

@@ -57,7 +57,8 @@ def test_parse_conjugate():
 
 
 def test_image_scale_is_gaussian_magnification(s65):
-    # "12x" means Gaussian magnification -1/12 (docs/design.md, "Vocabulary"); Pestrecov Eq. (5) m0 = f/(f + s).
+    # "12x" means Gaussian magnification -1/12 (docs/design.md, "Vocabulary"); Pestrecov Eq. (5)
+    # m0 = f/(f + s).
     for n in (8.0, 12.0, 20.0):
         geo = conjugate_geometry(s65, Conjugate.scale(n))
         par = paraxial(s65, geo.object_distance)

@@ -278,3 +278,13 @@ def test_impossible_lenses_are_refused_as_the_native_format_refuses_them(old, ne
     assert old in text
     with pytest.raises(PrescriptionError, match=words):
         loads_zmx(text.replace(old, new, 1))
+
+
+def test_a_zemax_archive_is_refused_with_what_to_do(tmp_path):
+    from raytrace.files import read_lens_file
+
+    p = tmp_path / "lens.zar"
+    p.write_bytes(b"\x00ZAR archive bytes")
+    with pytest.raises(PrescriptionError, match=r"Zemax archive \(\.zar\).*give the \.zmx") as e:
+        read_lens_file(p)
+    assert e.value.path == str(p)

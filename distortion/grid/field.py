@@ -71,7 +71,7 @@ from raytrace.errors import TraceError
 from raytrace.lens import Lens
 from raytrace.paraxial import ImagePlane, ParaxialResult
 
-from ..curve import ANGLE, HEIGHT, NOMINAL_ANGLE
+from ..curve import FieldKindMixin, curve_field_kind, plane_label, requested_fields
 from ..errors import DataError
 from .decompose import solve_linear
 
@@ -82,7 +82,7 @@ PPBS_RADIAL_TERMS = 3
 
 
 @dataclass(frozen=True, eq=False)
-class DistortionGrid:
+class DistortionGrid(FieldKindMixin):
     """Distortion of one lens and object over a 2-D set of fields in one or more image planes.
 
     Arrays over fields have the grid's ``shape`` ((rows, columns) = (ny, nx) for a grid);
@@ -162,21 +162,11 @@ class DistortionGrid:
         return int(self.z_planes.size)
 
     @property
-    def finite(self) -> bool:
-        return self.field_kind != ANGLE
-
-    @property
     def ok(self) -> np.ndarray:
         return self.status == 0
 
     def plane_label(self, i: int) -> str:
-        d = self.defocus[i]
-        g = (
-            "Gaussian plane"
-            if abs(d) <= 1e-9 * max(1.0, abs(self.s_prime[i]))
-            else f"defocus {d:+.4f} mm"
-        )
-        return f"s' = {self.s_prime[i]:.4f} mm ({g})"
+        return plane_label(self.s_prime[i], self.defocus[i])
 
     def named_point(self, name: str) -> np.ndarray:
         """(p, 2) the reference point ``name`` (``REFERENCE_POINTS``) in every plane."""
@@ -300,23 +290,15 @@ def distortion_grid(
     -------
     DistortionGrid
     """
-    from raytrace.paraxial import paraxial, resolve_object_distance
+    from raytrace.paraxial import resolve_paraxial
 
     if reference_point not in REFERENCE_POINTS:
         raise TraceError(
             f"reference_point={reference_point!r}; use one of {', '.join(REFERENCE_POINTS)}"
         )
-    wl = _wavelength(wavelength)
-    od = resolve_object_distance(
-        lens,
-        object_distance=object_distance,
-        object_s=object_s,
-        object_scale=object_scale,
-        wavelength=wl,
-    )
     # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
     # centred lens (raytrace.paraxial refuses a lens that is not centred)
-    par = paraxial(lens.nominal(), object_distance=od, wavelength=wl)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength, nominal=True)
     angles = fields_x_deg is not None or fields_y_deg is not None
     heights = object_x_mm is not None or object_y_mm is not None
     if angles and heights:
@@ -346,17 +328,6 @@ def distortion_grid(
         clip=clip,
         sensor=_sensor(sensor) if sensor is not None else None,
     )
-
-
-def _wavelength(value) -> float | None:
-    if value is None:
-        return None
-    from raytrace.units import UnitError, wavelength_nm
-
-    try:
-        return wavelength_nm(value)
-    except UnitError as e:
-        raise TraceError(str(e)) from None
 
 
 def _grid_size(grid) -> tuple[int, int]:
@@ -446,9 +417,7 @@ def grid_from_fields(
     FX = np.asarray(fields_x, dtype=float)
     FY = np.asarray(fields_y, dtype=float)
     infinite = par.infinite
-    if field_kind == "height" and infinite:
-        raise TraceError("object heights need a finite object distance")
-    kind = ANGLE if infinite else (HEIGHT if field_kind == "height" else NOMINAL_ANGLE)
+    kind = curve_field_kind(field_kind, infinite)
     planes = image_planes(
         plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus
     )
@@ -607,30 +576,14 @@ def radial_by_azimuth(
         For a centred lens and ``reference_point="axial"`` its radial curves equal the 1-D
         characteristic distortion D0 at the same fields (tangential zero).
     """
-    from raytrace.paraxial import paraxial, resolve_object_distance
+    from raytrace.paraxial import resolve_paraxial
 
-    wl = _wavelength(wavelength)
-    od = resolve_object_distance(
-        lens,
-        object_distance=object_distance,
-        object_s=object_s,
-        object_scale=object_scale,
-        wavelength=wl,
-    )
     # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
     # centred lens (raytrace.paraxial refuses a lens that is not centred)
-    par = paraxial(lens.nominal(), object_distance=od, wavelength=wl)
-    if fields_deg is not None and object_radii_mm is not None:
-        raise TraceError("give fields_deg or object_radii_mm, not both")
-    if object_radii_mm is not None:
-        kind = "height"
-        r = np.atleast_1d(np.asarray(object_radii_mm, dtype=float)).ravel()
-    elif fields_deg is not None:
-        kind = "angle"
-        r = np.atleast_1d(np.asarray(fields_deg, dtype=float)).ravel()
-    else:
-        kind = lens.field.kind if not (par.infinite and lens.field.kind == "height") else "angle"
-        r = np.linspace(0.0, float(lens.field.value), 11)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength, nominal=True)
+    kind, r = requested_fields(
+        lens, par.infinite, fields_deg, object_radii_mm, heights_name="object_radii_mm"
+    )
     if np.any(r < 0):
         raise TraceError("radial fields are total field angles or radii: give values >= 0")
     az = np.atleast_1d(np.asarray(azimuths_deg, dtype=float)).ravel()

@@ -32,8 +32,8 @@ An infinite distance (``inf`` metres, N = ∞) is allowed for a focus setting. C
 paper's Table 1 text (Pentax, f = 45 mm): "focused at 8m (175×)", planes 1.5/2.1/2.6/3.4 m
 "approximately 33×, 45×, 56×, and 75×"; N = s/f − 1 gives 176.8, 32.3, 45.7, 56.8, 74.6.
 
-(The docs/design.md sign convention has s negative; the paper's formulas use positive distances, and so
-do these functions. They never mix the two.)
+(The docs/design.md sign convention has s negative; the paper's formulas use positive distances,
+and so do these functions. They never mix the two.)
 
 Comparing profiles
 ------------------
@@ -615,5 +615,3 @@ def brown_implied_gaussian(analysis: VariationAnalysis) -> dict[str, np.ndarray]
 # --------------------------------------------------------------------------------------------
 # Text and JSON output
 # --------------------------------------------------------------------------------------------
-
-

@@ -175,5 +175,3 @@ def fs_predict(dr_s: np.ndarray, dr_s_prime: np.ndarray, g: float) -> np.ndarray
     """Fraser & Shortis Eq. (6): δr_ss' = δr_s + g_ss' (δr_s' − δr_s)."""
     dr_s = np.asarray(dr_s, dtype=float)
     return dr_s + g * (np.asarray(dr_s_prime, dtype=float) - dr_s)
-
-

@@ -42,6 +42,7 @@ COMMANDS: tuple[str, ...] = (
     "coefficients",
     "camera",
     "optimize",
+    "tolerance",
     "convert",
     "glass",
 )
@@ -283,7 +284,9 @@ def _compile_notice() -> None:
     from raytrace.kernels import aim, bulk
     from raytrace.kernels.jit import cache_is_warm
 
-    if not cache_is_warm(aim.aim_chief, bulk.trace_batch_serial):
+    # the first run of any tracing command compiles its kernels; a later command that needs one
+    # more kernel compiles only that one (seconds), which is not worth a notice
+    if not any(cache_is_warm(k) for k in (aim.aim_chief, bulk.trace_batch_serial)):
         print(
             "orthoscope: compiling the ray-tracing kernels (first run only, about a minute)",
             file=sys.stderr,

@@ -197,13 +197,22 @@ def _emit(args, text: str, data: dict, csv: str | None = None, note: str | None 
         print(text)
 
 
-def _save_plot(make, path, args) -> None:
-    from ..plots.common import offscreen_figures
-    from ..plots.save import save_figure
+def _model_table_out(args, table, note: str | None = None) -> None:
+    """A table of camera models per object distance: written to ``-o`` (.csv or .json) when
+    given, and shown as text, JSON or CSV (:func:`_emit`, ``note`` as there)."""
+    from ..report.camera import format_model_table, model_table_csv, model_table_to_dict
+    from .common import CliError
 
-    with offscreen_figures():
-        fig = make()
-    save_figure(fig, path, overwrite=args.force, inputs=args._inputs)
+    data = {"models_by_distance": model_table_to_dict(table)}
+    if args.output:
+        from ..report.jsonout import dumps
+
+        suffix = str(args.output).lower().rsplit(".", 1)[-1]
+        if suffix not in ("csv", "json"):
+            raise CliError(f"-o {args.output}: a table of models is written as .csv or .json")
+        text = model_table_csv(table) if suffix == "csv" else dumps(data) + "\n"
+        _write(args.output, text, args)
+    _emit(args, format_model_table(table), data, model_table_csv(table), note)
 
 
 # ---------------------------------------------------------------------------------- actions
@@ -216,10 +225,7 @@ def _cmd_lens(args, lens_name: str) -> int:
     )
 
     from ..report.camera import (
-        format_model_table,
         format_traced_camera,
-        model_table_csv,
-        model_table_to_dict,
         points_csv,
         traced_camera_to_dict,
     )
@@ -245,25 +251,7 @@ def _cmd_lens(args, lens_name: str) -> int:
         if not objs:
             raise CliError("--object-distances: empty list")
         table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
-        if args.output:
-            suffix = str(args.output).lower().rsplit(".", 1)[-1]
-            if suffix not in ("csv", "json"):
-                raise CliError(f"-o {args.output}: a table of models is written as .csv or .json")
-            from ..report.jsonout import dumps
-
-            data = (
-                model_table_csv(table)
-                if suffix == "csv"
-                else dumps({"models_by_distance": model_table_to_dict(table)}) + "\n"
-            )
-            _write(args.output, data, args)
-        _emit(
-            args,
-            format_model_table(table),
-            {"models_by_distance": model_table_to_dict(table)},
-            model_table_csv(table),
-            setup.resolve(lens).projection_centre,
-        )
+        _model_table_out(args, table, setup.resolve(lens).projection_centre)
         return 0
     tc = camera_model(lens, setup, args.model, n_coefficients=n)
     if args.output:
@@ -273,8 +261,9 @@ def _cmd_lens(args, lens_name: str) -> int:
           tc.geometry.projection_centre)  # fmt: skip
     if args.plot:
         from ..plots.camera import plot_camera_residuals
+        from .common import save_plot
 
-        _save_plot(lambda: plot_camera_residuals(tc), args.plot, args)
+        save_plot(lambda: plot_camera_residuals(tc), args.plot, args)
     if args.picture:
         pic = distortion_picture(tc.camera, args.pattern)
         _write(args.picture, _png(pic.image), args)
@@ -343,8 +332,9 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
           comparison_csv(cmp), cmp.prediction.geometry.projection_centre)  # fmt: skip
     if args.plot:
         from ..plots.camera import plot_calibration_comparison
+        from .common import save_plot
 
-        _save_plot(lambda: plot_calibration_comparison(cmp), args.plot, args)
+        save_plot(lambda: plot_calibration_comparison(cmp), args.plot, args)
     return 0
 
 
@@ -386,7 +376,6 @@ def _cmd_convert(args, cal_path: str) -> int:
 def _cmd_variation(args, cal1: str, cal2: str) -> int:
     from distortion.camera import calibrated_models_by_distance, read_calibration
 
-    from ..report.camera import format_model_table, model_table_csv, model_table_to_dict
     from .common import CliError, length
 
     args._inputs = [cal1, cal2]
@@ -418,24 +407,7 @@ def _cmd_variation(args, cal1: str, cal2: str) -> int:
         pixel_size_mm=ps,
         name=f"{cal1} and {cal2}",
     )
-    if args.output:
-        from ..report.jsonout import dumps
-
-        suffix = str(args.output).lower().rsplit(".", 1)[-1]
-        if suffix not in ("csv", "json"):
-            raise CliError(f"-o {args.output}: a table of models is written as .csv or .json")
-        data = (
-            model_table_csv(table)
-            if suffix == "csv"
-            else dumps({"models_by_distance": model_table_to_dict(table)}) + "\n"
-        )
-        _write(args.output, data, args)
-    _emit(
-        args,
-        format_model_table(table),
-        {"models_by_distance": model_table_to_dict(table)},
-        model_table_csv(table),
-    )
+    _model_table_out(args, table)
     return 0
 
 

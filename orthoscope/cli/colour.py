@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_field_args, add_object_args, add_output_args, add_plane_args
+from .common import add_field_args, add_lens_arg, add_object_args, add_output_args, add_plane_args
 
 #: Quick runs of this command for the per-command tests: argv lists with {data} = tests/data,
 #: {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -68,15 +68,14 @@ def cmd_colour(args) -> int:
     from .common import (
         CliError,
         field_keyword,
-        load,
+        load_input,
         print_json,
         resolve_fields,
         resolve_object,
         resolve_planes,
     )
 
-    lens = load(args.lens)
-    args._inputs = [lens.path] if lens.path else []
+    lens = load_input(args)
     if args.plot:
         from pathlib import Path
 
@@ -119,13 +118,10 @@ def cmd_colour(args) -> int:
         print(format_chromatic_distortion(cd))
     if args.plot:
         from ..plots.colour import plot_colour_summary
-        from ..plots.common import offscreen_figures
-        from ..plots.save import save_figure
+        from .common import save_plot
 
         curve = focal_shift(lens, kind=args.focus, object_distance=od)
-        with offscreen_figures():
-            fig = plot_colour_summary(curve, lc, cd)
-        save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
+        save_plot(lambda: plot_colour_summary(curve, lc, cd), args.plot, args)
     return 0
 
 
@@ -148,7 +144,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_object_args(q)
     add_field_args(q)
     add_plane_args(q, repeatable=True)

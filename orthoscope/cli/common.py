@@ -126,6 +126,39 @@ def load(name: str):
     return load_lens(name)
 
 
+def load_input(args):
+    """The lens of ``args.lens`` (:func:`load`), recorded as the command's input
+    (``args._inputs``) so that no output is ever written onto it."""
+    lens = load(args.lens)
+    args._inputs = [lens.path] if lens.path else []
+    return lens
+
+
+def save_plot(make, path, args) -> None:
+    """Draw the figure ``make()`` off screen and write it to ``path`` (.png, .svg or .pdf),
+    never onto one of the command's inputs (``args._inputs``), over an existing file only
+    with ``--force`` (``args.force``)."""
+    from ..plots.common import offscreen_figures
+    from ..plots.save import save_figure
+
+    with offscreen_figures():
+        fig = make()
+    save_figure(fig, path, overwrite=args.force, inputs=args._inputs)
+
+
+def strict_check(args, status, what: str = "field(s)", see: str = " (see the table)") -> None:
+    """With ``--strict`` (``args.strict``), fail when any trace ``status`` is not OK (0).
+
+    Raises
+    ------
+    CliError
+        Naming how many ``what`` could not be traced.
+    """
+    n_bad = int(np.count_nonzero(np.asarray(status) != 0))
+    if n_bad and args.strict:
+        raise CliError(f"{n_bad} {what} could not be traced{see}; --strict fails")
+
+
 def load_scaled(args):
     """The lens of ``--lens``, scaled to ``--scale-to-efl`` mm when given."""
     from raytrace.files.library import load_lens
@@ -145,6 +178,11 @@ def load_scaled(args):
 
 
 # ----------------------------------------------------------------------------- objects
+def add_lens_arg(p: argparse.ArgumentParser) -> None:
+    """The positional LENS argument: a lens file or a bundled lens name."""
+    p.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+
+
 def add_object_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("object plane (give at most one)", OBJECT_HELP)
     g.add_argument(

@@ -65,9 +65,7 @@ def cmd_compensate(args) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from .common import METHODS
-
-    from .common import DeprecatedAlias
+    from .common import METHODS, DeprecatedAlias
 
     q = sub.add_parser(
         "compensate",

@@ -35,12 +35,11 @@ def add_definition_args(q: argparse.ArgumentParser) -> None:
 
 def run_definition(lens, fields, kind, od, planes, args) -> int:
     """The distortion command with ``--definition``: text (default), ``--json`` or ``--csv``."""
-    import numpy as np
 
     from distortion.definitions import projection_distortion
 
     from ..report.definitions import format_projection, projection_csv, projection_to_dict
-    from .common import CliError, print_json
+    from .common import CliError, print_json, strict_check
 
     bad = [
         flag
@@ -76,7 +75,5 @@ def run_definition(lens, fields, kind, od, planes, args) -> int:
         print(projection_csv(res))
     else:
         print(format_projection(res, layout=args.table_layout))
-    n_bad = int(np.count_nonzero(res.status != 0))
-    if n_bad and args.strict:
-        raise CliError(f"{n_bad} field(s) could not be traced (see the table); --strict fails")
+    strict_check(args, res.status)
     return 0

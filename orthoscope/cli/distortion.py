@@ -6,6 +6,7 @@ import argparse
 
 from .common import (
     add_field_args,
+    add_lens_arg,
     add_object_args,
     add_output_args,
     add_plane_args,
@@ -122,15 +123,15 @@ def cmd_distortion(args) -> int:
     from .common import (
         CliError,
         field_keyword,
-        load,
+        load_input,
         print_json,
         resolve_fields,
         resolve_object,
         resolve_planes,
+        strict_check,
     )
 
-    lens = load(args.lens)
-    args._inputs = [lens.path] if lens.path else []
+    lens = load_input(args)
     if _grid_mode(args):  # 2-D distortion: --grid / --plot-grid / --plot-vectors (below)
         return _grid(args, lens)
     od = resolve_object(lens, args)
@@ -186,20 +187,17 @@ def cmd_distortion(args) -> int:
                 print(f"Plane {i + 1}: {res.plane_label(i)}")
             print(format_calibration(c, layout=args.table_layout))
     _plots(res, cals, args, lens)
-    bad = int(np.count_nonzero(res.status != 0))
-    if bad and args.strict:
-        raise CliError(f"{bad} field(s) could not be traced (see the table); --strict fails")
+    strict_check(args, res.status)
     return 0
 
 
 def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
     """--wavelengths: distortion per wavelength (one trace), against --scale."""
-    import numpy as np
 
     from distortion.characteristic import characteristic_distortion
 
     from ..report.colour import chromatic_distortion_to_dict, format_chromatic_distortion
-    from .common import CliError, field_keyword, print_json
+    from .common import CliError, field_keyword, print_json, strict_check
 
     bad = [
         flag
@@ -229,15 +227,10 @@ def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
         print(format_chromatic_distortion(cd))
     if args.plot:
         from ..plots.colour import plot_distortion_by_wavelength
-        from ..plots.common import offscreen_figures
-        from ..plots.save import save_figure
+        from .common import save_plot
 
-        with offscreen_figures():
-            fig = plot_distortion_by_wavelength(cd)
-        save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
-    n_bad = int(np.count_nonzero(cd.status != 0))
-    if n_bad and args.strict:
-        raise CliError(f"{n_bad} ray(s) could not be traced (see the table); --strict fails")
+        save_plot(lambda: plot_distortion_by_wavelength(cd), args.plot, args)
+    strict_check(args, cd.status, "ray(s)")
     return 0
 
 
@@ -314,7 +307,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_object_args(q)
     add_field_args(q)
     add_plane_args(q, repeatable=True)
@@ -416,7 +409,15 @@ def _grid(args, lens) -> int:
     from distortion.grid import decompose_distortion, distortion_grid, fit_brown_conrady
 
     from ..report.grid import format_grid, grid_to_dict
-    from .common import MAX_FIELDS, CliError, check_size, print_json, resolve_object, resolve_planes
+    from .common import (
+        MAX_FIELDS,
+        CliError,
+        check_size,
+        print_json,
+        resolve_object,
+        resolve_planes,
+        strict_check,
+    )
 
     bad = [
         flag
@@ -484,21 +485,14 @@ def _grid(args, lens) -> int:
     if (args.plot_grid or args.plot_vectors) and not np.isfinite(g.actual).any():
         raise CliError("no field could be traced: there is nothing to plot")
     if args.plot_grid or args.plot_vectors:
-        from ..plots.common import offscreen_figures
         from ..plots.grid import plot_distortion_vectors, plot_grid_distortion
-        from ..plots.save import save_figure
+        from .common import save_plot
 
         if args.plot_grid:
-            with offscreen_figures():
-                fig = plot_grid_distortion(g)
-            save_figure(fig, args.plot_grid, overwrite=args.force, inputs=args._inputs)
+            save_plot(lambda: plot_grid_distortion(g), args.plot_grid, args)
         if args.plot_vectors:
-            with offscreen_figures():
-                fig = plot_distortion_vectors(g)
-            save_figure(fig, args.plot_vectors, overwrite=args.force, inputs=args._inputs)
-    n_bad = int(np.count_nonzero(~g.ok))
-    if n_bad and args.strict:
-        raise CliError(f"{n_bad} field(s) could not be traced; --strict fails")
+            save_plot(lambda: plot_distortion_vectors(g), args.plot_vectors, args)
+    strict_check(args, g.status, see="")
     return 0
 
 

@@ -36,17 +36,31 @@ def _check_plot(args, lens) -> None:
     check_plot_path(args.plot, "--plot", args)
 
 
-def _save(fig, args) -> None:
-    from ..plots.save import save_figure
+def _output(args, lens, key, items, to_dict, to_csv, to_text, what) -> None:
+    """``items`` (ray fans or spot diagrams) as JSON (``{"lens", key: [...]}``), CSV or text on
+    stdout, and the plot of ``--plot`` (:func:`orthoscope.plots.rays.plot_ray_fan` for
+    ``key="fans"``, :func:`~orthoscope.plots.rays.plot_spot` for ``"spots"``)."""
+    from .common import print_json
 
-    save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
+    if args.json:
+        print_json({"lens": lens.name, key: [to_dict(i) for i in items]})
+    elif args.csv:
+        print(to_csv(items))
+    else:
+        print(to_text(items))
+    if args.plot:
+        from ..plots.rays import plot_ray_fan, plot_spot
+        from .common import save_plot
+
+        plot = plot_ray_fan if key == "fans" else plot_spot
+        save_plot(lambda: plot(items, title=f"{lens.name}: {what}"), args.plot, args)
 
 
 def cmd_fan(args) -> int:
     from raytrace.trace import ray_fan
 
     from ..report.rays import fan_to_dict, fans_csv, format_fans
-    from .common import MAX_SAMPLES, check_size, load, number, print_json
+    from .common import MAX_SAMPLES, check_size, load, number
 
     lens = load(args.lens)
     _check_plot(args, lens)
@@ -57,18 +71,7 @@ def cmd_fan(args) -> int:
     fans = [
         ray_fan(lens, **_field_kw(field, kind), n=n, axis=a, **_common(lens, args)) for a in axes
     ]
-    if args.json:
-        print_json({"lens": lens.name, "fans": [fan_to_dict(f) for f in fans]})
-    elif args.csv:
-        print(fans_csv(fans))
-    else:
-        print(format_fans(fans))
-    if args.plot:
-        from ..plots.common import offscreen_figures
-        from ..plots.rays import plot_ray_fan
-
-        with offscreen_figures():
-            _save(plot_ray_fan(fans, title=f"{lens.name}: ray fans"), args)
+    _output(args, lens, "fans", fans, fan_to_dict, fans_csv, format_fans, "ray fans")
     return 0
 
 
@@ -76,7 +79,7 @@ def cmd_spot(args) -> int:
     from raytrace.trace import spot_diagram
 
     from ..report.rays import format_spots, spot_to_dict, spots_csv
-    from .common import check_size, load, print_json, resolve_fields
+    from .common import check_size, load, resolve_fields
 
     lens = load(args.lens)
     _check_plot(args, lens)
@@ -89,23 +92,12 @@ def cmd_spot(args) -> int:
         )
         for f in fields
     ]  # fmt: skip
-    if args.json:
-        print_json({"lens": lens.name, "spots": [spot_to_dict(s) for s in spots]})
-    elif args.csv:
-        print(spots_csv(spots))
-    else:
-        print(format_spots(spots))
-    if args.plot:
-        from ..plots.common import offscreen_figures
-        from ..plots.rays import plot_spot
-
-        with offscreen_figures():
-            _save(plot_spot(spots, title=f"{lens.name}: spot diagrams"), args)
+    _output(args, lens, "spots", spots, spot_to_dict, spots_csv, format_spots, "spot diagrams")
     return 0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from .common import add_field_args
+    from .common import add_field_args, add_lens_arg
     from .distortion import add_force_arg
 
     q = sub.add_parser(
@@ -118,7 +110,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         epilog="Example: orthoscope fan cooke-triplet-f4 --field 14 --axis both --plot fan.png",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     q.add_argument("--field", default="0", metavar="F", help="Field: degrees or object mm.")
     q.add_argument("--field-kind", choices=["angle", "height"], help="What --field is.")
     q.add_argument("--axis", choices=["y", "x", "both"], default="y", help="Fan direction.")
@@ -140,7 +132,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         epilog="Example: orthoscope spot cooke-triplet-f4 --fields 0,10,20 --plot spots.png",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_field_args(q)
     q.add_argument(
         "--pattern", choices=["hexapolar", "rings", "square"], default="hexapolar",

@@ -226,40 +226,55 @@ def cmd_optimize(args) -> int:
     return _run_local(args, spec, lens, out, inputs)
 
 
-def _run_local(args, spec, lens, out, inputs) -> int:
+def _write_design(args, res, spec, out, inputs, notes, source: str) -> bool:
+    """Write the optimized lens ``res.lens`` to ``out`` when it converged (or with
+    ``--write-anyway``, its notes then marked NOT CONVERGED); ``notes()`` gives its provenance
+    notes and ``source`` its origin. Returns whether it was written."""
     from raytrace.files.native import write_lens
+
+    written = res.converged or args.write_anyway
+    if written:
+        designed = replace(res.lens, name=spec.name or res.lens.name, notes=notes(), source=source)
+        if not res.converged:
+            designed = replace(designed, notes=designed.notes + " NOT CONVERGED: " + res.message)
+        write_lens(designed, out, inputs=inputs, overwrite=args.force, flag="--force")
+    return written
+
+
+def _result_json(spec, res, out, written, table, before=None, after=None) -> dict:
+    """The JSON of an optimization run: spec, start, ``before`` (the global search's
+    settings), convergence, merit, evaluations, seconds, ``after`` (the chosen glasses), the
+    file written (or None) and the operand table."""
+    return {
+        "spec": spec.path,
+        "start": spec.start,
+        **(before or {}),
+        "converged": res.converged,
+        "message": res.message,
+        "merit_start": res.merit_start,
+        "merit": res.merit,
+        "evaluations": res.evaluations,
+        "seconds": res.seconds,
+        **(after or {}),
+        "written": str(out) if written else None,
+        "operands": table,
+    }
+
+
+def _run_local(args, spec, lens, out, inputs) -> int:
     from raytrace.optimize import optimize
 
     prog = _Progress(args.quiet or args.json)
     res = optimize(lens, spec, progress=prog)
     prog.done()
     table = _operand_table(res.operands)
-    written = res.converged or args.write_anyway
-    if written:
-        designed = replace(
-            res.lens,
-            name=spec.name or res.lens.name,
-            notes=provenance_notes(lens, spec, res, spec.start),
-            source=f"derived by orthoscope optimize from {spec.start} with {Path(spec.path).name}",
-        )
-        if not res.converged:
-            designed = replace(designed, notes=designed.notes + " NOT CONVERGED: " + res.message)
-        write_lens(designed, out, inputs=inputs, overwrite=args.force, flag="--force")
+    written = _write_design(
+        args, res, spec, out, inputs,
+        lambda: provenance_notes(lens, spec, res, spec.start),
+        f"derived by orthoscope optimize from {spec.start} with {Path(spec.path).name}",
+    )  # fmt: skip
     if args.json:
-        print_json(
-            {
-                "spec": spec.path,
-                "start": spec.start,
-                "converged": res.converged,
-                "message": res.message,
-                "merit_start": res.merit_start,
-                "merit": res.merit,
-                "evaluations": res.evaluations,
-                "seconds": res.seconds,
-                "written": str(out) if written else None,
-                "operands": table,
-            }
-        )
+        print_json(_result_json(spec, res, out, written, table))
     else:
         print(f"{spec.name}: {res.message}")
         print(
@@ -277,7 +292,6 @@ def _run_local(args, spec, lens, out, inputs) -> int:
 
 
 def _run_global(args, spec, lens, out, inputs, over) -> int:
-    from raytrace.files.native import write_lens
     from raytrace.optimize import global_optimize
 
     spec = replace(spec, search=replace(spec.search, **over))  # the notes tell the settings
@@ -287,20 +301,11 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
     finally:
         prog.close()
     table = _operand_table(res.operands)
-    written = res.converged or args.write_anyway
-    if written:
-        designed = replace(
-            res.lens,
-            name=spec.name or res.lens.name,
-            notes=global_provenance_notes(spec, res, spec.start),
-            source=(
-                f"derived by orthoscope optimize --global from {spec.start} with "
-                f"{Path(spec.path).name}"
-            ),
-        )
-        if not res.converged:
-            designed = replace(designed, notes=designed.notes + " NOT CONVERGED: " + res.message)
-        write_lens(designed, out, inputs=inputs, overwrite=args.force, flag="--force")
+    written = _write_design(
+        args, res, spec, out, inputs,
+        lambda: global_provenance_notes(spec, res, spec.start),
+        f"derived by orthoscope optimize --global from {spec.start} with {Path(spec.path).name}",
+    )  # fmt: skip
     if args.glass_map is not None:
         from raytrace.optimize import glass_pool
 
@@ -317,39 +322,30 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         )
         save_figure(fig, args.glass_map, overwrite=args.force, inputs=inputs)
     if args.json:
-        print_json(
-            {
-                "spec": spec.path,
-                "start": spec.start,
-                "global": True,
-                "seed": res.seed,
-                "starts": res.starts,
-                "starts_done": res.starts_done,
-                "best_start": res.best_start,
-                "start_merits": [None if m != m else float(m) for m in res.start_merits],
-                "workers": res.workers,
-                "stopped": res.stopped or None,
-                "converged": res.converged,
-                "message": res.message,
-                "merit_start": res.merit_start,
-                "merit": res.merit,
-                "evaluations": res.evaluations,
-                "seconds": res.seconds,
-                "glasses": [
-                    {
-                        "surface": g.surface,
-                        "name": g.name,
-                        "catalog": g.catalog,
-                        "nd": g.nd,
-                        "vd": g.vd,
-                        "availability": g.availability,
-                    }
-                    for g in res.glasses
-                ],
-                "written": str(out) if written else None,
-                "operands": table,
-            }
-        )
+        search = {
+            "global": True,
+            "seed": res.seed,
+            "starts": res.starts,
+            "starts_done": res.starts_done,
+            "best_start": res.best_start,
+            "start_merits": [None if m != m else float(m) for m in res.start_merits],
+            "workers": res.workers,
+            "stopped": res.stopped or None,
+        }
+        glasses = {
+            "glasses": [
+                {
+                    "surface": g.surface,
+                    "name": g.name,
+                    "catalog": g.catalog,
+                    "nd": g.nd,
+                    "vd": g.vd,
+                    "availability": g.availability,
+                }
+                for g in res.glasses
+            ],
+        }
+        print_json(_result_json(spec, res, out, written, table, search, glasses))
     else:
         print(f"{spec.name}: {res.message}")
         print(

@@ -6,7 +6,13 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_field_args, add_object_args, add_output_args, add_wavelength_arg
+from .common import (
+    add_field_args,
+    add_lens_arg,
+    add_object_args,
+    add_output_args,
+    add_wavelength_arg,
+)
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -24,11 +30,19 @@ def cmd_pupils(args) -> int:
     from distortion.telecentricity import pupil_analysis
 
     from ..report.telecentricity import format_pupils, pupils_csv, pupils_to_dict
-    from .common import CliError, field_keyword, load, print_json, resolve_fields, resolve_object
+    from .common import (
+        CliError,
+        field_keyword,
+        load_input,
+        print_json,
+        resolve_fields,
+        resolve_object,
+        save_plot,
+        strict_check,
+    )
     from .distortion import check_plot_path
 
-    lens = load(args.lens)
-    args._inputs = [lens.path] if lens.path else []
+    lens = load_input(args)
     check_plot_path(args.plot, "--plot", args)
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
@@ -46,16 +60,10 @@ def cmd_pupils(args) -> int:
     if args.plot:
         if not np.isfinite(pa.cra_deg).any():
             raise CliError("no field could be traced (see the table): there is nothing to plot")
-        from ..plots.common import offscreen_figures
-        from ..plots.save import save_figure
         from ..plots.telecentricity import plot_pupils
 
-        with offscreen_figures():
-            fig = plot_pupils(pa)
-        save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
-    bad = int(np.count_nonzero(pa.status != 0))
-    if bad and args.strict:
-        raise CliError(f"{bad} field(s) could not be traced (see the table); --strict fails")
+        save_plot(lambda: plot_pupils(pa), args.plot, args)
+    strict_check(args, pa.status)
     return 0
 
 
@@ -81,7 +89,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_object_args(q)
     add_field_args(q)
     add_wavelength_arg(q)

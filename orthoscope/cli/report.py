@@ -31,11 +31,10 @@ def cmd_report(args) -> int:
     from distortion.certificate import calibration_certificate
 
     from ..report.certificate import certificate_to_dict, format_certificate
-    from .common import CliError, load, print_json, resolve_object, resolve_planes
+    from .common import CliError, load_input, print_json, resolve_object, resolve_planes
     from .distortion import check_plot_path
 
-    lens = load(args.lens)
-    args._inputs = [lens.path] if lens.path else []
+    lens = load_input(args)
     check_plot_path(args.output, "-o", args)
     if args.sensor is not None and args.max_field is not None:
         raise CliError("give --sensor or --max-field, not both")
@@ -62,12 +61,9 @@ def cmd_report(args) -> int:
         print(format_certificate(d))
     if args.output:
         from ..plots.certificate import plot_certificate
-        from ..plots.common import offscreen_figures
-        from ..plots.save import save_figure
+        from .common import save_plot
 
-        with offscreen_figures():
-            fig = plot_certificate(d)
-        save_figure(fig, args.output, overwrite=args.force, inputs=args._inputs)
+        save_plot(lambda: plot_certificate(d), args.output, args)
     return 0
 
 
@@ -93,6 +89,7 @@ def _step(text: str) -> float:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from .common import add_lens_arg
     from .distortion import add_force_arg
 
     q = sub.add_parser(
@@ -116,7 +113,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_object_args(q)
     add_plane_args(q)
     add_wavelength_arg(q)

@@ -114,6 +114,19 @@ def cmd_variation(args) -> int:
             "--focal-length is for data mode; in prescription mode f comes from the "
             "lens (use --scale-to-efl to scale the lens)"
         )
+    if args.configurations:  # the lens file's focus configurations (docs/focus.md)
+        from distortion.variation.focus import focus_study
+        from raytrace.files.configurations import read_configured
+
+        from ..report.focus import focus_study_to_dict, format_focus_study
+
+        lens, confs = read_configured(args.lens)
+        st = focus_study(lens, confs, focus_index=len(confs) // 2, max_field_deg=args.max_field)
+        if args.json:
+            print_json(focus_study_to_dict(st))
+        else:
+            print(format_focus_study(st))
+        return 0
     if not args.focus:
         raise CliError("prescription mode needs --focus (e.g. --focus 12x)")
     if not args.objects:
@@ -269,6 +282,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--objects",
         metavar="D1,D2,...",
         help="Prescription mode: object planes, e.g. 8x,16x,20x or 0.6,1.1 (metres).",
+    )
+    q.add_argument(
+        "--configurations",
+        action="store_true",
+        help="Prescription mode: study the lens file's focus configurations (Zemax THIC, CODE V "
+        "ZOO THI, TOML [[configurations]]): distortion, principal distance and Brown's model per "
+        "focus (docs/focus.md).",
     )
     q.add_argument(
         "--scale-to-efl",

@@ -27,33 +27,12 @@ FIGSIZE_IMAGE = (7.2, 5.2)
 ARROWS_PER_ROW = 14
 
 
-def _key_length(vmax: float) -> float:
-    """A 1-2-5 length near half the longest arrow."""
-    mag = 10.0 ** math.floor(math.log10(vmax))
-    for m in (5.0, 2.0, 1.0):
-        if m * mag <= 0.75 * vmax:
-            return m * mag
-    return mag / 2.0
-
-
 def _arrows(ax, pos: np.ndarray, vec: np.ndarray, width: int, unit: str = "px"):
     """Quiver of ``vec`` at ``pos`` (pixels) scaled so the longest arrow spans ~1.5 grid
     steps, with a key; returns the longest length."""
-    ok = np.all(np.isfinite(pos), axis=1) & np.all(np.isfinite(vec), axis=1)
-    pos, vec = pos[ok], vec[ok]
-    lengths = np.hypot(vec[:, 0], vec[:, 1])
-    vmax = float(lengths.max()) if lengths.size else 0.0
-    if vmax > 0:
-        n_side = max(2.0, math.sqrt(max(pos.shape[0], 1)))
-        scale = vmax / (1.5 * width / n_side)
-        q = ax.quiver(
-            pos[:, 0], pos[:, 1], vec[:, 0], vec[:, 1], angles="xy", scale_units="xy",
-            scale=scale, color=ARROWS, width=0.004, zorder=2,
-        )  # fmt: skip
-        key = _key_length(vmax)
-        ax.quiverkey(q, 0.97, 1.015, key, f"{fmt(key, 3)} {unit}", labelpos="W",
-                     coordinates="axes")  # fmt: skip
-    return vmax
+    from .grid import arrow_field
+
+    return arrow_field(ax, pos, vec, ARROWS, lambda key: f"{fmt(key, 3)} {unit}", span=width)[1]
 
 
 def _image_axes(ax, width: int, height: int) -> None:

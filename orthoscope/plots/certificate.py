@@ -303,6 +303,7 @@ def plot_certificate(cert):
     fig, ax = figure_and_axes(None, figsize=PAGE)
     ax.remove()
     fig.set_layout_engine("none")
+    fig.orthoscope_page = True  # save_figure keeps the whole A4 page (no tight bounding box)
     pg = _Page(fig)
     _header(pg, d)
     _summary(pg, d)

@@ -131,25 +131,13 @@ def plot_distortion_vectors(
         vec = decomposition.components[component]
         what = f"{component.replace('_', ' ')} part"
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE_SQUARE)
-    pos = grid.ideal[p].reshape(-1, 2)
-    v = np.asarray(vec, dtype=float).reshape(-1, 2)
-    ok = np.all(np.isfinite(pos), axis=1) & np.all(np.isfinite(v), axis=1)
-    pos, v = pos[ok], v[ok]
-    lengths = np.hypot(v[:, 0], v[:, 1])
-    vmax = float(lengths.max()) if lengths.size else 0.0
-    span = max(float(np.ptp(pos[:, 0])) if pos.size else 1.0, 1e-300)
-    n_side = max(2.0, math.sqrt(max(pos.shape[0], 1)))
-    if vmax > 0:
-        # the longest arrow spans about 1.5 grid steps
-        scale = vmax / (1.5 * span / n_side)
-        q = ax.quiver(
-            pos[:, 0], pos[:, 1], v[:, 0], v[:, 1], angles="xy", scale_units="xy", scale=scale,
-            color=REAL, width=0.004, zorder=2,
-        )  # fmt: skip
-        key = _key_length(vmax)
-        ax.quiverkey(
-            q, 0.97, 1.015, key, f"{fmt(key * 1000, 3)} um", labelpos="W", coordinates="axes"
-        )  # fmt: skip
+    pos, vmax = arrow_field(
+        ax,
+        grid.ideal[p].reshape(-1, 2),
+        np.asarray(vec, dtype=float).reshape(-1, 2),
+        REAL,
+        lambda key: f"{fmt(key * 1000, 3)} um",
+    )
     ax.plot(pos[:, 0], pos[:, 1], ".", color=IDEAL, ms=2.5, zorder=1)
     ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
     ax.set_aspect("equal", adjustable="datalim")
@@ -167,8 +155,39 @@ def plot_distortion_vectors(
     return fig
 
 
-def _key_length(vmax: float) -> float:
-    """A 1-2-5 length near half the longest vector for the arrow key (mm)."""
+def arrow_field(ax, pos, vec, color, key_label, span: float | None = None):
+    """Arrows ``vec`` at the points ``pos`` (both (N, 2), in the axes' data units; rows with a
+    NaN are dropped), scaled so that the longest spans about 1.5 steps of a square grid of
+    width ``span`` (default: the x extent of ``pos``), with a 1-2-5 key (:func:`key_length`)
+    labelled ``key_label(key)``.
+
+    Returns
+    -------
+    pos : ndarray
+        (M, 2) the points drawn.
+    vmax : float
+        The longest vector (data units; 0 when there is none).
+    """
+    ok = np.all(np.isfinite(pos), axis=1) & np.all(np.isfinite(vec), axis=1)
+    pos, vec = pos[ok], vec[ok]
+    lengths = np.hypot(vec[:, 0], vec[:, 1])
+    vmax = float(lengths.max()) if lengths.size else 0.0
+    if span is None:
+        span = max(float(np.ptp(pos[:, 0])) if pos.size else 1.0, 1e-300)
+    if vmax > 0:
+        n_side = max(2.0, math.sqrt(max(pos.shape[0], 1)))
+        scale = vmax / (1.5 * span / n_side)
+        q = ax.quiver(
+            pos[:, 0], pos[:, 1], vec[:, 0], vec[:, 1], angles="xy", scale_units="xy",
+            scale=scale, color=color, width=0.004, zorder=2,
+        )  # fmt: skip
+        key = key_length(vmax)
+        ax.quiverkey(q, 0.97, 1.015, key, key_label(key), labelpos="W", coordinates="axes")
+    return pos, vmax
+
+
+def key_length(vmax: float) -> float:
+    """A 1-2-5 length near half the longest vector ``vmax`` for an arrow key (same unit)."""
     mag = 10.0 ** math.floor(math.log10(vmax))
     for m in (5.0, 2.0, 1.0):
         if m * mag <= 0.75 * vmax:

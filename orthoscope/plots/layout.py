@@ -273,16 +273,10 @@ def layout_rays(
     """
     from dataclasses import replace
 
-    from raytrace.paraxial import image_planes, paraxial, plane_z, resolve_object_distance
+    from raytrace.paraxial import image_planes, plane_z, resolve_paraxial
 
-    od = resolve_object_distance(
-        lens,
-        object_distance=object_distance,
-        object_s=object_s,
-        object_scale=object_scale,
-        wavelength=wavelength,
-    )
-    par = paraxial(lens, od, wavelength)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength)
+    od = par.object_distance
     if fields_deg is not None and object_heights_mm is not None:
         raise TraceError("give fields_deg or object_heights_mm, not both")
     if object_heights_mm is not None:

@@ -23,7 +23,10 @@ def save_figure(
     dpi: int = 150,
     flag: str = "--force",
 ) -> Path:
-    """Render ``fig`` in the format of ``path``'s suffix (.png, .svg, .pdf) and write it."""
+    """Render ``fig`` in the format of ``path``'s suffix (.png, .svg, .pdf) and write it.
+
+    The drawing is cropped to what is drawn (a tight bounding box), except for a fixed page (a
+    figure with ``orthoscope_page = True``, e.g. the A4 certificate), which keeps its size."""
     from raytrace.files.output import check_output, write_atomic
 
     p = Path(path)
@@ -32,5 +35,6 @@ def save_figure(
         raise OutputError(f"{p}: unsupported plot format {p.suffix!r}; use {', '.join(FORMATS)}")
     check_output(p, inputs=inputs, overwrite=overwrite, flag=flag)
     buf = io.BytesIO()
-    fig.savefig(buf, format=fmt[1:], dpi=dpi, bbox_inches="tight")
+    bbox = None if getattr(fig, "orthoscope_page", False) else "tight"
+    fig.savefig(buf, format=fmt[1:], dpi=dpi, bbox_inches=bbox)
     return write_atomic(p, buf.getvalue(), inputs=inputs, overwrite=overwrite, flag=flag)

@@ -34,8 +34,6 @@ def format_curve(
     return format_columns(title, curve.field_label, curve.fields, q, layout=layout)
 
 
-
-
 def curve_to_dict(curve: DistortionCurve) -> dict:
     """JSON-ready dict of a curve (lists of floats; Dr as a fraction and in per cent)."""
     return {
@@ -53,8 +51,6 @@ def curve_to_dict(curve: DistortionCurve) -> dict:
         "Dr": curve.Dr.tolist(),
         "Dr_pct": (100.0 * curve.Dr).tolist(),
     }
-
-
 
 
 def format_characteristic(
@@ -232,9 +228,7 @@ def compensation_to_dict(res: CompensationResult) -> dict:
 
 def characteristic_csv(res: CharacteristicDistortion) -> str:
     """CSV: one row per (plane, field) with s', defocus, field, y, y0', y', D0, Dr (%), status."""
-    fname = {ANGLE: "alpha_deg", HEIGHT: "y_mm", NOMINAL_ANGLE: "nominal_alpha_deg"}[
-        res.field_kind
-    ]
+    fname = {ANGLE: "alpha_deg", HEIGHT: "y_mm", NOMINAL_ANGLE: "nominal_alpha_deg"}[res.field_kind]
     rows = []
     for p in range(res.n_planes):
         for i in range(res.fields.size):

@@ -32,6 +32,12 @@ def read_lens_file(path: str | Path) -> Lens:
         from .oslo import read_len
 
         return read_len(path)
+    if suffix == ".zar":
+        raise PrescriptionError(
+            "a Zemax archive (.zar) holds the lens file packed with its catalogs: unpack it "
+            "(OpticStudio: File > Archive, or any ZAR extractor) and give the .zmx inside",
+            path=str(path),
+        )
     from .native import read_lens
 
     return read_lens(path)
@@ -42,7 +48,8 @@ def _check_suffix(path: str | Path) -> str:
     if suffix not in WRITE_SUFFIXES:
         raise PrescriptionError(
             f"cannot write {suffix or 'a file without suffix'}: the output must end in "
-            f"{' or '.join(WRITE_SUFFIXES)} (CODE V .seq files can be read, not written)",
+            f"{' or '.join(WRITE_SUFFIXES)} (CODE V .seq and OSLO .len files can be read, not "
+            "written)",
             path=str(path),
         )
     return suffix
@@ -70,7 +77,9 @@ def save_lens(lens: Lens, path: str | Path, *, overwrite: bool = False) -> None:
     write_lens_file(lens, path, overwrite=overwrite, inputs=inputs)
 
 
-def convert(in_path: str | Path, out_path: str | Path, *, overwrite: bool = False, **options) -> Lens:
+def convert(
+    in_path: str | Path, out_path: str | Path, *, overwrite: bool = False, **options
+) -> Lens:
     """Convert a lens file: IN (.toml, .zmx or .seq) to OUT (.toml or .zmx), formats chosen by
     the suffixes. Zemax .zmx files may be ASCII or UTF-16 (written: UTF-16, as OpticStudio
     does); numbers are written at full double precision, so .toml -> .zmx -> .toml reproduces

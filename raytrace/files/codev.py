@@ -51,7 +51,9 @@ Anything that changes the optics and cannot be modelled (diffractive or special 
 gradient index, other pickups) raises :class:`~raytrace.errors.PrescriptionError` with the file,
 line and what to do; other unknown commands are listed in one
 :class:`~raytrace.zemax.InteropWarning`. Every problem with the input raises PrescriptionError
-(never another exception type).
+(never another exception type). A file cut short is refused, never read as a shorter lens
+(``check_complete``: ``GO``, or without it ``SI``, aperture, field and wavelengths;
+lenses/INTEROP.md, "Truncated files").
 """
 
 from __future__ import annotations
@@ -62,7 +64,7 @@ from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
 from ..frames import Placement, codev_tilt
-from ..glass import lookup_glass, normalize_name, parse_glass_code, private_material
+from ..glass import normalize_name, parse_glass_code, private_material, resolve_glass
 from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material
 from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
@@ -100,6 +102,15 @@ class _CSurf:
     dtype: str = "basic"
     refl: bool = False
     ap: dict[str, float] = field(default_factory=dict)  # REX REY ELX ELY ADX ADY
+
+
+def _ends_continued(text: str) -> bool:
+    """True when the last line that holds a command (comments removed) ends with ``&``."""
+    for raw in reversed(text.split("\n")):
+        body = raw.split("!", 1)[0].strip()
+        if body:
+            return body.endswith("&")
+    return False
 
 
 def _logical_lines(text: str) -> list[tuple[int, list[str]]]:
@@ -210,6 +221,7 @@ class _SeqParser:
         self.private: dict[str, Material] = {}
         self.pickups: list[tuple[list[str], int]] = []
         rdm_seen = False
+        self.go_line = 0
         for line, toks in _logical_lines(self.text):
             cmd, args = toks[0].upper(), toks[1:]
             if in_prv:
@@ -221,6 +233,7 @@ class _SeqParser:
                     self.private_glass(toks, prv_wl, line)
                 continue
             if cmd == "GO":
+                self.go_line = line
                 break
             if cmd == "PRV":
                 in_prv = True
@@ -248,7 +261,21 @@ class _SeqParser:
             elif cmd == "WL":
                 h["WL"] = (self.nums(args, "WL", line), line)
             elif cmd == "REF":
-                h["REF"] = (int(self.num(args, 0, "REF", line)), line)
+                v = self.num(args, 0, "REF", line)
+                if v != int(v):
+                    raise self.err(
+                        f"REF {args[0][:20]}: expected the whole number of a WL wavelength "
+                        "(REF 1 is the first)",
+                        line,
+                    )
+                h["REF"] = (int(v), line)
+            elif cmd in ("ZOO", "ZOOM"):
+                if "ZOO" not in h:
+                    h["ZOO"] = line
+                    self.warn(
+                        f"line {line}: ZOO: zoom data; the base lens is read, its thickness "
+                        "positions by raytrace.files.configurations.read_configured"
+                    )
             elif cmd == "WTW":
                 h["WTW"] = (self.nums(args, "WTW", line), line)
             elif cmd == "TEM":
@@ -369,9 +396,48 @@ class _SeqParser:
                 pass
             else:
                 self.unknown.setdefault(cmd[:20], line)
+        self.check_complete(surfs, h, xan, yan, xob, yob, in_prv)
         if not rdm_seen:
             self.warn("no RDM line: surface values are read as radii (RDM Y, CODE V's default)")
         return self.build(surfs, h, xan, yan, xob, yob)
+
+    def check_complete(self, surfs, h, xan, yan, xob, yob, in_prv: bool) -> None:
+        """Refuse a truncated file (a cut file must not read as a shorter lens).
+
+        CODE V ends a sequence with ``GO`` (every file CODE V writes; in tests/data/corpus the
+        files of CODE V and opticspy): with ``GO`` read, the lens is complete. Without it (files
+        written by hand or by other programs), the file must hold its image surface ``SI``, an
+        aperture, a field and a wavelength, a ``PRV`` block must be closed by ``END``, and the
+        last line must not be continued with ``&``. Not detectable without ``GO``: a cut after
+        ``SI`` that leaves the aperture, field and wavelength lines but drops later optional
+        ones (``REF``, ``WTW``, an ``XAN`` line after ``YAN``), and a cut inside the
+        last line that leaves a valid shorter number or list (``WL 650 550 450`` → ``WL 650
+        55``)."""
+        if self.go_line:
+            return
+        last_line = len(self.text.rstrip().split("\n"))
+        missing = []
+        if in_prv:
+            missing.append("the END of its PRV block")
+        if _ends_continued(self.text):
+            missing.append("the rest of its last line (it ends with '&')")
+        if not surfs or surfs[-1].kind != "SI":
+            missing.append("the image surface SI")
+        if "APER" not in h:
+            missing.append("an aperture (EPD, FNO or NAO)")
+        if not (xan or yan or xob or yob or h.get("IMF")):
+            missing.append("a field (YAN, YOB, YIM ...)")
+        elif (xan and not yan) or (xob and not yob):
+            missing.append("the y field (YAN / YOB) that goes with its XAN / XOB")
+        if "WL" not in h:
+            missing.append("a wavelength (WL)")
+        if missing:
+            raise self.err(
+                f"the file ends at line {last_line} without GO and without "
+                f"{'; '.join(missing)}: it looks truncated (or is not a CODE V sequence file); "
+                "use the complete file (CODE V writes GO at the end of a sequence)",
+                last_line,
+            )
 
     def surface_command(self, cur: _CSurf, cmd: str, args: list[str], line: int, no: int):
         if cmd == "SLB":
@@ -455,10 +521,12 @@ class _SeqParser:
         if code is not None:
             return code
         try:
-            cg = lookup_glass(name)
+            r = resolve_glass(name)
         except PrescriptionError as e:
             raise self.err(f"glass {name}: {e.reason}", line, no) from None
-        return cg.material
+        if r.warning:
+            self.warn(f"line {line}: {r.warning}")
+        return r.material
 
     def object_material(self, obj: _CSurf) -> Material:
         return self.material(obj.glass, 0) if obj.glass else AIR

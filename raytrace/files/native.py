@@ -125,6 +125,9 @@ _TOP_KEYS = (
     "field",
     "surfaces",
     "image",
+    # [[configurations]] (thicknesses per focus / zoom position) are read by
+    # raytrace.files.configurations; the lens read here is the base configuration.
+    "configurations",
 )
 _OBJECT_KEYS = ("distance", "glass", "catalog", "model", "n", "formula", "coefficients", "range_nm")
 _APERTURE_KEYS = tuple(APERTURE_KINDS)
@@ -306,7 +309,9 @@ def _number(
     try:
         v = float(value)
     except OverflowError:
-        raise src.error(f"{what}: the number is too large ({str(value)[:20]}...)", line, surface)
+        raise src.error(
+            f"{what}: the number is too large ({str(value)[:20]}...)", line, surface
+        ) from None
     if math.isnan(v) or (math.isinf(v) and not (allow_inf and v > 0)):
         raise src.error(f"{what} must be a finite number, got {value!r}", line, surface)
     return v

@@ -25,7 +25,9 @@ Anything that changes the optics and is not read (decenters ``DCX DCY DCZ TLA TL
 solves and pickups, special surfaces, gradient index) raises
 :class:`~raytrace.errors.PrescriptionError` with the file, line and what to do; display and
 bookkeeping commands are listed in one InteropWarning. The file format is OSLO 5/6 as written by
-OSLO and by optiland's OSLO writer (the corpus files of tests/data/corpus/optiland/).
+OSLO and by optiland's OSLO writer (the corpus files of tests/data/corpus/optiland/). A file cut
+short is refused (``check_complete``: the closing ``END`` and the surface counts of ``END n`` and
+``LEN NEW "title" … n``; lenses/INTEROP.md, "Truncated files").
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
-from ..glass import lookup_glass, private_material
+from ..glass import private_material, resolve_glass
 from ..lens import Aperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material
 from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
@@ -142,6 +144,9 @@ class _LenParser:
         cur: _OSurf | None = None
         wvs: dict[int, tuple[float, int]] = {}
         seen_len = False
+        declared: tuple[int, int] | None = None  # surface count on the LEN line, its line
+        end: tuple[int | None, int] | None = None  # surface count on the END line, its line
+        nxt = 0
         for lineno, raw in enumerate(self.text.split("\n"), start=1):
             toks = _tokens(raw.strip().lstrip("\ufeff"))
             if not toks:
@@ -152,15 +157,20 @@ class _LenParser:
                 title = [a.strip("\"'") for a in args if a.upper() != "NEW"]
                 if title and not _is_number(title[0]):
                     h["NAME"] = title[0]
+                nums = [t for t in title if _is_number(t)]
+                n_decl = _count(nums) if len(nums) >= 2 else None  # "title" value count
+                declared = None if n_decl is None else (n_decl, lineno)
                 continue
             if not seen_len:
                 raise self.err(
                     f"{cmd}: an OSLO lens file starts with 'LEN [NEW] \"title\"'", lineno
                 )
             if cmd == "END":
+                end = (_count(args), lineno)
                 break
             if cmd == "NXT":
                 cur = None
+                nxt += 1
                 continue
             if cmd in ("UNI", "EBR", "FNO", "NAO", "ANG", "OBH"):
                 h[cmd] = (self.num(args, 0, cmd, lineno), lineno)
@@ -195,7 +205,35 @@ class _LenParser:
             self.unknown.setdefault(cmd[:20], lineno)
         if not seen_len:
             raise self.err("not an OSLO .len lens file: no LEN line", 1)
+        self.check_complete(nxt, declared, end)
         return self.build(surfs, h, wvs)
+
+    def check_complete(
+        self, nxt: int, declared: tuple[int, int] | None, end: tuple[int | None, int] | None
+    ) -> None:
+        """Refuse a truncated file (a cut file must not read as a shorter lens). An OSLO lens
+        ends with ``END n`` and its first line ``LEN NEW "title" ... n`` may carry the same n,
+        the number of the image surface (= the number of ``NXT`` lines: surface 0 is the
+        object); both are checked when present. Not detectable: a cut inside the ``END`` line
+        itself (``END 12`` → ``END 1`` is caught by the count, ``END`` alone is not when the
+        LEN line has no count)."""
+        last_line = len(self.text.rstrip().split("\n"))
+        if end is None:
+            raise self.err(
+                f"the file ends at line {last_line} without OSLO's closing END (after {nxt} "
+                "surfaces): it looks truncated; use the complete file (OSLO writes END n last)",
+                last_line,
+            )
+        for what, count, line in (
+            ("END", end[0], end[1]),
+            ("LEN", *(declared if declared else (None, 0))),
+        ):
+            if count is not None and count != nxt:
+                raise self.err(
+                    f"{what} declares {count} surfaces after the object, but the file has "
+                    f"{nxt} (NXT lines): it is truncated or damaged; use the complete file",
+                    line,
+                )
 
     def surface_command(self, cur: _OSurf, cmd: str, args: list[str], line: int, no: int):
         if cmd == "RD":
@@ -254,9 +292,12 @@ class _LenParser:
                 raise self.err(f"GLA MOD {name}: {e}", line, no) from None
         name = args[0].strip("\"'")
         try:
-            return lookup_glass(name, ["SCHOTT"], first_catalog_wins=True).material
+            r = resolve_glass(name, ["SCHOTT"])
         except PrescriptionError as e:
             raise self.err(f"GLA {name}: {e.reason}", line, no) from None
+        if r.warning:
+            self.warn(f"line {line}: {r.warning}")
+        return r.material
 
     def build(self, surfs: list[_OSurf], h: dict, wvs: dict[int, tuple[float, int]]):
         last_line = len(self.text.split("\n"))
@@ -379,6 +420,14 @@ class _LenParser:
         s = list(lens.surfaces)
         s[-1] = replace(s[-1], thickness=d)
         return replace(lens, surfaces=tuple(s), image_solve="gaussian")
+
+
+def _count(args: list[str]) -> int | None:
+    """The last token as a whole number >= 0 (OSLO's surface count on LEN / END), else None."""
+    if not args or not _is_number(args[-1]):
+        return None
+    v = float(args[-1])
+    return int(v) if v == int(v) and 0 <= v < 1e6 else None
 
 
 def _is_number(s: str) -> bool:

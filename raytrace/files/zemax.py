@@ -50,7 +50,9 @@ the optics and cannot be modelled (non-sequential mode, other surface types such
 toroids and freeforms, gradient index, the r² term, a tilt/decenter mode other than explicit
 where the order matters) raises :class:`~raytrace.errors.PrescriptionError` with the file, line
 and what to do.
-Every problem with the input raises PrescriptionError (never another exception type).
+Every problem with the input raises PrescriptionError (never another exception type). A file cut
+short is refused, never read as a shorter lens (:meth:`_ZmxParser.check_complete` says what is
+checked and what cannot be detected; lenses/INTEROP.md, "Truncated files").
 
 Writing (:func:`dumps_zmx`, :func:`write_zmx`) produces a sequential file OpticStudio reads, with
 every number at full float64 precision (``repr``), model glasses, fixed semi-diameters, and the
@@ -68,7 +70,7 @@ from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
 from ..frames import ORDERS, Placement
-from ..glass import lookup_glass, parse_glass_code
+from ..glass import lookup_glass, parse_glass_code, printed_nd_vd, resolve_glass
 from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from .output import write_atomic
@@ -99,8 +101,9 @@ _IGNORED_GLOBAL = set(
     """VERS PFIL LANG GFAC RAIM PUSH SDMA ROPD PICB FWGN FWGT VDXN VDYN VCXN VCYN VANN
     POLS GLRS GSTD NSCD COFN TOL TOLE MOFF BLNK TRAC OPDX HYPR EFLY DMFS OMMA OEMA RCMF AUTH
     DBDT WAVN XFIE PUCN TCMM TOTR FLAN WFAN SSOB SGLI ZVDX ZVDY ZVCX ZVCY ZVAN PMAG
-    MAZH TCED WFNO""".split()
+    MAZH TCED WFNO THIC""".split()
 )
+# THIC: a multi-configuration thickness row (raytrace.files.configurations reads those)
 # WFNO is a merit-function / default-merit setting line (``WFNO 0 0 0 ...``), not an aperture:
 # the aperture is ENPD, FNUM (flag 0 image-space F/#, 1 paraxial working F/#), OBNA (flag 0 NA,
 # 1 object cone angle) or FLOA (float by stop size).
@@ -146,6 +149,7 @@ class _ZSurf:
     elap: tuple[float, float] | None = None
     obdc: tuple[float, float] = (0.0, 0.0)
     ap_line: int = 0
+    cmds: list[str] = field(default_factory=list)  # the block's commands in order
 
 
 class _ZmxParser:
@@ -191,6 +195,7 @@ class _ZmxParser:
         wavm: dict[int, tuple[float, int]] = {}
         wavl: tuple[list[float], int] | None = None
         gcat: list[str] = []
+        self.after_surfaces = 0  # first top-level line after the last SURF block (0: none)
         for lineno, raw in enumerate(lines, start=1):
             s = raw.strip().lstrip("\ufeff")
             if not s:
@@ -199,7 +204,13 @@ class _ZmxParser:
             cmd = parts[0].upper()
             args = parts[1:]
             rest = s[len(parts[0]) :].strip()
+            if surfaces and not self.after_surfaces and cmd != "SURF":
+                if cmd in _SURF_CMDS or raw[:1].isspace():
+                    surfaces[-1].cmds.append(cmd)
+                else:  # surface data is indented, the sections after the surfaces are not
+                    self.after_surfaces = lineno
             if cmd == "SURF":
+                self.after_surfaces = 0
                 n = self.integer(args, 0, "SURF", lineno)
                 expected = len(surfaces)
                 if n != expected:
@@ -304,8 +315,9 @@ class _ZmxParser:
                 n = self.integer(args, 0, "MNUM", lineno)
                 if n > 1:
                     self.warn(
-                        f"line {lineno}: MNUM {n}: a multi-configuration file; only the "
-                        "configuration stored in the surface data is read"
+                        f"line {lineno}: MNUM {n}: a multi-configuration file; the surface "
+                        "data are read as the base lens, its thickness configurations by "
+                        "raytrace.files.configurations.read_configured"
                     )
             elif cmd == "CONF":
                 self.warn(f"line {lineno}: CONF: multi-configuration data ignored")
@@ -450,10 +462,12 @@ class _ZmxParser:
         if code is not None:
             return code
         try:
-            g = lookup_glass(name, gcat, first_catalog_wins=True)
+            r = resolve_glass(name, gcat, printed=printed_nd_vd(args))
         except PrescriptionError as e:
             raise self.err(f"GLAS {name}: {e.reason}", line, no) from None
-        return g.material
+        if r.warning:
+            self.warn(f"line {line}: {r.warning}")
+        return r.material
 
     def aspheric(self, z: _ZSurf, scale: float) -> tuple[float, ...]:
         if z.type != "EVENASPH":
@@ -531,6 +545,46 @@ class _ZmxParser:
         wls = tuple(e[0] for e in entries)
         return wls, tuple(e[1] for e in entries), entries[primary_pos][2], wls[primary_pos]
 
+    def check_complete(self, surfaces: list[_ZSurf], last_line: int) -> None:
+        """Refuse a truncated file (a cut file must not read as a shorter lens).
+
+        A complete .zmx either goes on after its surfaces (OpticStudio writes top-level
+        sections there: ``BLNK``, ``TOL``, ``MNUM``, ``MOFF``, ...; surface data is indented,
+        those are not) or ends with a complete image surface: its ``DISZ`` is written and is 0,
+        it is no stop, mirror, glass or coordinate break, and it holds every command that
+        follows ``DISZ`` in all the other blocks (``DIAM``, ``MEMA``, ``POPS`` in OpticStudio's
+        files) — true of every real file in tests/data/corpus. Not detectable: a cut right
+        after the whole block of a plain lens surface of thickness 0 (it looks like an image
+        surface), a cut after ``DISZ 0`` of such a surface in a file whose blocks have nothing
+        after ``DISZ``, and a cut inside the last line that leaves a valid shorter number
+        (``DISZ 12.5`` → ``DISZ 1``) in a file without sections after the surfaces."""
+        if self.after_surfaces:
+            return
+        img = surfaces[-1]
+
+        def tail(z: _ZSurf) -> set[str] | None:
+            return set(z.cmds[z.cmds.index("DISZ") + 1 :]) if "DISZ" in z.cmds else None
+
+        tails = [t for t in (tail(z) for z in surfaces[:-1]) if t is not None]
+        missing = sorted(set.intersection(*tails) - (tail(img) or set())) if tails else []
+        what = ""
+        if not img.disz_line:
+            what = "has no DISZ line"
+        elif img.disz != 0.0:
+            what = f"has thickness DISZ {img.disz!r} (an image surface has 0)"
+        elif img.stop or img.mirror or img.glas is not None or img.type == "COORDBRK":
+            what = "is not an image surface (STOP, GLAS, a mirror or a coordinate break)"
+        elif missing:
+            what = f"lacks {', '.join(missing)}, which every other block has after DISZ"
+        if what:
+            raise self.err(
+                f"the file ends at line {last_line} inside the surface list, and its last block "
+                f"SURF {img.number} {what}: the file looks truncated (nothing follows the "
+                "surfaces); use the complete file (save or export it again from OpticStudio)",
+                img.line,
+                img.number,
+            )
+
     def coordinate_break(self, z: _ZSurf, scale: float, medium: Material) -> Surface:
         """A ``COORDBRK`` surface: PARM 1..6 = decenter x, y, tilt x, y, z (deg), order flag."""
 
@@ -607,9 +661,11 @@ class _ZmxParser:
         if len(surfaces) < 3:
             raise self.err(
                 f"found {len(surfaces)} SURF block(s): a lens needs the object surface (SURF 0), "
-                "at least one lens surface and the image surface",
+                "at least one lens surface and the image surface"
+                + ("" if self.after_surfaces else " (the file ends there: is it truncated?)"),
                 surfaces[-1].line if surfaces else last_line,
             )
+        self.check_complete(surfaces, last_line)
         scale = h.get("UNIT", (1.0, 0))[0]
         obj, img, body = surfaces[0], surfaces[-1], surfaces[1:-1]
         if obj.stop or img.stop:

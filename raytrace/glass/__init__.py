@@ -11,7 +11,9 @@ model (:mod:`.thermal`). :func:`search_glass` finds the catalog glasses nearest 
 A name found in several catalogs with different nd/vd is ambiguous: the error lists the
 candidates and how to pick one (a catalog suffix ``_SCHOTT``, a Zemax ``GCAT`` line, or a model
 glass). Six-digit glass codes (``620603`` → nd 1.620, vd 60.3) and ``nd:vd`` strings are parsed
-by :func:`parse_glass_code` without any catalog.
+by :func:`parse_glass_code` without any catalog. The file readers resolve names through
+:func:`resolve_glass` (:mod:`.legacy`): the file's catalogs first, then Schott's ``N-``
+successors of old glasses, each substitution with a warning.
 """
 
 from ..materials import OutOfRangeError, OutOfRangeWarning
@@ -33,6 +35,7 @@ from .catalog import (
     search_glass,
 )
 from .formulas import FORMULAS, evaluate
+from .legacy import GlassResolution, printed_nd_vd, resolve_glass
 from .thermal import delta_n_absolute, dn_dt_absolute, index_at
 
 __all__ = [
@@ -41,6 +44,7 @@ __all__ = [
     "FORMULAS",
     "CatalogGlass",
     "GlassMatch",
+    "GlassResolution",
     "OutOfRangeError",
     "OutOfRangeWarning",
     "PRIVATE",
@@ -57,7 +61,9 @@ __all__ = [
     "lookup_glass",
     "normalize_name",
     "parse_glass_code",
+    "printed_nd_vd",
     "private_material",
     "relative_to_absolute",
+    "resolve_glass",
     "search_glass",
 ]

@@ -27,13 +27,24 @@ from .codes import (
     G_ZV,
     KIND_ASPHERE,
     L_COAXIAL,
+    STATUS_BACKWARD,
     STATUS_CLIPPED,
     STATUS_MISSED,
     STATUS_OK,
     STATUS_TIR,
 )
 from .jit import kernel
-from .surface import NEWTON_MAX, NEWTON_TOL, quadric_root, reframe, snell, surface_step
+from .surface import (
+    NEWTON_MAX,
+    NEWTON_TOL,
+    acts,
+    backward_limit,
+    path_length,
+    quadric_root,
+    reframe,
+    snell,
+    surface_step,
+)
 
 BLOCK = 256
 #: Blocks per parallel work item (one scratch buffer per item): 16 x 256 = 4096 rays.
@@ -61,23 +72,35 @@ _RZC = 11 * BLOCK
 _RDC = 12 * BLOCK
 _RP = 13 * BLOCK
 _RDP = 14 * BLOCK
-NROWS = 15
+# path since the last acting surface (the backward-travel test, :mod:`.surface`)
+_RT = 15 * BLOCK
+NROWS = 16
 
 
 @kernel(error_model="numpy", inline="always")
-def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere):
+def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere, check, carry):
     """One plane / quadric surface for the nb rays of the scratch buffer, branch-free (selects
     only) so that it vectorises. Failed rays keep computing on meaningless values; their status
-    row records the first failure and they are replaced by NaN when the block is written out."""
+    row records the first failure and they are replaced by NaN when the block is written out.
+    ``check``: apply the backward-travel test (:mod:`.surface`, "Travelling backwards": only at
+    a surface that refracts, and once an acting surface was met); row ``_RT`` gets the path to
+    this surface and is added in only when ``carry`` (dummy surfaces were traced since the last
+    acting one). Branch-free, so the loop stays vectorised."""
     ck = cj * (1.0 + kj)
     mu2 = mu * mu
+    test = check and mu != 1.0
+    dummy = mu == 1.0
+    lim = backward_limit(zvj)
     for i in range(nb):
         LL = buf[_RL + i]
         MM = buf[_RM + i]
         NN = buf[_RN + i]
-        t0 = (zvj - buf[_RZ + i]) / NN
-        xx = buf[_RX + i] + t0 * LL
-        yy = buf[_RY + i] + t0 * MM
+        x0 = buf[_RX + i]
+        y0 = buf[_RY + i]
+        z0 = buf[_RZ + i]
+        t0 = (zvj - z0) / NN
+        xx = x0 + t0 * LL
+        yy = y0 + t0 * MM
         s, hit = quadric_root(cj, kj, xx, yy, LL, MM, NN)
         xx += s * LL
         yy += s * MM
@@ -98,8 +121,15 @@ def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere):
         # time); the drift measured over 11 surfaces is <= 2e-15 (tests check <= 1e-14).
         missed = (not (NN > 0.0)) or not hit or not (w > 0.0)
         clipped = xx * xx + yy * yy > sd2
+        tt = t0 + s  # the path: p = p0 + (t0 + s) d
+        if carry:  # loop-invariant branches: LLVM unswitches them, the loop stays vectorised
+            tt += buf[_RT + i]
+        if dummy:
+            buf[_RT + i] = tt
+        back = (tt < lim) & test
         code = float(STATUS_TIR) if sin2t > 1.0 else 0.0
         code = float(STATUS_CLIPPED) if clipped else code
+        code = float(STATUS_BACKWARD) if back else code
         code = float(STATUS_MISSED) if missed else code
         buf[_RX + i] = xx
         buf[_RY + i] = yy
@@ -141,11 +171,12 @@ def _asphere_sag_rows(buf, nb, c, k, asph, j):
 
 
 @kernel(error_model="numpy", inline="always")
-def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1):
+def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
     """One even-asphere surface for the nb rays of the scratch buffer, vectorised: the conic
     start point (as in :func:`surface_step`), then Newton passes over all rays still iterating
     (same step and stopping rule as :func:`surface_step`, at most ``NEWTON_MAX``), then the
-    normal, clipping and vector refraction as in :func:`_quadric_rows`."""
+    normal, clipping, the backward-travel test (``check``) and vector refraction as in
+    :func:`_quadric_rows`."""
     live = 0
     for i in range(nb):
         LL = buf[_RL + i]
@@ -208,6 +239,9 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1):
             buf[_RF + i] = jp1 if nc else buf[_RF + i]
     _asphere_sag_rows(buf, nb, cj, kj, asph, j)
     mu2 = mu * mu
+    test = check and mu != 1.0
+    carried = 1.0 if carry else 0.0
+    lim = backward_limit(zvj)
     for i in range(nb):
         LL = buf[_RL + i]
         MM = buf[_RM + i]
@@ -226,10 +260,17 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1):
         refract = mu != 1.0
         missed = not math.isfinite(dsag)
         clipped = xx * xx + yy * yy > sd2
+        # row _RZ still holds the start point's z; along the line the path is Δz / N (N > 0 here)
+        z0 = buf[_RZ + i]
+        z1 = zvj + buf[_RZL + i]
+        tt = (z1 - z0) / NN + buf[_RT + i] * carried
+        back = (tt < lim) & test
+        buf[_RT + i] = tt
         code = float(STATUS_TIR) if (refract and sin2t > 1.0) else 0.0
         code = float(STATUS_CLIPPED) if clipped else code
+        code = float(STATUS_BACKWARD) if back else code
         code = float(STATUS_MISSED) if missed else code
-        buf[_RZ + i] = zvj + buf[_RZL + i]
+        buf[_RZ + i] = z1
         buf[_RL + i] = L2 * inv if refract else LL
         buf[_RM + i] = M2 * inv if refract else MM
         buf[_RN + i] = N2 * inv if refract else NN
@@ -240,7 +281,7 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1):
 
 
 @kernel(error_model="numpy")
-def _general_rows(buf, nb, kind, c, k, asph, geo, j, mu, sdj, clip):
+def _general_rows(buf, nb, kind, c, k, asph, geo, j, mu, sdj, clip, check, acting, carry):
     """Surface j (flagged in the placement table) for the nb rays of the scratch buffer, one ray
     at a time with :func:`.surface.surface_step` (frame move, mirror, aperture, rays toward −z).
     Rays that failed before are left as they are."""
@@ -259,9 +300,13 @@ def _general_rows(buf, nb, kind, c, k, asph, geo, j, mu, sdj, clip):
             x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
         st = STATUS_OK
         if (fl & F_SKIP) == 0:
+            x0, y0, z0, L0, M0, N0 = x, y, z, L, M, N
             st, x, y, z, L, M, N = surface_step(
-                kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N
-            )
+                kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N,
+                False, buf[_RT + i] if carry else 0.0, 1 if check else 0,
+            )  # fmt: skip
+            t = path_length(x0, y0, z0, x, y, z, L0, M0, N0)
+            buf[_RT + i] = t + (buf[_RT + i] if carry else 0.0)
         buf[_RX + i] = x
         buf[_RY + i] = y
         buf[_RZ + i] = z
@@ -295,22 +340,35 @@ def _trace_block(kind, c, k, asph, geo, n_in, n_out, sd, clip, i0, i1, x, y, z, 
         buf[_RN + i] = N[ii] / nrm
         buf[_RS + i] = 0.0 if good else float(STATUS_MISSED)
         buf[_RF + i] = 0.0 if good else 1.0
+        buf[_RT + i] = 0.0
     coaxial = (int(geo[0, G_LENS]) & L_COAXIAL) != 0
+    check = False  # an acting surface was met: the backward-travel test applies (.surface)
+    carry = False  # dummy surfaces traced since the last acting one: row _RT holds their path
     for j in range(c.shape[0]):
         mu = n_in[j] / n_out[j]
+        acting = acts(geo, j, n_in, n_out)
         if not coaxial and geo[j, G_FLAGS] != 0.0:
-            _general_rows(buf, nb, kind[j], c[j], k[j], asph, geo, j, mu, sd[j], clip)
+            _general_rows(
+                buf, nb, kind[j], c[j], k[j], asph, geo, j, mu, sd[j], clip, check, acting, carry
+            )
+            if (int(geo[j, G_FLAGS]) & F_SKIP) == 0:
+                carry = not acting
+            check = check or acting
             continue
         zvj = geo[j, G_ZV]
         if kind[j] == KIND_ASPHERE:
             sd2 = sd[j] * sd[j] if clip else np.inf
-            _asphere_rows(buf, nb, c[j], k[j], asph, j, zvj, sd2, mu, float(j + 1))
+            _asphere_rows(buf, nb, c[j], k[j], asph, j, zvj, sd2, mu, float(j + 1), check, carry)
+            carry = not acting
+            check = check or acting
             continue
         sd2 = sd[j] * sd[j] if clip else np.inf
         if k[j] == 0.0:
-            _quadric_rows(buf, nb, c[j], 0.0, zvj, sd2, mu, float(j + 1), True)
+            _quadric_rows(buf, nb, c[j], 0.0, zvj, sd2, mu, float(j + 1), True, check, carry)
         else:
-            _quadric_rows(buf, nb, c[j], k[j], zvj, sd2, mu, float(j + 1), False)
+            _quadric_rows(buf, nb, c[j], k[j], zvj, sd2, mu, float(j + 1), False, check, carry)
+        carry = not acting
+        check = check or acting
     for i in range(nb):
         ii = i0 + i
         s = buf[_RS + i]

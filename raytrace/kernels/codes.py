@@ -4,7 +4,9 @@ Status codes (one per ray; every ray gets one, a failed ray has NaN coordinates 
 number of the surface where it failed): ``STATUS_OK`` 0, ``STATUS_MISSED`` 1 (the ray misses the
 surface or meets only its far branch, or travels away from it), ``STATUS_TIR`` 2 (total internal
 reflection), ``STATUS_CLIPPED`` 3 (outside the semi-diameter, when clipping is on),
-``STATUS_AIM_FAILED`` 4 (chief-ray aiming did not converge).
+``STATUS_AIM_FAILED`` 4 (chief-ray aiming did not converge), ``STATUS_BACKWARD`` 5 (the ray
+would have to travel against its direction to reach the surface: the surface lies behind the
+point where the ray met the previous one, so the two overlap; see :mod:`.surface`).
 
 Surface kind codes (:func:`raytrace.packing.pack`): ``KIND_PLANE`` 0, ``KIND_QUADRIC`` 1 (sphere
 or conic, closed-form intersection), ``KIND_ASPHERE`` 2 (even asphere, Newton iteration).
@@ -15,6 +17,7 @@ STATUS_MISSED = 1
 STATUS_TIR = 2
 STATUS_CLIPPED = 3
 STATUS_AIM_FAILED = 4
+STATUS_BACKWARD = 5
 
 #: status code -> the name used in tables and JSON
 STATUS_NAMES = {
@@ -23,7 +26,33 @@ STATUS_NAMES = {
     STATUS_TIR: "tir",
     STATUS_CLIPPED: "clipped",
     STATUS_AIM_FAILED: "aim_failed",
+    STATUS_BACKWARD: "backward",
 }
+
+#: status code -> what it means for a person, with the fix (``{surface}``: the 1-based surface)
+STATUS_HELP = {
+    STATUS_OK: "traced",
+    STATUS_MISSED: "ray misses surface {surface} (or meets only its far branch)",
+    STATUS_TIR: "total internal reflection at surface {surface}",
+    STATUS_CLIPPED: "ray clipped by the semi-diameter or clear aperture of surface {surface}",
+    STATUS_AIM_FAILED: "chief-ray aiming did not converge",
+    STATUS_BACKWARD: (
+        "ray travels backwards to surface {surface}: surfaces overlap; "
+        "check thicknesses / semi-diameters"
+    ),
+}
+
+
+def status_message(status: int, surface: int = 0) -> str:
+    """One line for a ray's status: what happened and where (``surface`` 1-based, 0 unknown).
+
+    >>> status_message(STATUS_BACKWARD, 3)
+    'ray travels backwards to surface 3: surfaces overlap; check thicknesses / semi-diameters'
+    """
+    text = STATUS_HELP.get(int(status), f"status {int(status)}")
+    where = str(int(surface)) if surface else "?"
+    return text.format(surface=where)
+
 
 KIND_PLANE = 0
 KIND_QUADRIC = 1

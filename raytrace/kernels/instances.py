@@ -120,7 +120,7 @@ def _irregular_step(c, k, asph, j, zs, za, rn, mu, sdj, clip, zvj, x, y, z, L, M
     return STATUS_OK, x, y, z, L, M, N
 
 
-@kernel(error_model="numpy", inline="always")
+@kernel(error_model="numpy")
 def _span(kind, c, k, asph, geo, n_in, n_out, sd, irr, j0, j1, clip, x, y, z, L, M, N):
     """Trace surfaces j0 .. j1-1 of ONE instance (its rows); as
     :func:`raytrace.kernels.surface.trace_span`, with irregular surfaces. Returns
@@ -156,7 +156,7 @@ def _start(finite, z_obj, f1, f2, u1, u2):
     return f1, f2, z_obj, u1 * nrm, u2 * nrm, nrm
 
 
-@kernel(error_model="numpy", inline="always")
+@kernel(error_model="numpy")
 def _stop_point(kind, c, k, asph, geo, n_in, n_out, sd, irr, stop, finite, z_obj, f1, f2, u1, u2):
     """(ok, x, y) where the ray (f, u) meets the stop surface of one instance (unclipped)."""
     x0, y0, z0, L0, M0, N0 = _start(finite, z_obj, f1, f2, u1, u2)
@@ -216,7 +216,7 @@ def _newton(kind, c, k, asph, geo, n_in, n_out, sd, irr, stop, finite, z_obj, f1
     return max(abs(r1), abs(r2)) <= tol, u1, u2
 
 
-@kernel(error_model="numpy", inline="always")
+@kernel(error_model="numpy")
 def _aim_one(kind, c, k, asph, geo, n_in, n_out, sd, irr, stop, finite, z_obj, f1, f2, unom, jinv,
              tol, hscale, clip, last, status, evals, resid):  # fmt: skip
     """Every field of ONE instance (module docstring); outputs its rows: last (6, F), status
@@ -336,8 +336,10 @@ def stop_points(lens, i, stop, finite, z_obj, f1, f2, u, out):
     (NaN when not traceable). For the nominal Jacobian of the chord iteration."""
     kind, c, k, asph, geo, n_in, n_out, sd, irr = lens
     for f in range(f1.shape[0]):
-        ok, x, y = _stop_point(kind[i], c[i], k[i], asph[i], geo[i], n_in[i], n_out[i], sd[i],
-                               irr[i], stop, finite, z_obj, f1[f], f2[f], u[f, 0], u[f, 1])  # fmt: skip
+        ok, x, y = _stop_point(
+            kind[i], c[i], k[i], asph[i], geo[i], n_in[i], n_out[i], sd[i], irr[i], stop,
+            finite, z_obj, f1[f], f2[f], u[f, 0], u[f, 1],
+        )  # fmt: skip
         out[f, 0] = x if ok else np.nan
         out[f, 1] = y if ok else np.nan
 

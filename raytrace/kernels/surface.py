@@ -1,11 +1,11 @@
 """Numba primitives of the real-ray trace: surface intersection, vector refraction, one surface
 step and a span of surfaces for a single ray (used by :mod:`.bulk`, :mod:`.aim`, :mod:`.paths`).
 
-Everything here sees only contiguous float64 / int64 arrays and scalars (docs/design.md, "Performance"); the Python
-layer in :mod:`raytrace.trace` owns objects, validation and errors.
+Everything here sees only contiguous float64 / int64 arrays and scalars (docs/design.md,
+"Performance"); the Python layer in :mod:`raytrace.trace` owns objects, validation and errors.
 
-Geometry (docs/design.md, "Conventions"): millimetres, light toward +z, first vertex at z = 0. A ray is a point
-(x, y, z) and unit direction cosines (L, M, N). The lens arrays are those of
+Geometry (docs/design.md, "Conventions"): millimetres, light toward +z, first vertex at z = 0. A
+ray is a point (x, y, z) and unit direction cosines (L, M, N). The lens arrays are those of
 :class:`raytrace.packing.PackedLens`: ``kind, c, k, asph, geo, n_in, n_out, sd``, where ``geo`` is
 the placement table (:mod:`.codes`, column ``G_ZV`` the vertex z).
 
@@ -48,9 +48,29 @@ Refraction (vector Snell)
 Clear apertures (``F_APERTURE``, clipping on): circle / rectangle / ellipse of half-widths
 (hx, hy) about (x0, y0) in the surface frame, besides the semi-diameter about the vertex.
 
+Travelling backwards (``STATUS_BACKWARD``)
+    The path length from the point where the ray met the previous surface to the point on this
+    one is ``t = d·(p_new − p_old)`` (d the unit direction: exact for a point on the line; frame
+    moves are rigid and keep it). A surface that *acts* on the ray (it refracts, n ≠ n', or
+    reflects) must be reached from the last acting surface by a path ``T = Σ t`` (summed over the
+    dummy surfaces between, where the ray goes straight on) with
+    ``T ≥ −BACKWARD_TOL (1 mm + |z_vertex|)``; otherwise the ray would have to travel
+    against its direction — the surfaces overlap (a negative air gap, a curved surface reaching
+    past one set at zero distance) — and it fails with BACKWARD instead of passing with a silent
+    number. The sign is taken along the current direction, so the reversed direction after a
+    mirror and the moved frames of placed surfaces count correctly; T ≈ 0 within the tolerance
+    (coincident surfaces, round-off) passes. Dummy surfaces (n = n', no mirror: reference planes,
+    a stop drawn in air, CODE V / Zemax test files of decenters) may be reached virtually, as the
+    source programs allow. Before the first acting surface nothing is checked: a ray is a line
+    that may start anywhere before it (for an object at infinity a point on the vertex plane of
+    surface 1, behind a concave first surface). Callers that carry T (:func:`trace_span`, the
+    bulk trace) pass ``t_before`` and ``check``; a bare call (``check = -1``) measures T from the
+    incoming point and checks once any surface before j is traced. Not detected: overlaps off
+    the ray's path (semi-diameters are the lens's business: :func:`raytrace.lens.check_physical`).
+
 Status codes: OK 0, MISSED 1, TIR 2, CLIPPED 3 (outside the semi-diameter or clear aperture, when
-clipping is on), AIM_FAILED 4. A failed ray carries the 1-based number of the surface where it
-failed and NaN coordinates; every ray gets a status.
+clipping is on), AIM_FAILED 4, BACKWARD 5. A failed ray carries the 1-based number of the surface
+where it failed and NaN coordinates; every ray gets a status.
 """
 
 from __future__ import annotations
@@ -72,6 +92,7 @@ from .codes import (
     KIND_PLANE,
     KIND_QUADRIC,
     L_COAXIAL,
+    STATUS_BACKWARD,
     STATUS_CLIPPED,
     STATUS_MISSED,
     STATUS_OK,
@@ -81,6 +102,43 @@ from .jit import kernel
 
 NEWTON_MAX = 60
 NEWTON_TOL = 1e-14
+#: relative tolerance of the backward-travel test (module docstring): t < -BACKWARD_TOL * scale
+BACKWARD_TOL = 1e-9
+
+
+@kernel(error_model="numpy", inline="always")
+def path_length(x0, y0, z0, x1, y1, z1, L, M, N):
+    """Signed path length (mm) from (x0, y0, z0) to (x1, y1, z1) along the unit direction
+    (L, M, N) of the line through both."""
+    return L * (x1 - x0) + M * (y1 - y0) + N * (z1 - z0)
+
+
+@kernel(error_model="numpy", inline="always")
+def backward_limit(zvj):
+    """The most negative path (mm) still taken as forward at a surface whose vertex is at z =
+    zvj of its axis frame: −BACKWARD_TOL (1 mm + |zvj|) (module docstring)."""
+    return -BACKWARD_TOL * (1.0 + abs(zvj))
+
+
+@kernel(error_model="numpy", inline="always")
+def traced_before(geo, j, coaxial):
+    """True when some surface before j is traced (not ``F_SKIP``): the check of a bare
+    :func:`surface_step` call (``check = -1``)."""
+    if coaxial:
+        return j > 0
+    for i in range(j):
+        if (int(geo[i, G_FLAGS]) & F_SKIP) == 0:
+            return True
+    return False
+
+
+@kernel(error_model="numpy", inline="always")
+def acts(geo, j, n_in, n_out):
+    """True when surface j acts on a ray (refracts with n ≠ n', or reflects) and is traced."""
+    fl = int(geo[j, G_FLAGS])
+    if (fl & F_SKIP) != 0:
+        return False
+    return (fl & F_MIRROR) != 0 or n_in[j] != n_out[j]
 
 
 @kernel(error_model="numpy", inline="always")
@@ -162,10 +220,16 @@ def outside_aperture(geo, j, x, y):
 
 
 @kernel(error_model="numpy", inline="always")
-def surface_step(kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N, coaxial=False):
+def surface_step(
+    kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N, coaxial=False, t_before=0.0, check=-1
+):
     """Intersect surface j and refract (or reflect). The ray is in surface j's axis frame
     (module docstring). Returns (status, x, y, z, L, M, N) with the point on the surface (axis
     frame) and the direction after it; status != 0 leaves the values meaningless.
+
+    ``t_before``: path (mm) from the last acting surface to the incoming point; ``check``: 1 / 0
+    apply / skip the backward-travel test, -1 decide by :func:`traced_before` (module
+    docstring, "Travelling backwards").
 
     ``coaxial=True`` (a literal at the call site, for a lens without any flag: lens flag
     ``L_COAXIAL``) skips reading the surface's flags; after inlining the branches it leaves are
@@ -178,6 +242,9 @@ def surface_step(kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N, coax
     elif not (N > 0.0):
         return STATUS_MISSED, x, y, z, L, M, N
     sg = 1.0 if (coaxial or N > 0.0) else -1.0
+    x0 = x
+    y0 = y
+    z0 = z
     t0 = (zvj - z) / N
     x = x + t0 * L
     y = y + t0 * M
@@ -230,6 +297,11 @@ def surface_step(kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N, coax
             ny = -2.0 * y * dsag
             nz = 1.0
     z = zvj + zl
+    if check != 0 and ((fl & F_MIRROR) != 0 or mu != 1.0):
+        t = t_before + path_length(x0, y0, z0, x, y, z, L, M, N)
+        if t < backward_limit(zvj):
+            if check == 1 or traced_before(geo, j, coaxial):
+                return STATUS_BACKWARD, x, y, z, L, M, N
     if clip:
         if x * x + y * y > sdj * sdj:
             return STATUS_CLIPPED, x, y, z, L, M, N
@@ -269,14 +341,30 @@ def trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L,
     """Trace surfaces j0 .. j1-1 (0-based) of the packed lens; the ray comes in the axis frame of
     the last traced surface before j0 (global for j0 = 0) and leaves in that of the last one
     traced (for j1 = n: the image frame). Returns (status, surface_1based, x, y, z, L, M, N)."""
+    # the ray starts on the last surface traced before j0: when that surface acts, the path
+    # since the last acting surface is 0 and the backward-travel test applies at once; when it is
+    # a dummy (a stop in air) the path from the acting surface before it is not known here, and
+    # the test starts at the next acting surface (the full trace of the bulk kernels checks it)
+    acted = False
+    for jb in range(j0 - 1, -1, -1):
+        if (int(geo[jb, G_FLAGS]) & F_SKIP) == 0:
+            acted = acts(geo, jb, n_in, n_out)
+            break
+    tacc = 0.0  # path since the last acting surface
     if (int(geo[0, G_LENS]) & L_COAXIAL) != 0:  # a centred refracting lens: no flags to read
         for j in range(j0, j1):
+            x0, y0, z0, L0, M0, N0 = x, y, z, L, M, N
             st, x, y, z, L, M, N = surface_step(
                 kind[j], c[j], k[j], asph, geo, j, n_in[j] / n_out[j], sd[j], clip,
-                x, y, z, L, M, N, True,
+                x, y, z, L, M, N, True, tacc, 1 if acted else 0,
             )  # fmt: skip
             if st != STATUS_OK:
                 return st, j + 1, x, y, z, L, M, N
+            if n_in[j] != n_out[j]:
+                acted = True
+                tacc = 0.0
+            else:
+                tacc += path_length(x0, y0, z0, x, y, z, L0, M0, N0)
         return STATUS_OK, 0, x, y, z, L, M, N
     for j in range(j0, j1):
         fl = int(geo[j, G_FLAGS])
@@ -284,9 +372,16 @@ def trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L,
             x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
         if (fl & F_SKIP) != 0:
             continue
+        x0, y0, z0, L0, M0, N0 = x, y, z, L, M, N
         st, x, y, z, L, M, N = surface_step(
-            kind[j], c[j], k[j], asph, geo, j, n_in[j] / n_out[j], sd[j], clip, x, y, z, L, M, N
-        )
+            kind[j], c[j], k[j], asph, geo, j, n_in[j] / n_out[j], sd[j], clip, x, y, z, L, M, N,
+            False, tacc, 1 if acted else 0,
+        )  # fmt: skip
         if st != STATUS_OK:
             return st, j + 1, x, y, z, L, M, N
+        if acts(geo, j, n_in, n_out):
+            acted = True
+            tacc = 0.0
+        else:
+            tacc += path_length(x0, y0, z0, x, y, z, L0, M0, N0)
     return STATUS_OK, 0, x, y, z, L, M, N

@@ -4,11 +4,13 @@ No numba here: paraxial-only commands stay fast to start."""
 
 from .conjugates import (
     ImagePlane,
+    checked_wavelength,
     image_planes,
     object_distance_for_s,
     object_distance_for_scale,
     plane_z,
     resolve_object_distance,
+    resolve_paraxial,
 )
 from .firstorder import ParaxialResult, paraxial
 from .orthoscopy import (
@@ -25,6 +27,7 @@ __all__ = [
     "ImagePlane",
     "ParaxialResult",
     "PestrecovConstants",
+    "checked_wavelength",
     "distortion_slope",
     "ideal_heights",
     "image_planes",
@@ -37,4 +40,5 @@ __all__ = [
     "pestrecov_constants",
     "plane_z",
     "resolve_object_distance",
+    "resolve_paraxial",
 ]

@@ -245,3 +245,77 @@ def resolve_object_distance(
             f"first vertex) or inf, got {od!r}; for Pestrecov's signed s use object_s="
         )
     return od
+
+
+def checked_wavelength(value: float | str | None, what: str = "wavelength") -> float | None:
+    """A wavelength keyword through the one check (:func:`raytrace.units.wavelength_nm`).
+
+    Parameters
+    ----------
+    value : float, str or None
+        nm, or a string with a unit (``"0.5876um"``); ``None`` passes through (the caller's
+        default, usually the lens's reference wavelength).
+    what : str
+        The name used in the error message.
+
+    Returns
+    -------
+    float or None
+        The wavelength in nm, or ``None``.
+
+    Raises
+    ------
+    TraceError
+        A value the check refuses (e.g. a bare number below 100, which looks like µm).
+    """
+    if value is None:
+        return None
+    from ..units import UnitError, wavelength_nm
+
+    try:
+        return wavelength_nm(value, what)
+    except UnitError as e:
+        raise TraceError(str(e)) from None
+
+
+def resolve_paraxial(
+    lens: Lens,
+    object_distance: float | str | None = None,
+    object_s: float | None = None,
+    object_scale: float | None = None,
+    wavelength: float | str | None = None,
+    *,
+    nominal: bool = False,
+) -> ParaxialResult:
+    """The paraxial data of ``lens`` for an object given in the project's vocabulary.
+
+    Checks ``wavelength`` (:func:`checked_wavelength`), resolves the object plane
+    (:func:`resolve_object_distance`) at that wavelength and runs
+    :func:`raytrace.paraxial.paraxial` there: the one path from the API keywords to a
+    :class:`ParaxialResult`.
+
+    Parameters
+    ----------
+    lens : Lens
+    object_distance, object_s, object_scale
+        The object plane (at most one): mm from the first vertex (or ``inf`` / ``"12x"``),
+        Pestrecov's signed s from H (mm, negative for a real object), or an image scale N
+        ("N×"). Default: the lens file's object.
+    wavelength : float or str, optional
+        nm (or a string with a unit); default the lens's reference wavelength.
+    nominal : bool
+        Take the first-order data of the lens's centred nominal (``lens.nominal()``), for a lens
+        with decentred or tilted surfaces; the object is still resolved with ``lens``.
+
+    Returns
+    -------
+    ParaxialResult
+        Its ``object_distance`` (mm from the first vertex, or inf) and ``wavelength`` (nm) are
+        the resolved ones.
+    """
+    from .firstorder import paraxial
+
+    wl = checked_wavelength(wavelength)
+    obj = dict(object_distance=object_distance, object_s=object_s, object_scale=object_scale)
+    od = resolve_object_distance(lens, **obj, wavelength=wl)
+    return paraxial(lens.nominal() if nominal else lens, object_distance=od, wavelength=wl)

@@ -3,11 +3,12 @@
 K. Pestrecov, *Radial Distortion: Its Calibration, Computation in Non-Gaussian Image Planes, and
 Compensation*, Photogrammetric Engineering (1958), Sections II–III.
 
-Signs follow Pestrecov's Fig. 1 (docs/design.md, "Conventions"): distances are measured from the reference point,
-negative to the left (object side) and positive to the right. ``s`` (object plane from the first
-nodal point H) is negative for a real object, ``s'`` (actual image plane from the second nodal
-point H') is positive, ``HE0`` / ``H'E0'`` are the paraxial entrance / exit pupil positions measured
-from H / H'. All lengths are in millimetres; magnifications are dimensionless.
+Signs follow Pestrecov's Fig. 1 (docs/design.md, "Conventions"): distances are measured from the
+reference point, negative to the left (object side) and positive to the right. ``s`` (object
+plane from the first nodal point H) is negative for a real object, ``s'`` (actual image plane from
+the second nodal point H') is positive, ``HE0`` / ``H'E0'`` are the paraxial entrance / exit
+pupil positions measured from H / H'. All lengths are in millimetres; magnifications are
+dimensionless.
 
 The functions of numbers check a paper's tables without a lens (Table III → Table IV);
 :func:`pestrecov_constants`, :func:`orthoscopy_abscissa` and :func:`ideal_heights` apply the same

@@ -474,43 +474,80 @@ def perturbed_lens(
 class ParaxialBatch:
     """First-order data of the centred part of many instances (arrays (I,), mm, absolute z from
     the first vertex): ``efl``; ``z_image`` the paraxial image of the object (the Gaussian plane;
-    for an object at infinity the back focal point); ``z_last`` the last vertex."""
+    for an object at infinity the back focal point); ``z_last`` the last vertex; ``chief_h`` and
+    ``chief_slope`` the paraxial chief ray (through the centre of the stop) per unit field
+    abscissa t (t = tan α for an object at infinity; for a finite object the object point is
+    ``object_per_t · t``): its height at the last vertex (mm) and its image-space slope u'
+    (height per mm of z), so that Pestrecov's constant of orthoscopy of a plane z is
+    ``K0(z) = chief_h + (z − z_last) · chief_slope`` (Eq. 8 as the paraxial chief ray's height in
+    the plane: F0 in mm for an object at infinity, M0·object_per_t for a finite one)."""
 
     efl: np.ndarray
     z_image: np.ndarray
     z_last: np.ndarray
+    chief_h: np.ndarray
+    chief_slope: np.ndarray
+
+    def k0_at(self, z) -> np.ndarray:
+        """Pestrecov's K0 (mm per unit t) of each instance in the planes ``z`` ((I,) or scalar)."""
+        return self.chief_h + (np.asarray(z, dtype=float) - self.z_last) * self.chief_slope
 
 
-def paraxial_batch(arrays: InstanceArrays, object_distance: float) -> ParaxialBatch:
-    """Paraxial marginal and system rays of every instance's centred part (its decenters and
-    tilts left out, as :meth:`Lens.nominal` does): the y-nu trace ``n'u' = nu − y (n' − n) c``,
-    ``y += t u'`` of :func:`raytrace.paraxial.paraxial`, over instances at once (tested equal to
-    :func:`raytrace.paraxial.paraxial` on the instances' lenses)."""
+def paraxial_batch(
+    arrays: InstanceArrays, object_distance: float, object_per_t: float | None = None
+) -> ParaxialBatch:
+    """Paraxial marginal, system and chief rays of every instance's centred part (its decenters
+    and tilts left out, as :meth:`Lens.nominal` does): the y-nu trace ``n'u' = nu − y (n' − n)
+    c``, ``y += t u'`` of :func:`raytrace.paraxial.paraxial`, over instances at once (tested
+    equal to :func:`raytrace.paraxial.paraxial` on the instances' lenses). ``object_per_t``: for a
+    finite object, the object height (mm) per unit field abscissa t (Pestrecov's nominal
+    ``p0 = z_object − z_E0`` of the nominal lens); unused for an object at infinity."""
     n = arrays.n_surfaces
     c = arrays.c[:, :n]
     n_in = arrays.n_in[:, :n]
     n_out = arrays.n_out[:, :n]
     t = arrays.thickness
     I = c.shape[0]
+    stop = arrays.stop
 
-    def trace(y, nu):
-        for j in range(n):
+    def trace(y, nu, upto=n):
+        """(y, nu) after surface upto − 1; y_stop: height at the stop surface."""
+        y_stop = y
+        for j in range(upto):
+            if j == stop:
+                y_stop = y
             nu = nu - y * (n_out[:, j] - n_in[:, j]) * c[:, j]
             if j + 1 < n:
                 y = y + t[:, j] * nu / n_out[:, j]
-        return y, nu
+        return y, nu, y_stop
 
     # system matrix columns: (y, nu) = (1, 0) and (0, 1) at the first vertex
-    A, C = trace(np.ones(I), np.zeros(I))
+    A, C, sA = trace(np.ones(I), np.zeros(I))
+    B, D, sB = trace(np.zeros(I), np.ones(I))
     z_last = arrays.vertex_z[:, -1]
     nk = n_out[:, -1]
+    n0 = n_in[:, 0]
     efl = -1.0 / C
     if math.isinf(object_distance):
         z_img = z_last - A * nk / C
+        # chief ray: slope 1 in object space (nu = n0), height y1 with zero height at the stop
+        y1 = -n0 * sB / sA
+        nu1 = n0
     else:
-        n0 = n_in[:, 0]
         u = 1.0 / object_distance  # slope of a ray from the axial object point
-        y1 = u * object_distance
-        ym, num = trace(y1 * np.ones(I), n0 * u * np.ones(I))
+        y1m = u * object_distance
+        ym = A * y1m + B * (n0 * u)
+        num = C * y1m + D * (n0 * u)
         z_img = z_last - ym / (num / nk)
-    return ParaxialBatch(efl, z_img, z_last)
+        if object_per_t is None:
+            raise ValueError("a finite object needs object_per_t (the object height per unit t)")
+        # chief ray from the object point Y = object_per_t at z = -object_distance through the
+        # stop centre: y1 = Y + d u, nu1 = n0 u with sA y1 + sB nu1 = 0
+        Y = float(object_per_t)
+        d = float(object_distance)
+        uc = -sA * Y / (sA * d + sB * n0)
+        y1 = Y + d * uc
+        nu1 = n0 * uc
+    ch = A * y1 + B * nu1
+    cnu = C * y1 + D * nu1
+    return ParaxialBatch(efl, z_img, z_last, ch, cnu / nk)

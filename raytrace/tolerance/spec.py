@@ -219,7 +219,7 @@ class ToleranceSpec:
         if not self.items:
             raise ToleranceSpecError(
                 f"{self.path or 'tolerance spec'}: no tolerances; give at least one item "
-                "(e.g. { type = \"TEDY\", surfaces = [1, 2], limit = 0.02 })"
+                '(e.g. { type = "TEDY", surfaces = [1, 2], limit = 0.02 })'
             )
 
     @property
@@ -323,7 +323,9 @@ def make_item(
         raise ToleranceSpecError(f"{where}: sigma must be a positive number, got {sigma!r}")
     if t == "TTHI":
         if not _is_int(adjust) or adjust < 0:
-            raise ToleranceSpecError(f"{where}: adjust must be a surface number or 0, got {adjust!r}")
+            raise ToleranceSpecError(
+                f"{where}: adjust must be a surface number or 0, got {adjust!r}"
+            )
         if adjust == a:
             adjust = 0
     elif adjust:
@@ -410,7 +412,9 @@ def _monte_carlo(v: Any, where: str) -> dict:
     _keys(v, MC_KEYS, where)
     for k in MC_KEYS:
         if k in v and not (_is_int(v[k]) and v[k] >= (0 if k == "seed" else 1)):
-            raise ToleranceSpecError(f"{where}: {k} must be a whole number ≥ {0 if k == 'seed' else 1}")
+            raise ToleranceSpecError(
+                f"{where}: {k} must be a whole number ≥ {0 if k == 'seed' else 1}"
+            )
     return dict(v)
 
 

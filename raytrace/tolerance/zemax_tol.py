@@ -110,7 +110,7 @@ def parse_zmx_tolerances(text: str, path: str = "<zmx>") -> ZemaxTolerances:
         if code == "TWAV":
             if not (math.isfinite(lo) and lo > 0.0):
                 raise ToleranceSpecError(f"{where}: TWAV test wavelength must be positive µm")
-            test_wl = lo * 1000.0
+            test_wl = round(lo * 1000.0, 9)  # µm → nm without 632.8000000000001
             continue
         if code == "STAT":
             if i1 == 0:

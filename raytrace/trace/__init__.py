@@ -4,6 +4,7 @@ first use."""
 
 from ..kernels.codes import (
     STATUS_AIM_FAILED,
+    STATUS_BACKWARD,
     STATUS_CLIPPED,
     STATUS_MISSED,
     STATUS_NAMES,
@@ -19,6 +20,7 @@ from .rays import PARALLEL_THRESHOLD, RayBatch, RayPaths, packed_lens, ray_paths
 __all__ = [
     "PARALLEL_THRESHOLD",
     "STATUS_AIM_FAILED",
+    "STATUS_BACKWARD",
     "STATUS_CLIPPED",
     "STATUS_MISSED",
     "STATUS_NAMES",

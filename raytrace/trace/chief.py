@@ -31,7 +31,7 @@ from ..errors import LensError, TraceError
 from ..kernels.codes import STATUS_NAMES, STATUS_OK
 from ..lens import Lens
 from ..packing import PackedLens, pack
-from ..paraxial.conjugates import resolve_object_distance
+from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
 
 
@@ -41,6 +41,8 @@ class ApertureWarning(UserWarning):
 
 #: Fields per kernel call: a larger request is aimed in chunks (Ctrl-C stops between them).
 AIM_CHUNK = 8192
+#: the aim tolerance rule of docs/design.md, "Conventions": residual ≤ AIM_TOL × max(1 mm, R_stop)
+AIM_TOL = 1e-12
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,19 +79,48 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
                 ApertureWarning,
                 stacklevel=4,
             )
-    if math.isfinite(object_distance):
-        den = z_E0 + object_distance  # z_E0 − z_obj
-        slope0 = np.array([-1.0 / d if d != 0.0 else 0.0 for d in den])
-        hscale = np.ones(nw)
-    else:
-        slope0 = -z_E0
-        hscale = np.maximum(1.0, r_stop)
+    slope0, hscale = aim_start(z_E0, object_distance, r_stop)
     # one wavelength: its own pupil (as a monochromatic lens); several: the reference
     # wavelength's, so that every wavelength traces the same object points
     z_field = z_E0[0] if nw == 1 else _aim_setup(lens, (lens.wavelength,), object_distance).z_E0[0]
-    return _AimSetup(
-        p, z_E0, r_stop, 1e-12 * np.maximum(1.0, r_stop), slope0, hscale, float(z_field)
-    )
+    return _AimSetup(p, z_E0, r_stop, aim_tolerance(r_stop), slope0, hscale, float(z_field))
+
+
+def aim_tolerance(r_stop: np.ndarray | float) -> np.ndarray | float:
+    """The absolute aim tolerance (mm) of docs/design.md, "Conventions": the chief ray meets the
+    stop surface within ``AIM_TOL × max(1 mm, R_stop)`` of its centre, ``R_stop`` (mm) the stop's
+    semi-diameter when finite, else the paraxial marginal-ray height at the stop."""
+    return AIM_TOL * np.maximum(1.0, r_stop)
+
+
+def aim_start(
+    z_E0: np.ndarray, object_distance: float, r_stop: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The aim kernels' first-guess arguments per wavelength, from the paraxial entrance pupil.
+
+    Parameters
+    ----------
+    z_E0 : ndarray
+        (n_w,) paraxial entrance pupil, absolute z (mm).
+    object_distance : float
+        mm from the object plane to the first vertex (inf for infinity).
+    r_stop : ndarray
+        (n_w,) stop radius (mm) used for the tolerance.
+
+    Returns
+    -------
+    slope0 : ndarray
+        (n_w,) paraxial d(unknown)/d(field) at field 0: ``−1/(z_E0 − z_object)`` (1/mm) for a
+        finite object (0 when the pupil lies in the object plane), ``−z_E0`` (mm/rad) at infinity.
+    hscale : ndarray
+        (n_w,) scale of the unknown for finite differences: 1 (a slope), or
+        ``max(1 mm, R_stop)`` (a height) at infinity.
+    """
+    if math.isfinite(object_distance):
+        den = z_E0 + object_distance  # z_E0 − z_obj
+        slope0 = np.array([-1.0 / d if d != 0.0 else 0.0 for d in den])
+        return slope0, np.ones(len(z_E0))
+    return -z_E0, np.maximum(1.0, r_stop)
 
 
 @dataclass(frozen=True, eq=False)
@@ -331,7 +362,7 @@ def chief_rays(
         object_distance=object_distance,
         object_s=object_s,
         object_scale=object_scale,
-        wavelength=None if wavelengths is not None else _wl(wavelength),
+        wavelength=None if wavelengths is not None else checked_wavelength(wavelength),
     )
     if fields_deg is not None and object_heights_mm is not None:
         raise TraceError("give fields_deg or object_heights_mm, not both")
@@ -344,18 +375,6 @@ def chief_rays(
     if wavelengths is not None:
         return aim(lens, f, fk, od, clip=clip, wavelengths=wavelengths)
     return aim(lens, f, fk, od, wavelength, clip)
-
-
-def _wl(value, what: str = "wavelength") -> float | None:
-    """A wavelength in nm through the one check (:func:`raytrace.units.wavelength_nm`)."""
-    if value is None:
-        return None
-    from ..units import UnitError, wavelength_nm
-
-    try:
-        return wavelength_nm(value, what)
-    except UnitError as e:
-        raise TraceError(str(e)) from None
 
 
 def resolve_wavelengths(lens: Lens, wavelengths) -> tuple[float, ...]:
@@ -372,6 +391,48 @@ def resolve_wavelengths(lens: Lens, wavelengths) -> tuple[float, ...]:
         return wavelengths_nm(wavelengths)
     except UnitError as e:
         raise TraceError(str(e)) from None
+
+
+def checked_aim_request(
+    field_kind: str, object_distance: float, *fields: np.ndarray, heights: str = "object heights"
+) -> float:
+    """Check the resolved arguments of a chief-ray aim (:func:`aim`,
+    :func:`raytrace.trace.aim_2d`) before any tracing.
+
+    Parameters
+    ----------
+    field_kind : str
+        ``"angle"`` or ``"height"``.
+    object_distance : float
+        mm from the object plane to the first vertex: positive, or inf.
+    *fields : ndarray
+        The field arrays (degrees for angles, mm for object coordinates): finite, and angles
+        strictly within ±90°.
+    heights : str
+        What object heights are called in the message (``"object coordinates"`` in 2-D).
+
+    Returns
+    -------
+    float
+        The object distance (mm, or inf).
+
+    Raises
+    ------
+    TraceError
+        The first argument that is out of range, named.
+    """
+    if field_kind not in ("angle", "height"):
+        raise TraceError(f"field kind must be 'angle' or 'height', got {field_kind!r}")
+    od = float(object_distance)
+    if not (od > 0.0):
+        raise TraceError(f"object distance must be a positive magnitude or inf, got {od}")
+    if not all(np.all(np.isfinite(f)) for f in fields):
+        raise TraceError("fields must be finite numbers")
+    if field_kind == "height" and not math.isfinite(od):
+        raise TraceError(f"{heights} need a finite object distance")
+    if field_kind == "angle" and any(np.any(np.abs(f) >= 90.0) for f in fields):
+        raise TraceError("field angles must lie strictly between -90 and 90 degrees")
+    return od
 
 
 def aim(
@@ -391,28 +452,18 @@ def aim(
     from ..kernels.aim import aim_chief
 
     fk = field_kind
-    if fk not in ("angle", "height"):
-        raise TraceError(f"field kind must be 'angle' or 'height', got {fk!r}")
-    od = float(object_distance)
-    if not (od > 0.0):
-        raise TraceError(f"object distance must be a positive magnitude or inf, got {od}")
-    finite = math.isfinite(od)
     f = np.atleast_1d(np.asarray(fields, dtype=np.float64))
     if f.ndim != 1:
         raise TraceError("fields must be a scalar or a 1-D array")
-    if not np.all(np.isfinite(f)):
-        raise TraceError("fields must be finite numbers")
-    if fk == "height" and not finite:
-        raise TraceError("object heights need a finite object distance")
-    if fk == "angle" and np.any(np.abs(f) >= 90.0):
-        raise TraceError("field angles must lie strictly between -90 and 90 degrees")
+    od = checked_aim_request(fk, object_distance, f)
+    finite = math.isfinite(od)
     chromatic = wavelengths is not None
     if chromatic:
         if wavelength is not None:
             raise TraceError("give wavelength= or wavelengths=, not both")
         wls = resolve_wavelengths(lens, wavelengths)
     else:
-        wls = (lens.wavelength if wavelength is None else _wl(wavelength),)
+        wls = (lens.wavelength if wavelength is None else checked_wavelength(wavelength),)
     su = _aim_setup(lens, wls, od)
     z_obj = -od if finite else 0.0
     nw = len(wls)

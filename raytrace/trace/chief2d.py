@@ -40,11 +40,9 @@ from ..errors import LensError, TraceError
 from ..kernels.codes import STATUS_NAMES, STATUS_OK
 from ..lens import Lens
 from ..packing import PackedLens, pack
-from ..paraxial.conjugates import resolve_object_distance
+from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
-
-#: the aim tolerance rule of docs/design.md, "Conventions": residual ≤ AIM_TOL × max(1 mm, R_stop)
-AIM_TOL = 1e-12
+from .chief import aim_start, aim_tolerance, checked_aim_request
 
 
 @dataclass(frozen=True, eq=False)
@@ -64,7 +62,7 @@ def _setup(lens: Lens, wavelength: float, object_distance: float) -> _Setup2D:
         raise TraceError(str(e)) from None
     sd = float(p.sd[p.stop])
     r = sd if math.isfinite(sd) else r_par
-    return _Setup2D(p, float(z_E0), float(r), AIM_TOL * max(1.0, float(r)))
+    return _Setup2D(p, float(z_E0), float(r), float(aim_tolerance(float(r))))
 
 
 @dataclass(frozen=True, eq=False)
@@ -212,12 +210,7 @@ def chief_rays_2d(
     ChiefRays2D
         Named arrays in the broadcast shape of the fields; a failed ray has a status and NaN.
     """
-    from ..units import UnitError, wavelength_nm
-
-    try:
-        wl = lens.wavelength if wavelength is None else wavelength_nm(wavelength)
-    except UnitError as e:
-        raise TraceError(str(e)) from None
+    wl = lens.wavelength if wavelength is None else checked_wavelength(wavelength)
     od = resolve_object_distance(
         lens,
         object_distance=object_distance,
@@ -259,22 +252,12 @@ def aim_2d(
     first vertex (inf), ``wavelength`` nm."""
     from ..kernels.aim2d import aim_chief_2d
 
-    if field_kind not in ("angle", "height"):
-        raise TraceError(f"field kind must be 'angle' or 'height', got {field_kind!r}")
-    od = float(object_distance)
-    if not (od > 0.0):
-        raise TraceError(f"object distance must be a positive magnitude or inf, got {od}")
-    finite = math.isfinite(od)
     fx = np.asarray(fields_x, dtype=np.float64)
     fy = np.asarray(fields_y, dtype=np.float64)
     if fx.shape != fy.shape:
         raise TraceError(f"fields_x and fields_y differ in shape: {fx.shape} vs {fy.shape}")
-    if not (np.all(np.isfinite(fx)) and np.all(np.isfinite(fy))):
-        raise TraceError("fields must be finite numbers")
-    if field_kind == "height" and not finite:
-        raise TraceError("object coordinates need a finite object distance")
-    if field_kind == "angle" and (np.any(np.abs(fx) >= 90.0) or np.any(np.abs(fy) >= 90.0)):
-        raise TraceError("field angles must lie strictly between -90 and 90 degrees")
+    od = checked_aim_request(field_kind, object_distance, fx, fy, heights="object coordinates")
+    finite = math.isfinite(od)
     wl = float(lens.wavelength if wavelength is None else wavelength)
     su = _setup(lens, wl, od)
     z_obj = -od if finite else 0.0
@@ -287,13 +270,7 @@ def aim_2d(
         if finite:  # nominal angles → object point p0·(tan αx, tan αy)
             p0 = z_obj - su.z_E0
             f1, f2 = p0 * f1, p0 * f2
-    if finite:
-        den = su.z_E0 - z_obj
-        slope0 = -1.0 / den if den != 0.0 else 0.0
-        hscale = 1.0
-    else:
-        slope0 = -su.z_E0
-        hscale = max(1.0, su.r_stop)
+    slope0, hscale = aim_start(np.array([su.z_E0]), od, np.array([su.r_stop]))
     n = f1.size
     start = np.empty((1, 6, n))
     last = np.empty((1, 6, n))
@@ -308,9 +285,9 @@ def aim_2d(
         z_obj,
         np.ascontiguousarray(f1, dtype=np.float64),
         np.ascontiguousarray(f2, dtype=np.float64),
-        np.array([slope0]),
+        slope0,
         np.array([su.tol]),
-        np.array([hscale]),
+        hscale,
         bool(clip),
         start,
         last,

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import TraceError
 from ..kernels.codes import STATUS_OK
 from ..lens import Lens
-from ..paraxial import ImagePlane, image_planes, paraxial, plane_z, resolve_object_distance
+from ..paraxial import ImagePlane, image_planes, plane_z, resolve_paraxial
 from .chief import aim
 from .pupil import aimed_bundle, pupil_points
 from .rays import trace_rays
@@ -53,16 +53,12 @@ def _trace_field(
     wavelength,
     clip,
 ):
-    od = resolve_object_distance(
-        lens,
-        object_distance=object_distance,
-        object_s=object_s,
-        object_scale=object_scale,
-        wavelength=wavelength,
-    )
-    par = paraxial(lens, od, wavelength)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength)
+    od = par.object_distance
     f, kind = _field(lens, field_deg, object_height_mm, not par.infinite)
-    planes = image_planes(plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus)
+    planes = image_planes(
+        plane, s_prime=s_prime, from_last_vertex=from_last_vertex, defocus=defocus
+    )
     if len(planes) != 1:
         raise TraceError("ray fans and spot diagrams take one image plane")
     z = float(plane_z(par, planes)[0])
@@ -72,7 +68,9 @@ def _trace_field(
             f"{lens.name}: the chief ray of field {f:g} {'deg' if kind == 'angle' else 'mm'} "
             f"fails ({cr.status_names[0]}); no fan or spot about it"
         )
-    b = aimed_bundle(lens, par, (cr.y_start[0], cr.z_start[0], cr.M_start[0], cr.N_start[0]), px, py)
+    b = aimed_bundle(
+        lens, par, (cr.y_start[0], cr.z_start[0], cr.M_start[0], cr.N_start[0]), px, py
+    )
     rb = trace_rays(lens, b.origins, b.directions, wavelength=wavelength, clip=clip)
     x, y = rb.at_plane(z)
     yc = float(cr.heights_at(z)[0])

@@ -1,0 +1,501 @@
+"""Distortion, camera constant and principal point versus focus, for a lens whose configurations
+change thicknesses (focus positions), and Brown's variation model tested on it (issue 13 item 4).
+
+Brown (1971) and Fraser & Shortis (1992) model a lens focused by moving it as a whole (*unit
+focusing*): the thin-lens equation then gives the principal distance ``c_s = f (1 + 1/N)`` of the
+lens focused at image scale N (Gaussian magnification −1/N), hence Eq. (2)
+``γ_ss' = c_s'/c_s`` and Eq. (4) ``α_s``, both in :mod:`distortion.variation.models`. A lens that
+focuses by moving a group (front-cell, inner or rear focusing) changes its focal length and
+principal planes with focus; this module measures how far the model then is from the traced
+lens.
+
+Definitions (one per quantity; all from the configured lens, nothing from the thin-lens model):
+
+* **Focus distance** ``distance_mm``: object plane → image plane (the camera's focusing scale
+  reads this; it does not move when a group moves). ``object_distance_mm``: object plane → first
+  vertex (the Lens convention).
+* **Image scale** ``N = −1/m0``, m0 the Gaussian magnification of the object in focus (``inf`` at
+  infinity). Brown's γ and α are evaluated in image scales (``brown_gamma_scales``,
+  ``brown_alpha_scales``), as Fraser & Shortis label their settings (8×, 12×, ...).
+* **Principal distance** ``principal_distance_mm``: image plane → second principal point H'
+  (Pestrecov's s'; Brown's c_s). For unit focusing of any thick lens in air Newton's equation
+  gives exactly ``c_s = f (1 + 1/N)``: Brown's γ then holds to round-off.
+* **Camera constant** ``camera_constant_mm``: ``c = p0'/m_e`` (Pestrecov Eq. 8 with the
+  perspective centre at the entrance pupil; ``F0`` at infinity, ``M0·p0`` for a finite object):
+  the scale the distortion is measured against.
+* **Principal point** ``principal_point_mm``: the image of the axial object point (the real chief
+  ray of field 0) in the image plane, meridional coordinate. The study needs first-order data,
+  hence a centred lens, for which it is 0: it is reported as traced, not assumed.
+* **Distortion** ``dr_um``: the Gaussian profile δr_s of Fraser & Shortis, Pestrecov's
+  characteristic D0 (Eqs. 8–9) in the configuration's image plane, outward positive, against the
+  actual radius ``r_mm = |y'|`` (:mod:`distortion.variation.traced` has the same definition).
+
+Brown's Eq. (3)–(4) test (:class:`InterpolationTest`): the Gaussian profiles of two calibrated
+configurations predict every other configuration's with α_s from the image scales; profiles are
+compared on one grid of radii (cubic spline of δr against r, as in
+:mod:`distortion.variation.traced`) up to the smallest largest radius of the three.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from raytrace.errors import LensError, TraceError
+from raytrace.files.configurations import (
+    Configuration,
+    Configurations,
+    apply_configuration,
+    check_surfaces,
+)
+from raytrace.lens import Lens
+
+from ..errors import DataError
+from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
+from .models import Conjugate, brown_alpha_scales, brown_gamma_scales, brown_interpolate
+
+DEFAULT_N_FIELDS = 61
+DEFAULT_N_R = 25
+#: the in-focus solve stops when the Gaussian image is this close to the image plane (mm)
+FOCUS_TOLERANCE_MM = 1e-10
+
+
+# --------------------------------------------------------------------------------------------
+# Making focus configurations
+# --------------------------------------------------------------------------------------------
+
+
+def track_length(lens: Lens) -> float:
+    """First vertex → image plane (mm): the sum of the thicknesses (a centred, mirror-free lens)."""
+    return float(sum(s.thickness for s in lens.surfaces))
+
+
+def _gaussian_miss(lens: Lens, wavelength: float | None) -> float:
+    from raytrace.paraxial import paraxial
+
+    par = paraxial(lens, None, wavelength)
+    return float(par.gaussian_image_distance - lens.surfaces[-1].thickness)
+
+
+def _moved(lens: Lens, moving: int, compensating: int | None, delta: float, distance: float):
+    s = list(lens.surfaces)
+    s[moving - 1] = replace(s[moving - 1], thickness=s[moving - 1].thickness + delta)
+    if compensating is not None:
+        c = compensating - 1
+        s[c] = replace(s[c], thickness=s[c].thickness - delta)
+    out = replace(lens, surfaces=tuple(s), image_solve=None)
+    od = math.inf if math.isinf(distance) else distance - track_length(out)
+    if not od > 0:
+        raise DataError(
+            f"{lens.name}: focus distance {distance:g} mm is inside the lens (track "
+            f"{track_length(out):g} mm)"
+        )
+    return replace(out, object_distance=od)
+
+
+def solve_focus(
+    lens: Lens,
+    distance_mm: float,
+    *,
+    moving: int,
+    compensating: int | None = None,
+    name: str | None = None,
+    wavelength: float | None = None,
+) -> Configuration:
+    """The configuration that focuses ``lens`` on an object ``distance_mm`` from its image plane.
+
+    The thickness after surface ``moving`` (1-based) changes by δ, that after ``compensating``
+    by −δ (None: nothing compensates); the object distance becomes ``distance_mm`` − track.
+    Unit focusing: ``moving`` = the last surface (the whole lens moves away from the image
+    plane). Front-cell focusing: ``moving`` = the air space behind the front cell (the cell
+    moves forward, the rest stays). Inner focusing: ``moving``/``compensating`` = the air spaces
+    before / after the group (the track stays). δ is solved (secant method) until the Gaussian
+    image of the object lies within :data:`FOCUS_TOLERANCE_MM` of the image plane.
+    """
+    n = lens.n_surfaces
+    for k, what in ((moving, "moving"), (compensating, "compensating")):
+        if k is not None and not 1 <= k <= n:
+            raise DataError(f"{what} = {k}: {lens.name} has surfaces 1–{n}")
+    if compensating == moving:
+        raise DataError("moving and compensating must be different surfaces")
+    if not distance_mm > 0:
+        raise DataError(
+            f"focus distance must be positive (mm from the image plane), got {distance_mm}"
+        )
+
+    def miss(d: float) -> float:
+        return _gaussian_miss(_moved(lens, moving, compensating, d, distance_mm), wavelength)
+
+    d0, d1 = 0.0, 1e-3 * max(1.0, abs(lens.surfaces[moving - 1].thickness))
+    f0, f1 = miss(d0), miss(d1)
+    for _ in range(60):
+        if abs(f1) <= FOCUS_TOLERANCE_MM:
+            break
+        if f1 == f0:
+            break
+        d0, d1, f0 = d1, d1 - f1 * (d1 - d0) / (f1 - f0), f1
+        try:
+            f1 = miss(d1)
+        except (LensError, DataError) as e:
+            raise DataError(
+                f"{lens.name}: cannot focus on {distance_mm:g} mm by moving surface {moving}: {e}"
+            ) from None
+    if not abs(f1) <= FOCUS_TOLERANCE_MM:
+        raise DataError(
+            f"{lens.name}: focusing on {distance_mm:g} mm by moving surface {moving} did not "
+            f"converge (the Gaussian image misses the image plane by {f1:.3g} mm)"
+        )
+    out = _moved(lens, moving, compensating, d1, distance_mm)
+    ks = [moving] + ([compensating] if compensating is not None else [])
+    th = tuple(sorted((k, out.surfaces[k - 1].thickness) for k in ks))
+    label = name or ("inf" if math.isinf(distance_mm) else f"{distance_mm / 1000:g} m")
+    return Configuration(label, th, out.object_distance)
+
+
+def focus_configurations(
+    lens: Lens,
+    distances_mm: Sequence[float],
+    *,
+    moving: int,
+    compensating: int | None = None,
+    wavelength: float | None = None,
+) -> Configurations:
+    """:func:`solve_focus` for each focus distance (mm from the image plane; ``inf``)."""
+    return Configurations(
+        tuple(
+            solve_focus(lens, d, moving=moving, compensating=compensating, wavelength=wavelength)
+            for d in distances_mm
+        ),
+        1,
+        f"{lens.name}: focus by surface {moving}"
+        + ("" if compensating is None else f" against {compensating}"),
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# One focus setting
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class FocusSetting:
+    """One configuration traced in its own image plane (module docstring for each quantity).
+
+    Lengths in mm, ``dr_um`` in µm; ``fields_deg``: nominal field angles traced; ``defocus_mm``:
+    image plane − Gaussian image plane of the object (0 for a configuration in focus)."""
+
+    name: str
+    lens: Lens
+    object_distance_mm: float
+    distance_mm: float
+    image_scale: float
+    efl_mm: float
+    principal_distance_mm: float
+    camera_constant_mm: float
+    principal_point_mm: float
+    from_last_vertex_mm: float
+    defocus_mm: float
+    fields_deg: np.ndarray
+    r_mm: np.ndarray
+    dr_um: np.ndarray
+
+    def __repr__(self) -> str:
+        return (
+            f"FocusSetting({self.name!r}, N={self.image_scale:.6g}, f={self.efl_mm:.6f} mm, "
+            f"c={self.principal_distance_mm:.6f} mm)"
+        )
+
+
+def _field_limit(lens: Lens, max_field_deg: float | None) -> float:
+    if max_field_deg is not None:
+        if not 0 < max_field_deg < 90:
+            raise DataError(f"maximum field angle must lie in (0, 90) degrees, got {max_field_deg}")
+        return float(max_field_deg)
+    if lens.field.kind != "angle":
+        raise DataError(
+            f"{lens.name}: its field is an object height; give max_field_deg (degrees) for a "
+            "focus study"
+        )
+    return float(lens.field.value)
+
+
+def trace_focus_setting(
+    lens: Lens,
+    name: str,
+    fields_deg: np.ndarray,
+    *,
+    object_distance: float | None = None,
+    wavelength: float | None = None,
+) -> FocusSetting:
+    """Trace ``lens`` (one configuration) with the object at ``object_distance`` (default: the
+    lens's) in the lens's image plane (its last thickness)."""
+    from raytrace.paraxial import paraxial
+
+    from ..characteristic import characteristic_distortion
+
+    od = lens.object_distance if object_distance is None else float(object_distance)
+    par = paraxial(lens, od, wavelength)
+    t_img = lens.surfaces[-1].thickness
+    try:
+        cd = characteristic_distortion(
+            lens,
+            np.asarray(fields_deg, dtype=float),
+            object_distance=od,
+            from_last_vertex=t_img,
+            wavelength=wavelength,
+        )
+    except TraceError as e:
+        raise DataError(f"{lens.name}, configuration {name}: {e}") from None
+    finite = math.isfinite(od)
+    k0 = float(cd.constant[0])
+    c = k0 * par.p0 if finite else k0
+    yp, y0p, d0 = cd.yp[0], cd.y0p[0], cd.D0[0]
+    scale = -1.0 / par.m0 if finite else math.inf
+    return FocusSetting(
+        name=name,
+        lens=lens,
+        object_distance_mm=od,
+        distance_mm=od + track_length(lens) if finite else math.inf,
+        image_scale=float(scale),
+        efl_mm=float(par.efl),
+        principal_distance_mm=float(cd.s_prime[0]),
+        camera_constant_mm=float(c),
+        principal_point_mm=float(yp[0]) if cd.fields[0] == 0 else math.nan,
+        from_last_vertex_mm=float(t_img),
+        defocus_mm=float(cd.defocus[0]),
+        fields_deg=np.asarray(cd.fields, dtype=float),
+        r_mm=np.abs(yp),
+        dr_um=d0 * np.sign(y0p) * 1000.0,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Brown's model against the traced lens
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class GammaTest:
+    """Brown's Eq. (2) for configuration ``name`` against the ``reference`` one.
+
+    ``gamma_brown`` = ``brown_gamma_scales(N_ref, N)`` (thin lens, unit focusing);
+    ``gamma_traced`` = c/c_ref, the ratio of the traced principal distances;
+    ``relative_error`` = γ_brown/γ_traced − 1; ``error_um_at_edge`` (µm) = the image-radius
+    error at ``r_edge_mm`` (the largest radius all settings reach) of scaling the reference
+    calibration's principal distance by γ_brown instead of the true ratio:
+    ``relative_error · r_edge``.
+    """
+
+    name: str
+    reference: str
+    gamma_brown: float
+    gamma_traced: float
+    relative_error: float
+    r_edge_mm: float
+    error_um_at_edge: float
+
+
+@dataclass(frozen=True, eq=False)
+class InterpolationTest:
+    """Brown's Eq. (3)–(4): the Gaussian profile of ``name`` predicted from the calibrated
+    configurations ``s1``, ``s2`` with ``alpha`` (image scales), against the traced profile, at
+    radii ``r_mm``. ``error_um`` = predicted − traced; ``max_abs_um`` at ``r_at_max_mm``."""
+
+    name: str
+    s1: str
+    s2: str
+    alpha: float
+    r_mm: np.ndarray
+    traced_um: np.ndarray
+    predicted_um: np.ndarray
+    error_um: np.ndarray
+    rms_um: float
+    max_abs_um: float
+    r_at_max_mm: float
+
+
+@dataclass(frozen=True, eq=False)
+class FocusStudy:
+    """Everything a focus study gives: ``settings`` per configuration, Brown's γ per
+    configuration against the first (``gamma``), Eq. (3)–(4) from two calibrated configurations
+    (``interpolation``), and, when asked for, the Fraser–Shortis analysis (``analysis``) of the
+    Gaussian profiles and of the other configurations' object planes imaged with the lens in
+    configuration ``focus_index`` (non-Gaussian profiles δr_ss')."""
+
+    lens_name: str
+    settings: tuple[FocusSetting, ...]
+    gamma: tuple[GammaTest, ...]
+    calibrated: tuple[int, int]
+    interpolation: tuple[InterpolationTest, ...]
+    analysis: VariationAnalysis | None
+    notes: tuple[str, ...]
+
+
+def _spline(r: np.ndarray, dr: np.ndarray, grid: np.ndarray, label: str) -> np.ndarray:
+    ok = np.isfinite(r) & np.isfinite(dr)
+    n = int(np.argmin(ok)) if not ok.all() else ok.size
+    r, dr = r[:n], dr[:n]
+    if r.size < 4 or not np.all(np.diff(r) > 0):
+        raise DataError(f"profile {label}: fewer than 4 traced fields, or r does not grow")
+    if grid[-1] > r[-1] * (1 + 1e-12):
+        raise DataError(f"profile {label}: the radii reach only {r[-1]:.4g} mm")
+    return CubicSpline(r, dr)(grid)
+
+
+def _r_hi(settings: Sequence[FocusSetting]) -> float:
+    out = math.inf
+    for s in settings:
+        ok = np.isfinite(s.r_mm) & np.isfinite(s.dr_um)
+        n = int(np.argmin(ok)) if not ok.all() else ok.size
+        out = min(out, float(s.r_mm[n - 1]) if n else 0.0)
+    return out
+
+
+def gamma_tests(settings: Sequence[FocusSetting], reference: int = 0) -> tuple[GammaTest, ...]:
+    """Brown's Eq. (2) in image scales against the traced principal distances, every setting
+    against ``settings[reference]``."""
+    ref = settings[reference]
+    r_edge = _r_hi(settings)
+    out = []
+    for s in settings:
+        gb = brown_gamma_scales(ref.image_scale, s.image_scale)
+        gt = s.principal_distance_mm / ref.principal_distance_mm
+        # an image point at radius r_edge in setting s, scaled from the reference calibration:
+        # the radius error of using γ_brown instead of the traced ratio
+        err = (gb - gt) / gt * r_edge * 1000.0
+        out.append(GammaTest(s.name, ref.name, gb, gt, gb / gt - 1.0, r_edge, err))
+    return tuple(out)
+
+
+def interpolation_tests(
+    settings: Sequence[FocusSetting], s1: int, s2: int, *, n_r: int = DEFAULT_N_R
+) -> tuple[InterpolationTest, ...]:
+    """Brown's Eq. (3)–(4) from ``settings[s1]`` and ``settings[s2]`` for every other setting."""
+    a, b = settings[s1], settings[s2]
+    if a.image_scale == b.image_scale:
+        raise DataError("the two calibrated configurations focus at the same image scale")
+    out = []
+    for i, s in enumerate(settings):
+        if i in (s1, s2):
+            continue
+        hi = _r_hi([a, b, s])
+        grid = np.linspace(hi / n_r, hi, n_r)
+        p1 = _spline(a.r_mm, a.dr_um, grid, a.name)
+        p2 = _spline(b.r_mm, b.dr_um, grid, b.name)
+        p = _spline(s.r_mm, s.dr_um, grid, s.name)
+        alpha = brown_alpha_scales(s.image_scale, a.image_scale, b.image_scale)
+        pred = brown_interpolate(p1, p2, alpha)
+        err = pred - p
+        j = int(np.argmax(np.abs(err)))
+        out.append(
+            InterpolationTest(
+                s.name,
+                a.name,
+                b.name,
+                float(alpha),
+                grid,
+                p,
+                pred,
+                err,
+                float(np.sqrt(np.mean(err**2))),
+                float(abs(err[j])),
+                float(grid[j]),
+            )
+        )
+    return tuple(out)
+
+
+def _conj(s: FocusSetting) -> Conjugate:
+    return Conjugate(s.image_scale, "x", f"{s.image_scale:.6g}x")
+
+
+def focus_study(
+    lens: Lens,
+    configurations: Configurations,
+    *,
+    calibrated: tuple[int, int] | None = None,
+    focus_index: int | None = None,
+    n_fields: int = DEFAULT_N_FIELDS,
+    n_r: int = DEFAULT_N_R,
+    max_field_deg: float | None = None,
+    wavelength: float | None = None,
+) -> FocusStudy:
+    """Trace every configuration of ``lens`` and test Brown's model on them (module docstring).
+
+    calibrated: the two configurations (0-based) whose Gaussian profiles calibrate Eq. (3)–(4)
+    (default: the first and the last). focus_index: with it, the other configurations' object
+    planes are also traced with the lens in that configuration (δr_ss') and the whole profile
+    set goes through :func:`distortion.variation.analyze_variation` (γ, Eq. 1, g of Eq. 6).
+    Each configuration must give its object distance (surface 0) or keep the lens's.
+    """
+    check_surfaces(lens, configurations)
+    if len(configurations) < 2:
+        raise DataError(f"{lens.name}: a focus study needs at least two configurations")
+    if n_fields < 8 or n_r < 2:
+        raise DataError("need n_fields >= 8 traced fields and n_r >= 2 radii")
+    fields = np.linspace(0.0, _field_limit(lens, max_field_deg), n_fields)
+    lenses = [apply_configuration(lens, c) for c in configurations.configurations]
+    settings = tuple(
+        trace_focus_setting(ln, c.name, fields, wavelength=wavelength)
+        for ln, c in zip(lenses, configurations.configurations, strict=True)
+    )
+    scales = [s.image_scale for s in settings]
+    if len(set(scales)) != len(scales):
+        raise DataError(f"{lens.name}: two configurations focus at the same image scale")
+    n = len(settings)
+    cal = (0, n - 1) if calibrated is None else tuple(calibrated)
+    if len(cal) != 2 or not all(0 <= i < n for i in cal) or cal[0] == cal[1]:
+        raise DataError(f"calibrated must be two different configurations in 0–{n - 1}")
+    gam = gamma_tests(settings)
+    interp = interpolation_tests(settings, cal[0], cal[1], n_r=n_r) if n > 2 else ()
+    analysis = None
+    if focus_index is not None:
+        analysis = _fs_analysis(settings, focus_index, fields, n_r, wavelength)
+    notes = (
+        "image scale N = -1/m0 of the object in focus; Brown's gamma and alpha in image scales",
+        "principal distance: image plane from H' (Brown's c_s); camera constant p0'/m_e",
+        "distortion: Pestrecov's characteristic D0 in the configuration's image plane, "
+        "outward positive, against r = |y'|",
+    )
+    return FocusStudy(lens.name, settings, gam, cal, interp, analysis, notes)
+
+
+def _fs_analysis(settings, focus_index: int, fields, n_r: int, wavelength) -> VariationAnalysis:
+    n = len(settings)
+    if not 0 <= focus_index < n:
+        raise DataError(f"focus_index must lie in 0–{n - 1}")
+    foc = settings[focus_index]
+    cross = []
+    for i, s in enumerate(settings):
+        if i == focus_index or math.isinf(s.distance_mm):
+            continue
+        od = s.distance_mm - track_length(foc.lens)
+        t = trace_focus_setting(
+            foc.lens, foc.name, fields, object_distance=od, wavelength=wavelength
+        )
+        cross.append((s, t))
+    every = list(settings) + [t for _, t in cross]
+    hi = _r_hi(every)
+    grid = np.linspace(hi / n_r, hi, n_r)
+    profiles = [
+        Profile(_conj(s), _conj(s), grid.copy(), _spline(s.r_mm, s.dr_um, grid, s.name))
+        for s in settings
+    ]
+    profiles += [
+        Profile(_conj(foc), _conj(s), grid.copy(), _spline(t.r_mm, t.dr_um, grid, s.name))
+        for s, t in cross
+    ]
+    ps = ProfileSet(tuple(profiles), settings[0].efl_mm, f"{foc.lens.name} (configurations)")
+    return analyze_variation(ps)
+
+
+def unit_focus_configurations(
+    lens: Lens, distances_mm: Sequence[float], *, wavelength: float | None = None
+) -> Configurations:
+    """Unit focusing of ``lens``: only the last thickness (the back focus) and the object
+    distance change; :func:`solve_focus` with ``moving`` = the last surface."""
+    return focus_configurations(lens, distances_mm, moving=lens.n_surfaces, wavelength=wavelength)

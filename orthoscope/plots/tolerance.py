@@ -1,0 +1,152 @@
+"""Figures of a tolerancing run (:mod:`distortion.tolerance`): the percentile envelope of the
+distortion curve over a Monte Carlo batch (raw and calibrated), histograms of the per-lens
+outputs (P1, P2, Fc, g, ...) and the ranked sensitivity bars. Every function keeps the ``ax=``
+convention of :mod:`orthoscope.plots.common`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .common import GRID, ZERO, figure_and_axes, set_title
+
+#: the envelope bands drawn (outer, inner percentile pairs), when the run computed them
+BANDS = ((2.5, 97.5), (16.0, 84.0))
+
+
+def _level(levels, p: float):
+    """Index of percentile ``p`` in ``levels`` or None."""
+    hit = np.nonzero(np.isclose(np.asarray(levels, dtype=float), p))[0]
+    return int(hit[0]) if hit.size else None
+
+
+def plot_envelope(mc, *, calibrated: bool = False, limits=(), ax=None, title=None):
+    """Percentile envelope of the distortion curve D (µm) along +y against the field angle (deg):
+    the 2.5–97.5 % and 16–84 % bands, the median and the nominal lens; ``calibrated`` draws
+    ``D_cal`` (what a calibration of each lens leaves: camera constant and principal point
+    removed). ``limits`` [(µm, deg), ...] are drawn as ± marks. Returns the Figure."""
+    fig, ax = figure_and_axes(ax)
+    f = np.asarray(mc.fields_deg, dtype=float)
+    env = np.asarray(mc.envelope_cal_um if calibrated else mc.envelope_um, dtype=float)
+    levels = mc.percentiles
+    for (lo, hi), alpha in zip(BANDS, (0.18, 0.32), strict=True):
+        a, b = _level(levels, lo), _level(levels, hi)
+        if a is not None and b is not None:
+            ax.fill_between(f, env[a], env[b], color="C0", alpha=alpha, lw=0,
+                            label=f"{lo:g}–{hi:g} %")  # fmt: skip
+    m = _level(levels, 50.0)
+    if m is not None:
+        ax.plot(f, env[m], color="C0", lw=1.4, label="median")
+    nom = np.asarray((mc.nominal.D_cal_um if calibrated else mc.nominal.D_um), dtype=float).reshape(
+        -1
+    )
+    ax.plot(f, nom, color="k", lw=1.0, ls="--", label="nominal lens")
+    for lim, deg in limits:
+        ax.errorbar([deg], [0.0], yerr=[[lim], [lim]], fmt="none", ecolor="C3", capsize=4,
+                    lw=1.0)  # fmt: skip
+    ax.axhline(0.0, **ZERO)
+    ax.grid(True, **GRID)
+    ax.set_xlabel("field angle α (deg)")
+    ax.set_ylabel("calibrated distortion D_c (µm)" if calibrated else "distortion D (µm)")
+    ax.legend(fontsize=8, frameon=False)
+    what = "calibrated (Fc and principal point removed)" if calibrated else "raw"
+    set_title(ax, title or f"{mc.n} lenses: distortion along +y, {what}")
+    return fig
+
+
+def plot_histogram(values, *, label: str, nominal: float | None = None, ax=None, title=None):
+    """Histogram of one per-lens output (``values``: finite entries are counted), with the
+    nominal value marked. Returns the Figure."""
+    fig, ax = figure_and_axes(ax)
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size:
+        ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color="C0", alpha=0.75)
+    if nominal is not None and np.isfinite(nominal):
+        ax.axvline(nominal, color="k", ls="--", lw=1.0, label="nominal")
+        ax.legend(fontsize=8, frameon=False)
+    ax.grid(True, **GRID)
+    ax.set_xlabel(label)
+    ax.set_ylabel("lenses")
+    set_title(ax, title or label)
+    return fig
+
+
+def plot_sensitivity(rows, *, label: str, top: int = 15, ax=None, title=None):
+    """Ranked horizontal bars of a sensitivity table (``rows`` as
+    :meth:`SensitivityResult.table` returns them: name, delta_min, delta_max): the change at the
+    item's min and at its max, the largest ``top`` items. Returns the Figure."""
+    fig, ax = figure_and_axes(ax)
+    rows = list(rows)[:top][::-1]
+    y = np.arange(len(rows))
+    dmin = np.array([r["delta_min"] for r in rows], dtype=float)
+    dmax = np.array([r["delta_max"] for r in rows], dtype=float)
+    ax.barh(y - 0.2, dmin, height=0.4, color="C0", label="item at min")
+    ax.barh(y + 0.2, dmax, height=0.4, color="C1", label="item at max")
+    ax.set_yticks(y, [r["name"] for r in rows], fontsize=8)
+    ax.axvline(0.0, **ZERO)
+    ax.grid(True, axis="x", **GRID)
+    ax.set_xlabel(label)
+    ax.legend(fontsize=8, frameon=False)
+    set_title(ax, title or f"sensitivity: {label}")
+    return fig
+
+
+def _hist_panels(mc):
+    """(values, label, nominal) of the histograms of a run: P1, P2 (calibrated and raw), Fc, g."""
+    o, n = mc.outputs, mc.nominal
+    scale = 1e6  # P in 1e-6 / mm
+    out = []
+    for key, lab in (("P1", "P1"), ("P2", "P2"), ("P1_raw", "P1 raw"), ("P2_raw", "P2 raw")):
+        v = getattr(o, key, None)
+        if v is not None and np.any(np.isfinite(v)):
+            out.append((np.asarray(v) * scale, f"{lab} (1e-6 / mm)",
+                        float(np.asarray(getattr(n, key)).reshape(-1)[0]) * scale))  # fmt: skip
+    c = getattr(o, "c", None)
+    if c is not None and np.any(np.isfinite(c)):
+        out.append((np.asarray(c), "calibrated camera constant Fc (mm)",
+                    float(np.asarray(n.c).reshape(-1)[0])))  # fmt: skip
+    out.append((np.asarray(o.k0), "F0 of the refocused plane (mm)",
+                float(np.asarray(n.k0).reshape(-1)[0])))  # fmt: skip
+    g = getattr(o, "g", None)
+    if g is not None and np.any(np.isfinite(g)):
+        out.append((np.asarray(g), "variation factor g", float(np.asarray(n.g).reshape(-1)[0])))
+    return out
+
+
+def plot_tolerance(mc=None, sens=None, *, limits=()):
+    """One figure of a tolerancing run: the raw and calibrated envelopes and the histograms
+    (when ``mc``, a MonteCarloResult, is given) and the sensitivity bars (``sens``). Returns the
+    Figure."""
+    panels = []
+    if mc is not None:
+        panels += ["env", "env_cal"] + [("hist", h) for h in _hist_panels(mc)]
+    if sens is not None:
+        panels.append("sens")
+    cols = 3 if len(panels) > 2 else max(1, len(panels))
+    rows = -(-len(panels) // cols)
+    fig, ax0 = figure_and_axes(None, figsize=(5.2 * cols, 3.9 * rows))
+    ax0.remove()
+    axs = np.atleast_1d(fig.subplots(rows, cols)).ravel()
+    for ax, p in zip(axs, panels, strict=False):
+        if p == "env":
+            plot_envelope(mc, limits=limits, ax=ax)
+        elif p == "env_cal":
+            plot_envelope(mc, calibrated=True, limits=limits, ax=ax)
+        elif p == "sens":
+            fmax = float(np.max(sens.fields_deg))
+            plot_sensitivity(sens.table("D_cal_um", fmax), label=f"ΔD_c at {fmax:g}° (µm)",
+                             ax=ax)  # fmt: skip
+        else:
+            v, lab, nom = p[1]
+            plot_histogram(v, label=lab, nominal=nom, ax=ax)
+    for ax in axs[len(panels) :]:
+        ax.remove()
+    return fig
+
+
+__all__ = [
+    "plot_envelope",
+    "plot_histogram",
+    "plot_sensitivity",
+    "plot_tolerance",
+]

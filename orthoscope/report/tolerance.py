@@ -1,0 +1,241 @@
+"""Text and JSON of tolerancing results (:mod:`distortion.tolerance`): the ranked sensitivity
+table and the Monte Carlo summary (envelopes, spreads raw and calibrated, yield against limits).
+
+JSON keys carry their units (``_um``, ``_mm``, ``_deg``); the Monte Carlo block is the run's own
+:meth:`MonteCarloResult.summary` (bit-identical for a seed whatever the chunking or workers) with
+the yields added."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: the scalar spreads listed, in order: (key, label, unit shown, factor from the output's unit)
+SPREADS = (
+    ("efl", "EFL (paraxial)", "mm", 1.0),
+    ("k0", "F0 in the refocused plane", "mm", 1.0),
+    ("focus_shift", "focus shift (compensator)", "mm", 1.0),
+    ("P1_raw", "P1 raw", "1e-6/mm", 1e6),
+    ("P2_raw", "P2 raw", "1e-6/mm", 1e6),
+    ("c", "Fc (calibrated)", "mm", 1.0),
+    ("x0", "principal point x0", "µm", 1e3),
+    ("y0", "principal point y0", "µm", 1e3),
+    ("P1", "P1 calibrated", "1e-6/mm", 1e6),
+    ("P2", "P2 calibrated", "1e-6/mm", 1e6),
+    ("g", "variation factor g", "", 1.0),
+)
+#: the sensitivity columns: (output, at the largest field?, label, factor from the output's unit)
+SENS_COLUMNS = (
+    ("D_cal_um", True, "ΔD_c@{f}° µm", 1.0),
+    ("D_um", True, "ΔD@{f}° µm", 1.0),
+    ("c", False, "ΔFc µm", 1e3),
+    ("x0", False, "Δx0 µm", 1e3),
+    ("y0", False, "Δy0 µm", 1e3),
+    ("P1", False, "ΔP1 e-6/mm", 1e6),
+    ("P2", False, "ΔP2 e-6/mm", 1e6),
+)
+#: the outputs of the sensitivity JSON besides the curves at the largest field
+SENS_SCALARS = ("efl", "k0", "focus_shift", "c", "x0", "y0", "P1", "P2", "P1_raw", "P2_raw")
+MAX_TEXT_FIELDS = 11
+
+
+def _f(x) -> float | None:
+    v = float(x)
+    return v if math.isfinite(v) else None
+
+
+def _cell(v, dec: int = 3, width: int = 10) -> str:
+    if v is None or not math.isfinite(float(v)):
+        return f"{'-':>{width}}"
+    if round(float(v), dec) == 0.0:
+        return f"{0.0:>{width}.{dec}f}"
+    return f"{float(v):>+{width}.{dec}f}"
+
+
+def _worst(row: dict) -> float:
+    a, b = float(row["delta_min"]), float(row["delta_max"])
+    return a if abs(a) >= abs(b) else b
+
+
+def rank_key(sens) -> tuple[str, float]:
+    """What the sensitivity is ranked by: the calibrated distortion ``D_cal_um`` at the largest
+    curve field (output name, field in degrees)."""
+    return "D_cal_um", float(np.max(sens.fields_deg))
+
+
+def _rss(sens, output: str, field) -> float:
+    return float(np.asarray(sens.rss(output, field)).reshape(-1)[0])
+
+
+def sensitivity_to_dict(sens) -> dict:
+    """JSON of a SensitivityResult: for the distortion at the largest field (calibrated and raw)
+    and each scalar output, the items ranked by their largest change and the RSS of the 1-σ
+    changes (the predicted Monte Carlo standard deviation)."""
+    fmax = float(np.max(sens.fields_deg))
+    keys = [("D_cal_um", fmax), ("D_um", fmax)] + [(k, None) for k in SENS_SCALARS]
+    outputs = {}
+    for name, field in keys:
+        label = name if field is None else f"{name}@{fmax:g}deg"
+        outputs[label] = {
+            "output": name,
+            "field_deg": field,
+            "rss_1sigma": _f(_rss(sens, name, field)),
+            "items": [
+                {
+                    "name": r["name"],
+                    "unit": r["unit"],
+                    "min": _f(r["min"]),
+                    "max": _f(r["max"]),
+                    "delta_at_min": _f(r["delta_min"]),
+                    "delta_at_max": _f(r["delta_max"]),
+                    "share_of_rss": _f(r["share"]),
+                }
+                for r in sens.table(name, field)
+            ],
+        }
+    return {
+        "lens": sens.lens_name,
+        "compensator": sens.compensator,
+        "fields_deg": np.asarray(sens.fields_deg).tolist(),
+        "ranked_by": f"D_cal_um@{fmax:g}deg",
+        "outputs": outputs,
+    }
+
+
+def format_sensitivity(sens) -> str:
+    """The ranked sensitivity table: each item alone at its limits (compensator applied), the
+    change of the distortion at the largest field (calibrated and raw), of Fc, x0, y0, P1, P2
+    (the signed change of larger size of the two limits), and each item's share of the RSS of
+    the calibrated distortion there."""
+    key, fmax = rank_key(sens)
+    rows = sens.table(key, fmax)
+    cols = [
+        (name, fmax if at_field else None, lab.format(f=f"{fmax:g}"), fac)
+        for name, at_field, lab, fac in SENS_COLUMNS
+    ]
+    worst = {
+        name: {r["name"]: _worst(r) for r in sens.table(name, field)} for name, field, _, _ in cols
+    }
+    nw = max([len("item")] + [len(r["name"]) for r in rows])
+    lines = [
+        f"Sensitivity of {sens.lens_name}: each tolerance alone at its min and max, compensator "
+        f"{sens.compensator}; ranked by the calibrated distortion D_c at {fmax:g}°",
+        f"{'item':<{nw}} {'min':>9} {'max':>9} "
+        + " ".join(f"{lab:>13}" for _, _, lab, _ in cols)
+        + f" {'share':>7}",
+    ]
+    lines.append("-" * len(lines[-1]))
+    for r in rows:
+        cells = [
+            _cell(worst[name].get(r["name"], float("nan")) * fac, 3, 13) for name, _, _, fac in cols
+        ]
+        share = r["share"]
+        share_s = f"{100 * share:6.1f}%" if math.isfinite(share) else "      -"
+        lines.append(
+            f"{r['name']:<{nw}} {r['min']:>9.3g} {r['max']:>9.3g} "
+            + " ".join(cells)
+            + f" {share_s}"
+        )
+    rss = [f"{lab.lstrip('Δ')} {_rss(sens, n, f) * fac:.3g}" for n, f, lab, fac in cols]
+    lines.append(
+        "RSS of the 1-σ changes (the Monte Carlo standard deviation expected for small "
+        "tolerances): " + ", ".join(rss)
+    )
+    return "\n".join(lines)
+
+
+def yields(mc, limits) -> list[dict]:
+    """Yield against each (limit µm, field deg): share of the lenses with |D| below the limit,
+    raw and after calibration, with the sentence the text prints."""
+    out = []
+    for lim, deg in limits:
+        raw = float(mc.yield_fraction(lim, deg))
+        cal = float(mc.yield_fraction(lim, deg, calibrated=True))
+        out.append(
+            {
+                "limit_um": lim,
+                "field_deg": deg,
+                "fraction": raw,
+                "fraction_calibrated": cal,
+                "text": (
+                    f"{100 * raw:.1f} % of lenses have |D| < {lim:g} µm at {deg:g}° "
+                    f"({100 * cal:.1f} % after calibration)"
+                ),
+            }
+        )
+    return out
+
+
+def monte_carlo_to_dict(mc, limits=()) -> dict:
+    """JSON of a MonteCarloResult: its summary plus the yields."""
+    d = dict(mc.summary())
+    d["yield"] = yields(mc, limits)
+    return d
+
+
+def _text_fields(f: np.ndarray) -> np.ndarray:
+    if f.size <= MAX_TEXT_FIELDS:
+        return np.arange(f.size)
+    return np.unique(np.round(np.linspace(0, f.size - 1, MAX_TEXT_FIELDS)).astype(int))
+
+
+def format_monte_carlo(mc, limits=(), lens_name: str = "") -> str:
+    """The Monte Carlo summary as text: the run, the envelope of D along +y (raw and
+    calibrated), the spreads of the per-lens outputs and the yields."""
+    o = mc.outputs
+    ok = np.asarray(o.ok, dtype=bool)
+    lines = [
+        f"Monte Carlo of {lens_name or 'the lens'}: {mc.n} lenses "
+        f"({int(ok.sum())} traced in full), seed {mc.seed}, compensator {mc.compensator}, "
+        f"chunks of {mc.chunk_size}" + (f" ({mc.resumed_chunks} resumed)" if mc.resumed_chunks
+                                         else "") + f", {mc.elapsed_s:.2f} s",
+        f"generator: {mc.generator}",
+        "",
+    ]  # fmt: skip
+    f = np.asarray(mc.fields_deg, dtype=float)
+    lev = np.asarray(mc.percentiles, dtype=float)
+    want = [p for p in (2.5, 50.0, 97.5) if np.any(np.isclose(lev, p))]
+    idx = [int(np.nonzero(np.isclose(lev, p))[0][0]) for p in want]
+    env, envc = np.asarray(mc.envelope_um), np.asarray(mc.envelope_cal_um)
+    nom = np.asarray(mc.nominal.D_um).reshape(-1)
+    nomc = np.asarray(mc.nominal.D_cal_um).reshape(-1)
+    head = "  ".join(f"{'p' + format(p, 'g'):>8}" for p in want)
+    lines.append("distortion along +y (µm): nominal lens and percentiles over the lenses")
+    lines.append(f"{'α deg':>7} {'nominal':>9}  {head}   |  {'cal nom':>9}  {head}".rstrip())
+    for j in _text_fields(f):
+        a = "  ".join(_cell(env[i, j], 2, 8) for i in idx)
+        b = "  ".join(_cell(envc[i, j], 2, 8) for i in idx)
+        lines.append(f"{f[j]:>7.2f} {_cell(nom[j], 2, 9)}  {a}   |  {_cell(nomc[j], 2, 9)}  {b}")
+    lines += ["", "per-lens outputs: nominal, mean, standard deviation, 2.5 and 97.5 percentiles"]
+    lines.append(
+        f"{'':28} {'unit':>8} {'nominal':>12} {'mean':>12} {'std':>11} {'p2.5':>12} {'p97.5':>12}"
+    )
+    for key, lab, unit, fac in SPREADS:
+        st = mc.stats.get(key)
+        if st is None:
+            continue
+        nv = getattr(mc.nominal, key, None)
+        nv = float(np.asarray(nv).reshape(-1)[0]) * fac if nv is not None else float("nan")
+        vals = [st.get(k, float("nan")) for k in ("mean", "std", "p2.5", "p97.5")]
+        vals = [float("nan") if v is None else float(v) * fac for v in vals]
+        lines.append(
+            f"{lab:28} {unit:>8} {nv:>12.6g} {vals[0]:>12.6g} {vals[1]:>11.4g} {vals[2]:>12.6g} "
+            f"{vals[3]:>12.6g}"
+        )
+    if "g" not in mc.stats:
+        lines.append("variation factor g: not computed by this run")
+    if limits:
+        lines.append("")
+        lines += [y["text"] for y in yields(mc, limits)]
+    return "\n".join(lines)
+
+
+__all__ = [
+    "format_monte_carlo",
+    "format_sensitivity",
+    "monte_carlo_to_dict",
+    "rank_key",
+    "sensitivity_to_dict",
+    "yields",
+]

@@ -1,0 +1,176 @@
+"""``orthoscope tolerance`` end to end: text, --json, the plot, resume after an interruption,
+one-line errors (docs/tolerance.md; the science is tested in tests/test_tolerance_*.py).
+
+The numbers checked here are computed independently of the command's formatting: the yield is
+recounted from the per-lens curves of the API run with the same seed, the JSON summary is
+compared with the API's own summary of the same run, and a resumed run must give the summary of
+an uninterrupted one bit for bit (issue 15: "the same seed gives a bit-identical summary ...
+after a resumed interruption").
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from orthoscope.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SPEC = ROOT / "lenses" / "tolerances" / "cooke-triplet-f4.toml"
+LENS = "cooke-triplet-f4"
+FIELDS = "0,10,20"
+BASE = ["tolerance", LENS, str(SPEC), "--fields", FIELDS, "--quiet"]
+
+
+def run(argv):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main(argv)
+    return rc, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def api_run():
+    """The same run through the API (seed 3, 48 instances, chunks of 16)."""
+    from distortion.tolerance import monte_carlo
+    from raytrace.files.library import load_lens
+    from raytrace.tolerance import read_tolerance_spec
+
+    lens = load_lens(LENS)
+    spec = read_tolerance_spec(SPEC)
+    return monte_carlo(lens, spec, 48, seed=3, fields_deg=np.array([0.0, 10.0, 20.0]),
+                       chunk_size=16)  # fmt: skip
+
+
+def test_text_run_reports_envelope_spreads_and_yield(api_run):
+    rc, out, err = run(BASE + ["--samples", "48", "--seed", "3", "--chunk", "16",
+                               "--limit", "20@20"])  # fmt: skip
+    assert rc == 0, err
+    assert "48 lenses" in out and "seed 3" in out
+    assert api_run.generator in out
+    assert "Fc (calibrated)" in out and "P1 raw" in out
+    # the yield sentence, recounted from the API run's curves at the traced field 20 deg
+    o = api_run.outputs
+    ok = np.asarray(o.ok)
+    raw = np.mean(np.abs(o.D_um[ok, 2]) < 20.0)
+    cal = np.mean(np.abs(o.D_cal_um[ok, 2]) < 20.0)
+    assert f"{100 * raw:.1f} % of lenses have |D| < 20 µm at 20°" in out
+    assert f"({100 * cal:.1f} % after calibration)" in out
+
+
+def test_json_is_the_api_summary_plus_yield(api_run):
+    rc, out, err = run(BASE + ["--samples", "48", "--seed", "3", "--chunk", "16",
+                               "--limit", "15@10", "--json"])  # fmt: skip
+    assert rc == 0, err
+    d = json.loads(out)
+    mc = d["monte_carlo"]
+    y = mc.pop("yield")
+    from orthoscope.report.jsonout import jsonable
+
+    assert mc == jsonable(api_run.summary())
+    o = api_run.outputs
+    ok = np.asarray(o.ok)
+    assert y[0]["limit_um"] == 15.0 and y[0]["field_deg"] == 10.0
+    assert y[0]["fraction"] == pytest.approx(np.mean(np.abs(o.D_um[ok, 1]) < 15.0), abs=1e-12)
+
+
+def test_sensitivity_table_lists_every_item_and_the_rss():
+    from raytrace.tolerance import read_tolerance_spec
+
+    rc, out, err = run(BASE + ["--sensitivity"])
+    assert rc == 0, err
+    assert "Sensitivity of" in out and "RSS" in out
+    for name in read_tolerance_spec(SPEC).names():
+        assert name in out
+    rc, out, err = run(BASE + ["--sensitivity", "--json"])
+    assert rc == 0, err
+    s = json.loads(out)["sensitivity"]
+    ranked = s["outputs"][s["ranked_by"]]["items"]
+    worst = [max(abs(r["delta_at_min"] or 0.0), abs(r["delta_at_max"] or 0.0)) for r in ranked]
+    assert worst == sorted(worst, reverse=True)  # ranked by the largest change
+
+
+def test_plot_is_written_and_never_overwritten_without_force(tmp_path):
+    png = tmp_path / "tol.png"
+    rc, out, err = run(BASE + ["--samples", "16", "--plot", str(png)])
+    assert rc == 0, err
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    before = png.read_bytes()
+    rc, out, err = run(BASE + ["--samples", "16", "--plot", str(png)])
+    assert rc == 2 and "--force" in err and len(err.strip().splitlines()) == 1
+    assert png.read_bytes() == before
+
+
+def test_interrupted_run_keeps_chunks_and_resumes_bit_identical(tmp_path, monkeypatch):
+    import orthoscope.cli.tolerance as cli
+
+    run_dir = tmp_path / "run"
+    argv = BASE + ["--samples", "64", "--seed", "5", "--chunk", "16", "-o", str(run_dir),
+                   "--json"]  # fmt: skip
+    real_call = cli.Progress.__call__
+
+    def interrupt_after_two_chunks(self, done, total):
+        real_call(self, done, total)
+        if done >= 32:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli.Progress, "__call__", interrupt_after_two_chunks)
+    rc, out, err = run(argv)
+    assert rc == 130, err
+    assert "resume" in err and len(err.strip().splitlines()) == 1
+    manifest = json.loads((run_dir / "manifest.json").read_text())
+    assert 2 <= len(manifest["done"]) < 4
+    monkeypatch.setattr(cli.Progress, "__call__", real_call)
+    rc, out, err = run(argv)
+    assert rc == 0, err
+    resumed = json.loads(out)["monte_carlo"]
+    rc, out, err = run(BASE + ["--samples", "64", "--seed", "5", "--chunk", "32", "--json"])
+    assert rc == 0, err
+    fresh = json.loads(out)["monte_carlo"]
+    assert resumed == fresh  # bit-identical after resumption and with another chunk size
+
+
+@pytest.mark.parametrize(
+    "text,words",
+    [
+        ('tolerances = [ { type = "TWOBBLE", surface = 1, limit = 0.1 } ]', "TWOBBLE"),
+        ('tolerances = [ { type = "TRAD", surface = 40, limit = 0.1 } ]', "surface 40"),
+        ("tolerances = [ { type = ", "TOML"),
+    ],
+    ids=["unknown-type", "no-such-surface", "broken-toml"],
+)
+def test_bad_spec_is_one_line_exit_2(tmp_path, text, words):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text + "\n")
+    rc, out, err = run(["tolerance", LENS, str(bad), "--sensitivity"])
+    assert rc == 2
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert words in err and "bad.toml" in err
+
+
+@pytest.mark.parametrize(
+    "extra,words",
+    [
+        (["--dask", "localhost"], "tcp://HOST:PORT"),
+        (["--limit", "20"], "UM@DEG"),
+        (["--limit", "20@80"], "beyond"),
+        (["--samples", "0"], "at least 1"),
+        (["--sensitivity", "-o", "x"], "Monte Carlo"),
+    ],
+)
+def test_bad_flags_are_one_line_exit_2(extra, words):
+    rc, out, err = run(BASE + extra)
+    assert rc == 2, err
+    assert words in err and len(err.strip().splitlines()) == 1
+
+
+def test_compensator_choices_are_the_science_packages():
+    import orthoscope.cli.tolerance as cli
+    from raytrace.tolerance import COMPENSATORS
+
+    assert cli.COMPENSATORS == COMPENSATORS
