@@ -36,9 +36,10 @@ def _rays(n: int, seed: int = 0):
     rng = np.random.default_rng(seed)
     r = 6.25 * np.sqrt(rng.uniform(0, 1, n))
     t = rng.uniform(0, 2 * np.pi, n)
-    a = np.radians(rng.uniform(-20, 20, n))
-    b = np.radians(rng.uniform(-20, 20, n))
-    d = np.stack([np.tan(a), np.tan(b), np.ones(n)])
+    # field angle uniform over the disk of the 20-degree field (any azimuth): inside the field
+    w = np.radians(20.0 * np.sqrt(rng.uniform(0, 1, n)))
+    phi = rng.uniform(0, 2 * np.pi, n)
+    d = np.stack([np.tan(w) * np.cos(phi), np.tan(w) * np.sin(phi), np.ones(n)])
     d /= np.linalg.norm(d, axis=0)
     return r * np.cos(t), r * np.sin(t), np.full(n, -1.0), d[0].copy(), d[1].copy(), d[2].copy()
 

@@ -1,7 +1,8 @@
 """A minimal hand-written numba loop (spheres / conics only): the "honest limit" for the project's
 kernel. One ``prange`` over rays, a scalar loop over surfaces, the same curvature-form
-intersection and vector Snell as :mod:`raytrace.kernels`, a status byte (missed / TIR / clipped)
-and the transfer to the image plane. No objects, no blocks, no Python wrapper: arrays in, arrays
+intersection and vector Snell as :mod:`raytrace.kernels`, a status byte (missed / TIR / clipped /
+backward: the same travelling-backwards test, so both loops do the same work) and the transfer to
+the image plane. No objects, no blocks, no Python wrapper: arrays in, arrays
 out. Millimetres, light toward +z.
 """
 
@@ -16,6 +17,8 @@ from numba import njit, prange
 @njit(cache=True, error_model="numpy", fastmath=False)
 def _one(c, k, zv, mu, sd2, x, y, z, L, M, N):
     st = 0
+    tacc = 0.0  # path since the last refracting surface (surfaces with mu = 1 pass the ray on)
+    acted = False
     for j in range(c.shape[0]):
         t0 = (zv[j] - z) / N
         x += t0 * L
@@ -28,6 +31,15 @@ def _one(c, k, zv, mu, sd2, x, y, z, L, M, N):
         if D < 0.0:
             return 1, x, y, z, L, M, N
         s = C / (B + math.sqrt(D))
+        tt = tacc + t0 + s
+        m = mu[j]
+        if m != 1.0:
+            if acted and tt < -1e-9 * (1.0 + abs(zv[j])):
+                return 5, x, y, z, L, M, N
+            acted = True
+            tacc = 0.0
+        else:
+            tacc = tt
         x += s * L
         y += s * M
         zl = s * N
@@ -42,7 +54,6 @@ def _one(c, k, zv, mu, sd2, x, y, z, L, M, N):
         ny *= inv
         nz *= inv
         cosi = L * nx + M * ny + N * nz
-        m = mu[j]
         s2 = m * m * (1.0 - cosi * cosi)
         if s2 > 1.0:
             return 2, x, y, z, L, M, N

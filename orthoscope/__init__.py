@@ -147,6 +147,8 @@ _API: dict[str, str] = {
     "SensitivityResult": "distortion.tolerance",
     "MonteCarloResult": "distortion.tolerance",
     "ToleranceOutputs": "distortion.tolerance",
+    "tolerance_sensitivity": "distortion.tolerance",
+    "tolerance_monte_carlo": "distortion.tolerance",
     # plots (matplotlib loads with the first of these)
     "plot_distortion": "orthoscope.plots.distortion",
     "plot_characteristic": "orthoscope.plots.distortion",
@@ -272,7 +274,13 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
     from distortion.sensor_metrics import SensorMetrics, sensor_metrics
     from distortion.tablefile import read_distortion_table
     from distortion.telecentricity import PupilAnalysis, pupil_analysis
-    from distortion.tolerance import MonteCarloResult, SensitivityResult, ToleranceOutputs
+    from distortion.tolerance import (
+        MonteCarloResult,
+        SensitivityResult,
+        ToleranceOutputs,
+        tolerance_monte_carlo,
+        tolerance_sensitivity,
+    )
     from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
     from distortion.variation.focus import (
         FocusStudy,

@@ -1,4 +1,4 @@
-"""Tolerancing distortion (issue 15): how much the distortion of manufactured lenses scatters
+"""Tolerancing distortion: how much the distortion of manufactured lenses scatters
 and which tolerance drives it — the outputs of many perturbed instances computed together
 (:mod:`.outputs`), compensators (:mod:`.compensators`), sensitivity analysis
 (:mod:`.sensitivity`) and a seeded, chunked, resumable Monte Carlo on this machine or a Dask
@@ -18,6 +18,10 @@ from .outputs import (
 )
 from .sensitivity import SensitivityResult, sensitivity
 
+#: the names under which ``import orthoscope`` offers the two entry points
+tolerance_sensitivity = sensitivity
+tolerance_monte_carlo = monte_carlo
+
 __all__ = [
     "CURVES",
     "SCALARS",
@@ -34,4 +38,6 @@ __all__ = [
     "pupil_bundle",
     "run_chunk",
     "sensitivity",
+    "tolerance_monte_carlo",
+    "tolerance_sensitivity",
 ]

@@ -44,24 +44,6 @@ SAMPLES = [
 OUTPUTS = [("--plot", ".png")]
 
 
-def bundled_spec_dir() -> Path:
-    """The folder of the bundled example specs (``lenses/tolerances/``)."""
-    from raytrace.files.library import library_dir
-
-    return library_dir() / "tolerances"
-
-
-def resolve_spec_path(text: str) -> Path:
-    """SPEC as given: a file path, or the name of a bundled example (``lenses/tolerances/``)."""
-    p = Path(text)
-    if p.exists() or p.suffix:
-        return p
-    bundled = bundled_spec_dir() / f"{text}.toml"
-    if bundled.is_file():
-        return bundled
-    return p
-
-
 def parse_limits(values: list[str] | None) -> list[tuple[float, float]]:
     """``['20@35', '15um@30deg']`` → [(20.0, 35.0), (15.0, 30.0)] (µm, degrees)."""
     out = []
@@ -145,6 +127,7 @@ def cmd_tolerance(args) -> int:
     from raytrace.files.library import load_lens
     from raytrace.files.output import check_output
     from raytrace.tolerance import check_against_lens, read_tolerance_spec
+    from raytrace.tolerance.spec import resolve_spec_path
 
     from ..report.tolerance import (
         format_monte_carlo,

@@ -212,13 +212,15 @@ def catalog_sources() -> dict:
 
 def catalog_glasses(catalog: str) -> tuple[CatalogGlass, ...]:
     """Every material of one catalog (a name of :data:`CATALOGS`, case-insensitive)."""
-    c = _canonical_catalog(catalog)
+    c = canonical_catalog(catalog)
     if c is None:
         raise PrescriptionError(f"unknown glass catalog {catalog!r}; known: {', '.join(CATALOGS)}")
     return tuple(_glass(c, i) for i in range(len(_index()[c])))
 
 
-def _canonical_catalog(name: str) -> str | None:
+def canonical_catalog(name: str) -> str | None:
+    """The shipped catalog a file's catalog name means (``"SCHOTT"``, ``"schott_2017"`` ->
+    ``"Schott"``), or None when we ship no such catalog."""
     key = normalize_name(name)
     for c in CATALOGS:
         if normalize_name(c) == key or key.startswith(normalize_name(c)):
@@ -238,7 +240,7 @@ def find_glass(
     key = normalize_name(name)
     cats = CATALOGS
     if catalogs:
-        wanted = [c for c in (_canonical_catalog(x) for x in catalogs) if c is not None]
+        wanted = [c for c in (canonical_catalog(x) for x in catalogs) if c is not None]
         cats = tuple(dict.fromkeys(wanted))
     found: list[CatalogGlass] = []
     for c in cats:
@@ -288,7 +290,7 @@ def lookup_glass(
     cats = list(catalogs) if catalogs else []
     if "_" in raw:
         base, _, suffix = raw.rpartition("_")
-        if base and _canonical_catalog(suffix) is not None and not find_glass(raw):
+        if base and canonical_catalog(suffix) is not None and not find_glass(raw):
             raw, cats, first_catalog_wins = base, [suffix], True
     cand: list[CatalogGlass] = []
     if cats:
@@ -401,7 +403,7 @@ def search_glass(
     cats = CATALOGS
     if catalogs:
         cats = tuple(
-            dict.fromkeys(c for c in (_canonical_catalog(x) for x in catalogs) if c is not None)
+            dict.fromkeys(c for c in (canonical_catalog(x) for x in catalogs) if c is not None)
         )
     scored = []
     for c in cats:

@@ -34,7 +34,7 @@ from ..errors import PrescriptionError
 from ..materials import Material, model_glass
 from .catalog import (
     CatalogGlass,
-    _canonical_catalog,
+    canonical_catalog,
     find_glass,
     lookup_glass,
     normalize_name,
@@ -107,7 +107,7 @@ def _split_suffix(name: str, catalogs: list[str]) -> tuple[str, list[str]]:
     raw = name.strip()
     if "_" in raw:
         base, _, suffix = raw.rpartition("_")
-        if base and _canonical_catalog(suffix) is not None and not find_glass(raw):
+        if base and canonical_catalog(suffix) is not None and not find_glass(raw):
             return base, [suffix]
     return raw, catalogs
 
@@ -168,7 +168,7 @@ def _misc_data_set(name: str, raw: str) -> GlassResolution | None:
     if "_" not in raw or find_glass(raw):
         return None
     base, _, suffix = raw.rpartition("_")
-    if not base or _canonical_catalog(suffix) is not None:
+    if not base or canonical_catalog(suffix) is not None:
         return None
     found = find_glass(base, ["Misc"])
     if len(found) != 1 or find_glass(base) != found:
@@ -206,7 +206,7 @@ def resolve_glass(
     not name.
     """
     raw, cats = _split_suffix(name, list(catalogs) if catalogs else [])
-    named = tuple(dict.fromkeys(c for c in map(_canonical_catalog, cats) if c is not None))
+    named = tuple(dict.fromkeys(c for c in map(canonical_catalog, cats) if c is not None))
     for c in named:
         found = find_glass(raw, [c])
         if found:
@@ -232,7 +232,7 @@ def resolve_glass(
             if printed is not None
             else ""
         )
-        unshipped = [c for c in cats if _canonical_catalog(c) is None]
+        unshipped = [c for c in cats if canonical_catalog(c) is None]
         missing = (
             f"; the file also names catalogs orthoscope does not ship ({', '.join(unshipped)}): "
             "the glass may be theirs"

@@ -454,6 +454,23 @@ def spec_from_dict(d: dict, *, path: str | None = None) -> ToleranceSpec:
                          d.get("lens", ""), dict(outputs), mc, path)  # fmt: skip
 
 
+def bundled_spec_dir() -> Path:
+    """The folder of the bundled example specs (``lenses/tolerances/``)."""
+    from ..files.library import library_dir
+
+    return library_dir() / "tolerances"
+
+
+def resolve_spec_path(path: str | Path) -> Path:
+    """``path`` as given when it exists or has a suffix; else the bundled example of that name
+    (``lenses/tolerances/NAME.toml``) when there is one; else ``path`` unchanged."""
+    p = Path(path)
+    if p.exists() or p.suffix:
+        return p
+    bundled = bundled_spec_dir() / f"{p.name}.toml"
+    return bundled if bundled.is_file() else p
+
+
 def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
     """Read a TOML tolerance spec (docs/tolerance.md; examples in ``lenses/tolerances/``)::
 
@@ -475,10 +492,12 @@ def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
         seed = 1
 
     A ``.zmx`` path reads the file's TOL lines instead
-    (:func:`raytrace.tolerance.zemax_tol.read_zmx_tolerances`). Raises
-    :class:`ToleranceSpecError` (one line) for anything wrong.
+    (:func:`raytrace.tolerance.zemax_tol.read_zmx_tolerances`). A bare name that is not a file
+    (no suffix) is a bundled example, one per bundled lens and named like it
+    (``read_tolerance_spec("topogon-like-pestrecov")``). Raises :class:`ToleranceSpecError`
+    (one line) for anything wrong.
     """
-    p = Path(path)
+    p = resolve_spec_path(path)
     if p.suffix.lower() == ".zmx":
         from .zemax_tol import read_zmx_tolerances
 
