@@ -75,7 +75,7 @@ PRINCIPAL_POINTS = ("fit", "axial", "ppa", "ppbs")
 CAMERA_CONSTANTS = ("fit", "characteristic")
 
 
-def _columns(tx: np.ndarray, ty: np.ndarray, radial_terms: int, asymmetric: bool) -> list:
+def basis_columns(tx: np.ndarray, ty: np.ndarray, radial_terms: int, asymmetric: bool) -> list:
     """The model's basis vector fields, each (x-part, y-part) over the points, in the order
     x0, y0, c, a1.., q1, q2, σ1, σ2 (the last four when ``asymmetric``)."""
     one = np.ones_like(tx)
@@ -142,7 +142,7 @@ def solve_linear(
     good = np.all(np.isfinite(t), axis=1) & np.all(np.isfinite(img), axis=1)
     tx, ty = t[good, 0], t[good, 1]
     bx, by = img[good, 0].copy(), img[good, 1].copy()
-    cols = _columns(tx, ty, radial_terms, asymmetric)
+    cols = basis_columns(tx, ty, radial_terms, asymmetric)
     held = {}
     if principal_point is not None:
         held["x0"], held["y0"] = (float(v) for v in principal_point)

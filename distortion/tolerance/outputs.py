@@ -45,6 +45,7 @@ from raytrace.tolerance import (
 )
 
 from ..errors import DataError
+from ..grid.decompose import basis_columns
 from .compensators import image_planes, pupil_bundle
 
 #: default number of curve fields (0 .. the lens's max field)
@@ -167,22 +168,9 @@ class ToleranceSetup:
 
 def _basis(t: np.ndarray, radial_terms: int) -> list[tuple[str, np.ndarray]]:
     """The columns (x part stacked on y part) of the linear model of
-    :mod:`distortion.grid.decompose` in its order x0, y0, c, a1.., q1, q2, σ1, σ2 (tested equal
-    to :func:`distortion.grid.decompose.solve_linear`)."""
-    tx, ty = t[:, 0], t[:, 1]
-    one, zero = np.ones_like(tx), np.zeros_like(tx)
-    r2 = tx * tx + ty * ty
-    cols = [("x0", one, zero), ("y0", zero, one), ("c", tx, ty)]
-    p = r2.copy()
-    for i in range(1, radial_terms + 1):
-        cols.append((f"K{i}", p * tx, p * ty))
-        p = p * r2
-    cols += [
-        ("P1", r2 + 2 * tx * tx, 2 * tx * ty),
-        ("P2", 2 * tx * ty, r2 + 2 * ty * ty),
-        ("S1", r2, zero),
-        ("S2", zero, r2),
-    ]
+    :mod:`distortion.grid.decompose` (:func:`~distortion.grid.decompose.basis_columns`, with the
+    decentering and thin-prism terms) at the direction tangents ``t`` (N, 2)."""
+    cols = basis_columns(t[:, 0], t[:, 1], radial_terms, True)
     return [(n, np.concatenate([cx, cy])) for n, cx, cy in cols]
 
 
