@@ -1,4 +1,4 @@
-"""Fuzzing the .zmx and .seq readers (issue 7): a deterministic mutation corpus of damaged
+"""Fuzzing the .zmx, .seq and OSLO .len readers: a deterministic mutation corpus of damaged
 files (truncated, reordered or duplicated lines, garbage numbers and tokens, wrong encodings,
 bit flips, random binary) plus a hypothesis test on random command soup. Every reader call must
 either return a valid Lens or raise PrescriptionError carrying the path and a line number —
@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from raytrace.errors import PrescriptionError
 from raytrace.files.codev import parse_seq
 from raytrace.files.library import load_lens
+from raytrace.files.oslo import parse_len
 from raytrace.files.zemax import dumps_zmx, parse_zmx
 from raytrace.glass import catalog_available, find_glass
 from raytrace.lens import Lens
@@ -111,7 +112,14 @@ def _seeds() -> list[tuple[str, bytes]]:
     ]
     for name in ("super-angulon-de975637", "tessar-fr1066698"):
         out.append(("zmx", dumps_zmx(load_lens(name)).encode()))
+    # real OSLO files (tests/data/corpus/SOURCES.md: optiland 0.6.3's OSLO test files)
+    for name in ("test_cooke_triplet.len", "cox3_07.len"):
+        out.append(("len", (DATA / "corpus" / "optiland" / name).read_bytes()))
     return out
+
+
+READERS = {"zmx": parse_zmx, "seq": parse_seq, "len": parse_len}
+OTHER = {"zmx": parse_seq, "seq": parse_zmx, "len": parse_zmx}
 
 
 def _text(data: bytes) -> str:
@@ -190,9 +198,9 @@ def test_mutation_corpus_only_prescription_errors():
         mutant = data
         for _ in range(rng.choice((1, 1, 2, 3))):
             mutant = _mutate(rng, mutant)
-        readers = [parse_zmx if kind == "zmx" else parse_seq]
-        if k % 7 == 0:  # the other reader too: a file of the wrong kind
-            readers.append(parse_seq if kind == "zmx" else parse_zmx)
+        readers = [READERS[kind]]
+        if k % 7 == 0:  # another reader too: a file of the wrong kind
+            readers.append(OTHER[kind])
         for reader in readers:
             counts[_check(reader, mutant, f"mutant{k}.{kind}")] += 1
     # the corpus exercises both outcomes (a mutant that stays readable, and most that do not)
