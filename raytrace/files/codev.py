@@ -67,7 +67,15 @@ from ..frames import Placement, codev_tilt
 from ..glass import normalize_name, parse_glass_code, private_material, resolve_glass
 from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material
-from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
+from .text import (
+    ImportResult,
+    LineParser,
+    emit_warnings,
+    guarded_parse,
+    lens_error,
+    number,
+    read_bytes,
+)
 
 #: CODE V treats an object distance of 1e10 or more as infinite.
 CODEV_INFINITY = 1.0e10
@@ -82,7 +90,6 @@ _DECENTER = {"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE"}
 _DECENTER_TYPES = {"DEC": "basic", "DAR": "dar", "BEN": "bend", "REV": "rev"}
 _APERTURES = {"CIR", "REX", "REY", "ELX", "ELY", "ADX", "ADY"}
 _SPECIAL = {"DIF", "HOE", "HCO", "HWL", "HOR", "GRT", "SPS", "UDS", "GRIN", "GRD", "ZRN"}
-_MAX_WARNINGS = 50
 
 
 @dataclass
@@ -182,28 +189,7 @@ def _unquote(s: str) -> str:
     return s.strip("'\"")
 
 
-class _SeqParser:
-    def __init__(self, text: str, path: str | None) -> None:
-        self.text = text
-        self.path = path
-        self.warnings: list[str] = []
-        self.unknown: dict[str, int] = {}
-
-    def err(self, message: str, line: int | None, surface: int | None = None):
-        return PrescriptionError(message, path=self.path, line=line or 1, surface=surface)
-
-    def fail(self, message: str, line: int | None):
-        return self.err(message, line)
-
-    def warn(self, message: str) -> None:
-        if len(self.warnings) < _MAX_WARNINGS:
-            self.warnings.append(message)
-
-    def num(self, args: list[str], i: int, cmd: str, line: int) -> float:
-        if i >= len(args):
-            raise self.err(f"{cmd} needs a number (value {i + 1} is missing)", line)
-        return number(args[i], cmd, self.fail, line)
-
+class _SeqParser(LineParser):
     def nums(self, args: list[str], cmd: str, line: int) -> list[float]:
         if not args:
             raise self.err(f"{cmd} needs at least one number", line)

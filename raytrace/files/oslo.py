@@ -40,7 +40,15 @@ from ..errors import LensError, PrescriptionError
 from ..glass import private_material, resolve_glass
 from ..lens import Aperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material
-from .text import ImportResult, emit_warnings, guarded_parse, lens_error, number, read_bytes
+from .text import (
+    ImportResult,
+    LineParser,
+    emit_warnings,
+    guarded_parse,
+    lens_error,
+    number,
+    read_bytes,
+)
 
 #: OSLO treats a thickness of 1e10 or more on the object surface as an object at infinity
 OSLO_INFINITY = 1.0e10
@@ -69,7 +77,6 @@ _REFUSED = {
     "PUC": "solve",
     "CVM": "solve",
 }
-_MAX_WARNINGS = 50
 
 
 @dataclass
@@ -114,28 +121,7 @@ def _tokens(line: str) -> list[str]:
     return out
 
 
-class _LenParser:
-    def __init__(self, text: str, path: str | None) -> None:
-        self.text = text
-        self.path = path
-        self.warnings: list[str] = []
-        self.unknown: dict[str, int] = {}
-
-    def err(self, message: str, line: int | None, surface: int | None = None):
-        return PrescriptionError(message, path=self.path, line=line or 1, surface=surface)
-
-    def fail(self, message: str, line: int | None):
-        return self.err(message, line)
-
-    def warn(self, message: str) -> None:
-        if len(self.warnings) < _MAX_WARNINGS:
-            self.warnings.append(message)
-
-    def num(self, args: list[str], i: int, cmd: str, line: int) -> float:
-        if i >= len(args):
-            raise self.err(f"{cmd} needs a number (value {i + 1} is missing)", line)
-        return number(args[i], cmd, self.fail, line)
-
+class _LenParser(LineParser):
     def parse(self) -> ImportResult:
         if not self.text.strip():
             raise self.err("the file is empty: expected an OSLO .len lens file", 1)

@@ -181,3 +181,37 @@ def emit_warnings(result: ImportResult, path: str | None) -> Lens:
         where = f"{path}: " if path else ""
         warnings.warn(where + "; ".join(result.warnings), InteropWarning, stacklevel=3)
     return result.lens
+
+
+#: at most this many warnings are kept per file read
+MAX_WARNINGS = 50
+
+
+class LineParser:
+    """What the line-based readers (.zmx, .seq, .len) share: the file's text and path, the
+    warnings (at most :data:`MAX_WARNINGS`), the unknown commands, and errors that name the file,
+    the line and the surface. ``ITEM`` names a missing number in messages."""
+
+    ITEM = "value"
+
+    def __init__(self, text: str, path: str | None) -> None:
+        self.text = text
+        self.path = path
+        self.warnings: list[str] = []
+        self.unknown: dict[str, int] = {}
+
+    def err(self, message: str, line: int | None, surface: int | None = None) -> PrescriptionError:
+        return PrescriptionError(message, path=self.path, line=line or 1, surface=surface)
+
+    def fail(self, message: str, line: int | None) -> PrescriptionError:
+        return self.err(message, line)
+
+    def warn(self, message: str) -> None:
+        if len(self.warnings) < MAX_WARNINGS:
+            self.warnings.append(message)
+
+    def num(self, args: list[str], i: int, cmd: str, line: int, *, allow_inf=False) -> float:
+        """Number ``i`` of a command's arguments (finite; ``inf`` when ``allow_inf``)."""
+        if i >= len(args):
+            raise self.err(f"{cmd} needs a number ({self.ITEM} {i + 1} is missing)", line)
+        return number(args[i], cmd, self.fail, line, allow_inf=allow_inf)

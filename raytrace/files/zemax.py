@@ -76,6 +76,7 @@ from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from .output import write_atomic
 from .text import (
     ImportResult,
+    LineParser,
     emit_warnings,
     guarded_parse,
     lens_error,
@@ -121,7 +122,6 @@ _SURF_CMDS = (
     | _APERTURE_CMDS
     | _TILTS
 )
-_MAX_WARNINGS = 50
 
 
 @dataclass
@@ -152,27 +152,8 @@ class _ZSurf:
     cmds: list[str] = field(default_factory=list)  # the block's commands in order
 
 
-class _ZmxParser:
-    def __init__(self, text: str, path: str | None) -> None:
-        self.text = text
-        self.path = path
-        self.warnings: list[str] = []
-        self.unknown: dict[str, int] = {}
-
-    def err(self, message: str, line: int | None, surface: int | None = None) -> PrescriptionError:
-        return PrescriptionError(message, path=self.path, line=line or 1, surface=surface)
-
-    def fail(self, message: str, line: int | None) -> PrescriptionError:
-        return self.err(message, line)
-
-    def warn(self, message: str) -> None:
-        if len(self.warnings) < _MAX_WARNINGS:
-            self.warnings.append(message)
-
-    def num(self, args: list[str], i: int, cmd: str, line: int, *, allow_inf=False) -> float:
-        if i >= len(args):
-            raise self.err(f"{cmd} needs a number (field {i + 1} is missing)", line)
-        return number(args[i], cmd, self.fail, line, allow_inf=allow_inf)
+class _ZmxParser(LineParser):
+    ITEM = "field"
 
     def integer(self, args: list[str], i: int, cmd: str, line: int) -> int:
         v = self.num(args, i, cmd, line)
