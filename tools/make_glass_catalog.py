@@ -14,6 +14,15 @@ Sources
   (``site-packages/optiland/database/data-nk``): vendor shelves ``glass/<vendor>`` for legacy
   glasses no spreadsheet lists (the shelves were converted by refractiveindex.info from the
   vendors' Zemax AGF files), and a hand-picked list of non-catalog materials (``MISC`` below).
+  The database is public domain (CC0 1.0; ``optiland/database/doc/permission.txt``).
+* Schott's 1980 catalog as Robb & Mercado fitted it (P. N. Robb and R. I. Mercado,
+  "Calculation of refractive indices using Buchdahl's chromatic coordinate", Appl. Opt. 22,
+  1198-1215 (1983), Table V), as the ``opticalglass`` package transcribes it
+  (``robb1983_data_final.txt``): old Schott glasses that no later catalog, no shelf and no
+  ``N-`` successor covers, each only where the same name's row of another 1980 catalog of the
+  table (Ohara, Hoya, Corning-France, Chance: the equivalent glass) confirms the transcription
+  (:func:`robb_schott_1980`).
+* Definitions of the Zemax ``MISC`` catalog that are no measured data (``DEFINITIONS``).
 
 Every spreadsheet column is located by its header label and checked, so a changed file fails
 loudly instead of shifting columns. Output: one zip archive of JSON members (``index.json``
@@ -712,6 +721,169 @@ MISC = [
 ]
 
 
+# Materials the Zemax MISC catalog defines by a constant rather than by measured data: name,
+# formula (AGF number), coefficients, range (µm), nd, note. Source: MISC.AGF as Zemax ships it
+# ("Reproduced here by permission of RadiantZemax"), redistributed in KrakenOS 1.0.0.24
+# (KrakenOS/Cat/misc.agf) and ZemaxGlass 1.0 (AGF_files/misc.agf), identical files (sha256
+# below): "NM N15 5 1 1.500000 0.000000", "GC simulated glass with index of 1.5 at all
+# wavelengths between min wave and max wave", "CD 1.5 0 0 ...", "LD 0.365 1.014". Only the
+# definition is copied; no measured data of that file are shipped.
+DEFINITIONS_SOURCE = {
+    "file": "misc.agf (Zemax MISC catalog): KrakenOS/Cat/misc.agf, ZemaxGlass AGF_files/misc.agf",
+    "package": "KrakenOS 1.0.0.24 / ZemaxGlass 1.0 (redistributions of the Zemax catalog)",
+    "version": "",
+    "sha256": "3edff292e367144f4525e0a9fe8278d469f5bff1ebebddfc9c8d08c4312a7f53",
+    "catalog_date": "",
+    "role": "Misc: Zemax definitions that are constants, not measured data",
+}
+DEFINITIONS = [
+    (
+        "N15",
+        5,
+        [1.5, 0.0, 0.0],
+        (0.365, 1.014),
+        1.5,
+        "Zemax MISC N15: simulated glass of index 1.5 at all wavelengths of its range "
+        "(Conrady formula n0 = 1.5, A = B = 0)",
+    ),
+]
+
+# --------------------------------------------------------------------------- Robb & Mercado 1983
+
+ROBB_FILE = "robb1983_data_final.txt"
+#: base wavelength (µm) and α of the fits: ω = Δλ/(1 + 2.5 Δλ), Δλ = λ − 0.574 µm. The base
+#: index is n(0.574 µm), not nd: checked in robb_schott_1980 on the glasses the 2018 Schott
+#: sheet still lists (their formulas agree with the rows only for λ0 = 0.574 µm)
+ROBB_LAMBDA0_UM = 0.574
+ROBB_ALPHA = 2.5
+#: the visible region of the fits: the wavelengths of largest error the table lists span it
+ROBB_RANGE_UM = (0.400, 0.700)
+#: largest |n(Schott row) − n(other catalog's row of the same name)| over ROBB_RANGE_UM for a
+#: row to count as confirmed; equivalent glasses of two 1980 catalogs differ by ≤ 3.4e-4 in the
+#: table; the rows that disagree (SF18, LASF13, LASF15) do so by ≥ 5e-2 — a transcription error
+#: (the Schott SF18 row gives nd 1.654, Schott's SF18 is 1.7215) or another glass of that name
+ROBB_CONFIRM = 1e-3
+ROBB_NAMES = {
+    "OHARA": "Ohara",
+    "HOYA": "Hoya",
+    "CORNING-FRANCE": "Corning-France",
+    "CHANCE": "Chance",
+}
+
+
+def read_robb(path: Path) -> dict[str, dict[str, tuple[float, ...]]]:
+    """catalog → glass → (n0, ν1, ν2, std dev, max error, λ of max error µm) of the table."""
+    tables: dict[str, dict[str, tuple[float, ...]]] = {}
+    cat = None
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("#"):
+            m = re.match(r"#\s*(\S+) GLASS CATALOGUE", line)
+            if m:
+                cat = m.group(1)
+                tables[cat] = {}
+            continue
+        t = line.split()
+        if not t:
+            continue
+        if cat is None or len(t) != 7 or t[0] in tables[cat]:
+            raise SystemExit(f"{path.name}: unexpected line {line!r}")
+        tables[cat][t[0]] = tuple(float(x) for x in t[1:])
+    return tables
+
+
+def _robb_n(row: tuple[float, ...], lam_um):
+    import numpy as np
+
+    d = np.asarray(lam_um, dtype=float) - ROBB_LAMBDA0_UM
+    w = d / (1.0 + ROBB_ALPHA * d)
+    return row[0] + row[1] * w + row[2] * w * w
+
+
+def robb_schott_1980(
+    path: Path, source: str, catalogs: dict[str, list[dict]]
+) -> tuple[list[dict], dict]:
+    """Records for the Schott 1980 glasses of the Robb & Mercado table that nothing shipped
+    covers, and a summary of the selection (counts, rejected rows)."""
+    import numpy as np
+
+    tables = read_robb(path)
+    schott = tables["SCHOTT"]
+    lam = np.linspace(*ROBB_RANGE_UM, 61)
+
+    def key(name: str) -> str:
+        return re.sub(r"[^A-Z0-9.]", "", name.upper())
+
+    shipped = {
+        key(n)
+        for recs in catalogs.values()
+        for r in recs
+        for n in (r["name"], *r.get("aliases", []))
+    }
+    current = {key(r["name"]): r for r in catalogs["Schott"] if not r["status"]}
+    evaluate = _runtime_formulas().evaluate
+    check = []
+    for name, row in schott.items():
+        r = current.get(key(name))
+        if r is not None:
+            n = evaluate(r["formula"], tuple(r["coefficients"]), lam)
+            check.append(float(np.max(np.abs(_robb_n(row, lam) - n))))
+    if len(check) < 10 or float(np.median(check)) > 1e-4:
+        raise SystemExit(
+            f"{path.name}: the Schott rows do not reproduce the 2018 Schott formulas "
+            f"(median max |Δn| {np.median(check):.1e} over {len(check)} glasses): λ0, α?"
+        )
+    out, rejected, unconfirmed = [], [], []
+    for name, row in schott.items():
+        if key(name) in shipped or key("N-" + name) in shipped:
+            continue
+        others = {c: t[name] for c, t in tables.items() if c != "SCHOTT" and name in t}
+        diffs = {
+            c: float(np.max(np.abs(_robb_n(row, lam) - _robb_n(o, lam)))) for c, o in others.items()
+        }
+        if not diffs:
+            unconfirmed.append(name)
+            continue
+        if min(diffs.values()) > ROBB_CONFIRM:
+            rejected.append(name)
+            continue
+        n0, nu1, nu2, sd, emax, lam_emax = row
+        coef = [ROBB_LAMBDA0_UM, ROBB_ALPHA, n0, nu1, nu2]
+        nd, nf, nc = (
+            float(x) for x in evaluate("buchdahl", tuple(coef), [0.5875618, 0.4861327, 0.6562725])
+        )
+        by = "; ".join(
+            f"{ROBB_NAMES[c]} {d:.1e}" for c, d in sorted(diffs.items()) if d <= ROBB_CONFIRM
+        )
+        out.append(
+            _record(
+                name,
+                "buchdahl",
+                coef,
+                [],
+                nd=round(nd, 6),
+                vd=round((nd - 1.0) / (nf - nc), 4),
+                status="legacy",
+                source=source,
+                range_um=ROBB_RANGE_UM,
+                note=(
+                    "Schott 1980 catalog as fitted by Robb & Mercado 1983 (Appl. Opt. 22, 1198, "
+                    f"Table V; quadratic Buchdahl model, std dev {sd:g}, max error {emax:g} at "
+                    f"{lam_emax:g} µm over the visible); nd and vd computed from the fit; the "
+                    "row is confirmed by the same name's row of another 1980 catalog of the "
+                    f"table (max |Δn| over 400-700 nm: {by})"
+                ),
+            )
+        )
+    summary = {
+        "shipped": len(out),
+        "rejected": rejected,
+        "unconfirmed": len(unconfirmed),
+        "median_max_dn_vs_2018_formulas": round(float(np.median(check)), 7),
+        "glasses_compared_with_2018": len(check),
+    }
+    return out, summary
+
+
 def _rii_temperature(d: dict) -> float | None:
     specs = d.get("SPECS") or {}
     t = specs.get("temperature")
@@ -951,7 +1123,33 @@ def build(date: str) -> dict[str, bytes]:
                 note="; ".join(x for x in (what, rec["note"]) if x),
             )
         )
+    sources["Zemax MISC definitions"] = DEFINITIONS_SOURCE
+    for name, fid, coef, rng, nd, note in DEFINITIONS:
+        misc.append(
+            _record(
+                name,
+                fid,
+                coef,
+                [],
+                nd=nd,
+                vd=None,
+                source="Zemax MISC definitions",
+                range_um=rng,
+                note=note,
+            )
+        )
     catalogs["Misc"] = misc
+
+    rsrc = add_source(
+        ROBB_FILE,
+        og / ROBB_FILE,
+        "opticalglass",
+        og_v,
+        "Schott 1980 catalog (Robb & Mercado 1983, Table V): old glasses nothing else covers",
+    )
+    old_schott, summary = robb_schott_1980(og / ROBB_FILE, rsrc, catalogs)
+    catalogs["Schott"].extend(old_schott)
+    sources[rsrc]["selection"] = summary
 
     meta = {
         "format": FORMAT,

@@ -232,7 +232,7 @@ def _cmd_lens(args, lens_name: str) -> int:
     from .common import CliError, load
     from .distortion import check_plot_path
 
-    lens = load(lens_name)
+    lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
     for flag, path in (("-o", args.output), ("--picture", args.picture), ("--maps", args.maps)):
@@ -310,7 +310,7 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
     from .common import load
     from .distortion import check_plot_path
 
-    lens = load(lens_name)
+    lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
     _check_out(args.output, args, "-o")
@@ -607,7 +607,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "ideal one.",
     )
     o.add_argument(
-        "--strict", action="store_true", help="Exit with status 2 when a chief ray fails."
+        "--strict",
+        action="store_true",
+        help="Exit with status 2 when a chief ray fails, or when the lens file names a glass that "
+        "can only be read as a substitute (an N- successor, a parent glass, a model of nd/vd).",
     )
     add_force_arg(q)
     og = q.add_mutually_exclusive_group()

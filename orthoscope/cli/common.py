@@ -119,17 +119,18 @@ def signed_list(text: str) -> str:
     return text
 
 
-def load(name: str):
-    """Load a lens by bundled name or path (every reader the project has)."""
+def load(name: str, strict: bool = False):
+    """Load a lens by bundled name or path (every reader the project has); ``strict``: refuse a
+    glass that the file names but that is read only as a substitute (``--strict``)."""
     from raytrace.files.library import load_lens
 
-    return load_lens(name)
+    return load_lens(name, strict=strict)
 
 
 def load_input(args):
     """The lens of ``args.lens`` (:func:`load`), recorded as the command's input
     (``args._inputs``) so that no output is ever written onto it."""
-    lens = load(args.lens)
+    lens = load(args.lens, strict=getattr(args, "strict", False))
     args._inputs = [lens.path] if lens.path else []
     return lens
 
@@ -164,7 +165,7 @@ def load_scaled(args):
     from raytrace.files.library import load_lens
     from raytrace.paraxial import paraxial
 
-    lens = load_lens(args.lens)
+    lens = load_lens(args.lens, strict=getattr(args, "strict", False))
     if args.scale_to_efl is not None:
         if not (args.scale_to_efl > 0 and math.isfinite(args.scale_to_efl)):
             raise CliError(

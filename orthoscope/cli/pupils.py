@@ -95,7 +95,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_wavelength_arg(q)
     add_table_layout_arg(q)
     q.add_argument(
-        "--strict", action="store_true", help="Exit with status 2 when a field cannot be traced."
+        "--strict",
+        action="store_true",
+        help="Exit with status 2 when a field cannot be traced, or when the lens file names a "
+        "glass read only as a substitute (an N- successor, a parent glass, a model of nd/vd).",
     )
     q.add_argument(
         "--plot",

@@ -16,9 +16,17 @@ READ_SUFFIXES = (".toml", ".zmx", ".seq", ".len")
 WRITE_SUFFIXES = (".toml", ".zmx")
 
 
-def read_lens_file(path: str | Path) -> Lens:
+def read_lens_file(path: str | Path, *, strict: bool = False) -> Lens:
     """Read a lens file of any supported format (by suffix; anything else is read as native
-    TOML). Raises :class:`PrescriptionError`."""
+    TOML). Raises :class:`PrescriptionError`. ``strict``: a glass name that resolves only to a
+    substitute (a successor, another vendor's glass, a moulded glass's parent, a model glass of
+    the nd/vd the file prints; :func:`raytrace.glass.resolve_glass`) is refused instead of read
+    with a warning."""
+    if strict:
+        from ..glass import strict_glasses
+
+        with strict_glasses():
+            return read_lens_file(path)
     suffix = Path(path).suffix.lower()
     if suffix == ".zmx":
         from .zemax import read_zmx

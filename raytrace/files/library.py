@@ -90,16 +90,19 @@ def resolve_lens_path(name_or_path: str | Path) -> Path:
     )
 
 
-def load_lens(name_or_path: str | Path) -> Lens:
+def load_lens(name_or_path: str | Path, *, strict: bool = False) -> Lens:
     """Load a lens: a bundled lens by name (``"topogon-us2031792-fig1"``, with or without
     ``.toml``; see ``orthoscope lenses``) or a file path (``.toml``, Zemax ``.zmx``, CODE V
     ``.seq``, chosen by suffix). An existing file path wins over a bundled name.
+
+    ``strict``: refuse glass names that resolve only to a substitute glass (see
+    :func:`raytrace.files.read_lens_file`).
 
     Raises :class:`~raytrace.errors.PrescriptionError` naming the file, line and surface for a
     broken file, or listing the bundled names (with "did you mean") for an unknown one."""
     from . import read_lens_file
 
-    return read_lens_file(resolve_lens_path(name_or_path))
+    return read_lens_file(resolve_lens_path(name_or_path), strict=strict)
 
 
 def lens_info(lens: Lens, name: str | None = None) -> LensInfo:

@@ -13,7 +13,8 @@ candidates and how to pick one (a catalog suffix ``_SCHOTT``, a Zemax ``GCAT`` l
 glass). Six-digit glass codes (``620603`` → nd 1.620, vd 60.3) and ``nd:vd`` strings are parsed
 by :func:`parse_glass_code` without any catalog. The file readers resolve names through
 :func:`resolve_glass` (:mod:`.legacy`): the file's catalogs first, then Schott's ``N-``
-successors of old glasses, each substitution with a warning.
+successors of old glasses, the parents of moulded glasses and the nd/vd a file prints, each
+substitution with a warning (refused in a strict reading, :func:`strict_glasses`).
 """
 
 from ..materials import OutOfRangeError, OutOfRangeWarning
@@ -33,9 +34,17 @@ from .catalog import (
     parse_glass_code,
     private_material,
     search_glass,
+    split_catalog_suffix,
 )
 from .formulas import FORMULAS, evaluate
-from .legacy import GlassResolution, printed_nd_vd, resolve_glass
+from .legacy import (
+    GlassResolution,
+    ModelGlassError,
+    model_glass_error,
+    printed_nd_vd,
+    resolve_glass,
+    strict_glasses,
+)
 from .thermal import delta_n_absolute, dn_dt_absolute, index_at
 
 __all__ = [
@@ -45,6 +54,7 @@ __all__ = [
     "CatalogGlass",
     "GlassMatch",
     "GlassResolution",
+    "ModelGlassError",
     "OutOfRangeError",
     "OutOfRangeWarning",
     "PRIVATE",
@@ -59,6 +69,7 @@ __all__ = [
     "find_glass",
     "index_at",
     "lookup_glass",
+    "model_glass_error",
     "normalize_name",
     "parse_glass_code",
     "printed_nd_vd",
@@ -66,4 +77,6 @@ __all__ = [
     "relative_to_absolute",
     "resolve_glass",
     "search_glass",
+    "split_catalog_suffix",
+    "strict_glasses",
 ]

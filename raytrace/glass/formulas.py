@@ -33,6 +33,9 @@ id            equation (λ in µm; coefficients in the order listed)
               ends, extrapolated with the end cubics — the interpolation ray-optics applies to
               CODE V private glasses (scipy ``interp1d(kind="cubic")``); 3 points: the
               parabola, 2: the line, 1: a constant
+"buchdahl"    Buchdahl's chromatic-coordinate polynomial (Robb & Mercado 1983, Appl. Opt. 22,
+              1198): n = n0 + ν1 ω + ν2 ω² + …, ω = Δλ/(1 + α Δλ), Δλ = λ − λ0;
+              coefficients λ0 (µm), α, n0, ν1, ν2, …
 ============  ==========================================================================
 
 refractiveindex.info formula 7 is the Herzberger formula (AGF 3, same coefficient order) and is
@@ -196,6 +199,16 @@ def _spline(lam, c):
     )
 
 
+def _buchdahl(lam, c):
+    lam0, alpha, *nu = list(c)
+    d = lam - lam0
+    omega = d / (1.0 + alpha * d)
+    n = np.zeros_like(lam) + nu[0]
+    for k, v in enumerate(nu[1:], start=1):
+        n = n + v * omega**k
+    return n
+
+
 @dataclass(frozen=True)
 class Formula:
     """One dispersion formula: ``id``, its ``name``, the ``equation`` as text and the
@@ -264,6 +277,12 @@ FORMULAS: dict[int | str, Formula] = {
             "tabulated n(λ)",
             "piecewise-linear interpolation in λ of the table (λ1..λN, n1..nN)",
             _tabulated,
+        ),
+        Formula(
+            "buchdahl",
+            "Buchdahl chromatic coordinate",
+            "n = n0 + ν1ω + ν2ω² + …, ω = (λ − λ0)/(1 + α(λ − λ0))",
+            _buchdahl,
         ),
         Formula(
             "spline",

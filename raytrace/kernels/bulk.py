@@ -84,13 +84,15 @@ def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere, check, carry):
     row records the first failure and they are replaced by NaN when the block is written out.
     ``check``: apply the backward-travel test (:mod:`.surface`, "Travelling backwards": only at
     a surface that refracts, and once an acting surface was met); row ``_RT`` gets the path to
-    this surface and is added in only when ``carry`` (dummy surfaces were traced since the last
-    acting one). Branch-free, so the loop stays vectorised."""
+    this surface, to which the row's previous value is added only when ``carry`` (dummy surfaces
+    were traced since the last acting one). Branch-free, so the loop stays vectorised (an
+    interleaved A/B measured the earlier form, with branches on ``carry`` and a boolean ``and``
+    for the test, 3–4 % slower)."""
     ck = cj * (1.0 + kj)
     mu2 = mu * mu
-    test = check and mu != 1.0
-    dummy = mu == 1.0
-    lim = backward_limit(zvj)
+    carried = 1.0 if carry else 0.0
+    # the test applies (check, a refracting surface) or lim = −inf: one compare in the loop
+    lim = backward_limit(zvj) if (check and mu != 1.0) else -np.inf
     for i in range(nb):
         LL = buf[_RL + i]
         MM = buf[_RM + i]
@@ -121,12 +123,9 @@ def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere, check, carry):
         # time); the drift measured over 11 surfaces is <= 2e-15 (tests check <= 1e-14).
         missed = (not (NN > 0.0)) or not hit or not (w > 0.0)
         clipped = xx * xx + yy * yy > sd2
-        tt = t0 + s  # the path: p = p0 + (t0 + s) d
-        if carry:  # loop-invariant branches: LLVM unswitches them, the loop stays vectorised
-            tt += buf[_RT + i]
-        if dummy:
-            buf[_RT + i] = tt
-        back = (tt < lim) & test
+        tt = t0 + s + buf[_RT + i] * carried  # the path: p = p0 + (t0 + s) d
+        buf[_RT + i] = tt
+        back = tt < lim
         code = float(STATUS_TIR) if sin2t > 1.0 else 0.0
         code = float(STATUS_CLIPPED) if clipped else code
         code = float(STATUS_BACKWARD) if back else code
@@ -239,9 +238,9 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
             buf[_RF + i] = jp1 if nc else buf[_RF + i]
     _asphere_sag_rows(buf, nb, cj, kj, asph, j)
     mu2 = mu * mu
-    test = check and mu != 1.0
     carried = 1.0 if carry else 0.0
-    lim = backward_limit(zvj)
+    # the test applies (check, a refracting surface) or lim = −inf: one compare in the loop
+    lim = backward_limit(zvj) if (check and mu != 1.0) else -np.inf
     for i in range(nb):
         LL = buf[_RL + i]
         MM = buf[_RM + i]
@@ -264,7 +263,7 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
         z0 = buf[_RZ + i]
         z1 = zvj + buf[_RZL + i]
         tt = (z1 - z0) / NN + buf[_RT + i] * carried
-        back = (tt < lim) & test
+        back = tt < lim
         buf[_RT + i] = tt
         code = float(STATUS_TIR) if (refract and sin2t > 1.0) else 0.0
         code = float(STATUS_CLIPPED) if clipped else code
