@@ -426,11 +426,12 @@ def checked_aim_request(
     od = float(object_distance)
     if not (od > 0.0):
         raise TraceError(f"object distance must be a positive magnitude or inf, got {od}")
-    if not all(np.all(np.isfinite(f)) for f in fields):
+    fa = [np.abs(np.asarray(f, dtype=np.float64)) for f in fields]
+    if not all(np.isfinite(a).all() for a in fa):
         raise TraceError("fields must be finite numbers")
     if field_kind == "height" and not math.isfinite(od):
         raise TraceError(f"{heights} need a finite object distance")
-    if field_kind == "angle" and any(np.any(np.abs(f) >= 90.0) for f in fields):
+    if field_kind == "angle" and any(a.size and a.max() >= 90.0 for a in fa):
         raise TraceError("field angles must lie strictly between -90 and 90 degrees")
     return od
 
