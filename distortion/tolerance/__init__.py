@@ -1,8 +1,10 @@
 """Tolerancing distortion: how much the distortion of manufactured lenses scatters
 and which tolerance drives it — the outputs of many perturbed instances computed together
 (:mod:`.outputs`), compensators (:mod:`.compensators`), sensitivity analysis
-(:mod:`.sensitivity`) and a seeded, chunked, resumable Monte Carlo on this machine or a Dask
-cluster (:mod:`.montecarlo`). Specs and the perturbation model: :mod:`raytrace.tolerance`.
+(:mod:`.sensitivity`), Fraser & Shortis's g_ss' per instance (:mod:`.gfactor`) and a seeded,
+chunked, resumable Monte Carlo on this machine or a Dask cluster (:mod:`.montecarlo`) whose
+summary can be streamed (:mod:`.summary`). Specs and the perturbation model:
+:mod:`raytrace.tolerance`.
 """
 
 from .compensators import best_focus_planes, image_planes, pupil_bundle
@@ -17,6 +19,7 @@ from .outputs import (
     prepare,
 )
 from .sensitivity import SensitivityResult, sensitivity
+from .summary import StreamedSummary, StreamingSummary
 
 #: the names under which ``import orthoscope`` offers the two entry points
 tolerance_sensitivity = sensitivity
@@ -27,6 +30,8 @@ __all__ = [
     "SCALARS",
     "MonteCarloResult",
     "SensitivityResult",
+    "StreamedSummary",
+    "StreamingSummary",
     "ToleranceOutputs",
     "ToleranceSetup",
     "best_focus_planes",

@@ -52,10 +52,22 @@ from .outputs import (
     evaluate,
     prepare,
 )
+from .summary import (
+    PERCENTILE_METHOD,
+    SUMMARY_BINS,
+    SUMMARY_BLOCK,
+    StreamedSummary,
+    StreamingSummary,
+    interpolation_weights,
+    yield_counts,
+)
 
 FORMAT = "orthoscope-tolerance-mc-1"
 DEFAULT_PERCENTILES = (0.5, 2.5, 16.0, 50.0, 84.0, 97.5, 99.5)
 DEFAULT_CHUNK = 256
+#: ``summary="auto"`` gathers the instances (exact summary) up to this many, streams above
+EXACT_MAX_INSTANCES = 100_000
+SUMMARY_METHODS = ("auto", "exact", "streaming")
 
 
 # ------------------------------------------------------------------------------ one chunk
@@ -95,8 +107,12 @@ def spec_hash(spec: ToleranceSpec) -> str:
 
 
 def _settings_hash(setup: ToleranceSetup) -> str:
-    return _hash(setup.points_deg, setup.object_distance, setup.wavelength, setup.radial_terms,
-                 setup.grid_rings, setup.grid_azimuths)  # fmt: skip
+    parts = [setup.points_deg, setup.object_distance, setup.wavelength, setup.radial_terms,
+             setup.grid_rings, setup.grid_azimuths]  # fmt: skip
+    if setup.g is not None:  # (runs without g keep the hash they had before g existed)
+        gs = setup.g
+        parts += ["g", gs.object_distance, gs.n_r, gs.threshold_um, gs.method]
+    return _hash(*parts)
 
 
 # ------------------------------------------------------------------------------ the store
@@ -204,9 +220,10 @@ class MonteCarloResult:
 
     Attributes
     ----------
-    outputs : ToleranceOutputs
-        Every instance, in instance order.
-    values : (n, n_items) the perturbations (items' units).
+    outputs : ToleranceOutputs or None
+        Every instance, in instance order (``summary="exact"``); None for a streamed summary,
+        which never holds all instances.
+    values : (n, n_items) the perturbations (items' units), or None (streamed).
     nominal : ToleranceOutputs (1 instance).
     names : list of str, item labels.
     seed, n, chunk_size : int
@@ -216,11 +233,17 @@ class MonteCarloResult:
     percentiles : (P,) the envelope levels, %.
     envelope_um, envelope_cal_um : (P, F) percentiles over ok instances of D_um and D_cal_um.
     stats : dict name -> dict(mean, std, min, max, p2.5, p97.5) of the scalar outputs (units of
-        :class:`ToleranceOutputs`) over ok instances.
+        :class:`ToleranceOutputs`) over ok instances (finite values; ``"g"`` only when g was
+        computed, with ``"n"`` the number of instances whose g is determined).
+    g_object_distance : float or None, the object plane s' of g (mm from the first vertex).
     elapsed_s : float, wall time of this call.
     resumed_chunks : int, chunks read back from ``out_dir`` instead of computed.
     out_dir : str or None
     lens_hash, spec_hash : str
+    summary_method : ``"exact"`` (statistics over the gathered instances; exact percentiles) or
+        ``"streaming"`` (computed chunk by chunk, :mod:`distortion.tolerance.summary`).
+    streamed : the :class:`~distortion.tolerance.summary.StreamedSummary` (streaming), else None.
+    limits : ((limit µm, field deg), ...) the yields counted during the run.
     """
 
     outputs: ToleranceOutputs
@@ -242,26 +265,65 @@ class MonteCarloResult:
     out_dir: str | None
     lens_hash: str
     spec_hash: str
+    g_object_distance: float | None = None
+    summary_method: str = "exact"
+    streamed: StreamedSummary | None = None
+    limits: tuple = ()
 
     @property
     def n_ok(self) -> int:
+        if self.outputs is None:
+            return int(self.streamed.n_ok)
         return int(np.count_nonzero(self.outputs.ok))
 
     def yield_fraction(self, limit_um: float, field_deg: float, calibrated: bool = False) -> float:
         """Fraction of all instances with |D| < ``limit_um`` at ``field_deg`` (each instance's
         curve interpolated linearly; failed instances count as out of limit). ``calibrated``:
-        D_cal_um instead of the raw D_um."""
+        D_cal_um instead of the raw D_um. A streamed run answers the limits it counted
+        (``limits=`` of :func:`monte_carlo`) and raises ValueError for any other."""
+        j, w = interpolation_weights(self.fields_deg, field_deg)
+        if self.outputs is None:
+            key = (float(limit_um), float(field_deg))
+            if key not in self.streamed.limits:
+                raise ValueError(
+                    f"this streamed run counted the yields {list(self.streamed.limits)} only; "
+                    f"pass limits=[({limit_um:g}, {field_deg:g})] to monte_carlo"
+                )
+            k = self.streamed.limits.index(key)
+            y = self.streamed.yields_cal if calibrated else self.streamed.yields_raw
+            return float(int(y[k]) / max(self.n, 1))
         D = self.outputs.D_cal_um if calibrated else self.outputs.D_um
-        fd = self.fields_deg
-        if not (fd.min() <= field_deg <= fd.max()):
-            raise ValueError(
-                f"field {field_deg:g} deg is outside the traced {fd.min():g}..{fd.max():g}"
-            )
-        j = int(np.clip(np.searchsorted(fd, field_deg), 1, fd.size - 1))
-        w = (field_deg - fd[j - 1]) / (fd[j] - fd[j - 1])
-        d = D[:, j - 1] * (1.0 - w) + D[:, j] * w
-        good = self.outputs.ok & np.isfinite(d)
-        return float(np.count_nonzero(good & (np.abs(d) < limit_um)) / max(self.n, 1))
+        return float(yield_counts(D, self.outputs.ok, j, w, limit_um) / max(self.n, 1))
+
+    def percentile_values(self, name: str, levels) -> np.ndarray:
+        """Percentiles (``levels`` in %) of a scalar output (or ``K1``..) over the ok instances
+        with a finite value: exact (numpy) for an exact summary, from the histogram (within one
+        bin width) for a streamed one."""
+        if self.outputs is None:
+            return self.streamed.percentiles(name, levels)
+        v = self._values(name)
+        lev = np.asarray(levels, dtype=float)
+        return np.percentile(v, lev) if v.size else np.full(lev.shape, np.nan)
+
+    def histogram(self, name: str, bins: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(counts, edges) of a scalar output over the ok instances with a finite value, for
+        plots: ``bins`` equal bins between its min and max (default ~√n, 10..60)."""
+        if self.outputs is None:
+            return self.streamed.histogram(name, bins or 50)
+        v = self._values(name)
+        if v.size == 0:
+            return np.zeros(0, dtype=np.int64), np.zeros(1)
+        nb = bins or min(60, max(10, int(np.sqrt(v.size))))
+        return np.histogram(v, bins=nb)
+
+    def _values(self, name: str) -> np.ndarray:
+        o = self.outputs
+        if name.startswith("K") and name[1:].isdigit():
+            v = o.K[:, int(name[1:]) - 1]
+        else:
+            v = getattr(o, name)
+        v = np.asarray(v, dtype=float)[np.asarray(o.ok, dtype=bool)]
+        return v[np.isfinite(v)]
 
     def summary(self) -> dict:
         """JSON-ready summary (floats and lists; keys carry units): bit-identical for the same
@@ -283,6 +345,8 @@ class MonteCarloResult:
             "envelope_D_um": [[float(v) for v in row] for row in self.envelope_um],
             "envelope_D_cal_um": [[float(v) for v in row] for row in self.envelope_cal_um],
             "stats": {k: {s: float(x) for s, x in v.items()} for k, v in self.stats.items()},
+            "summary_method": self.summary_method,
+            **self._streaming_summary(),
             "units": {
                 "D_um": "um",
                 "efl": "mm",
@@ -299,7 +363,36 @@ class MonteCarloResult:
                 "P1_raw": "1/mm",
                 "P2_raw": "1/mm",
                 "fit_rms_um": "um",
+                "g": "1",
             },  # fmt: skip
+            **self._g_summary(),
+        }
+
+    def _streaming_summary(self) -> dict:
+        if self.streamed is None:
+            return {}
+        ss = self.streamed
+        return {
+            "percentile_method": PERCENTILE_METHOD.format(
+                bins=ss.bins, last=min(ss.block, ss.n) - 1, widen=ss.widen
+            ),
+            "summary_block": ss.block,
+            "summary_bins": ss.bins,
+            "yield_counts": [
+                {"limit_um": a, "field_deg": b, "raw": int(r), "calibrated": int(c)}
+                for (a, b), r, c in zip(ss.limits, ss.yields_raw, ss.yields_cal, strict=True)
+            ],
+        }
+
+    def _g_summary(self) -> dict:
+        if self.g_object_distance is None:
+            return {}
+        from .gfactor import DEFINITION
+
+        od = self.g_object_distance
+        return {
+            "g_object_distance_mm": od if math.isfinite(od) else "inf",
+            "g_definition": DEFINITION,
         }
 
     def __repr__(self) -> str:
@@ -350,6 +443,11 @@ def monte_carlo(
     grid_azimuths: int = DEFAULT_AZIMUTHS,
     radial_terms: int = 3,
     percentiles=DEFAULT_PERCENTILES,
+    g_object_distance=None,
+    limits=(),
+    summary: str = "auto",
+    summary_block: int = SUMMARY_BLOCK,
+    summary_bins: int = SUMMARY_BINS,
     setup: ToleranceSetup | None = None,
 ) -> MonteCarloResult:
     """Monte Carlo of ``n`` instances of ``lens`` under ``spec`` (module docstring).
@@ -363,17 +461,32 @@ def monte_carlo(
     object_distance : float, mm (positive magnitude; inf), default the lens's.
     wavelength : float, nm, default the lens's reference wavelength.
     out_dir : path or None
-        Folder for chunks, manifest and summary.json; None keeps everything in memory.
+        Folder for chunks, manifest and summary.json; None keeps nothing on disk.
     resume, overwrite : bool
         Continue a matching run found in ``out_dir``; replace any other run there.
     executor : None | "local" | "local[:N]" | "tcp://HOST:PORT" | distributed.Client
         None / "local": this process, numba threads over instances; otherwise Dask (imported only
-        then): chunks (instance ranges) are submitted with the shared setup scattered once.
+        then): chunks (instance ranges) are submitted with the shared setup scattered once, at
+        most a few per worker at a time.
     progress : callable(done, total) or None
         Called after every finished chunk with instance counts.
     grid_rings, grid_azimuths, radial_terms
         The 2-D fit points (fractions of the largest curve field × azimuths) and its radial order.
     percentiles : the envelope levels, %.
+    g_object_distance : mm, ``inf``, ``"2m"`` or ``"10x"``, or None
+        The object plane s' of Fraser & Shortis's g_ss' (the lens focused at ``object_distance``
+        by its compensator; :mod:`distortion.tolerance.gfactor`); None takes the spec's
+        ``[outputs] g_object_distance``; without either, g is not computed (NaN).
+    limits : ((limit µm, field deg), ...)
+        Yields counted during the run (a streamed run can answer only these).
+    summary : "auto" | "exact" | "streaming"
+        ``"exact"`` gathers every instance (``outputs``) and takes exact statistics;
+        ``"streaming"`` summarises chunk by chunk and never holds all instances
+        (:mod:`distortion.tolerance.summary`: exact counts, min, max and yields, means and
+        standard deviations by a pairwise merge, percentiles within one histogram bin);
+        ``"auto"``: exact up to :data:`EXACT_MAX_INSTANCES` instances, streaming above. The
+        choice depends on n only, never on the chunking.
+    summary_block, summary_bins : the streamed summary's block of instances and histogram bins.
     setup : a :class:`ToleranceSetup` to reuse (then the field / object / fit arguments are its).
 
     A ``KeyboardInterrupt`` propagates after the finished chunks are on disk.
@@ -387,69 +500,110 @@ def monte_carlo(
         raise ToleranceSpecError(
             f"samples {n}, chunk {cs}, seed {seed}: give samples and chunk ≥ 1 and a seed ≥ 0"
         )
+    if summary not in SUMMARY_METHODS:
+        raise ToleranceSpecError(f"summary {summary!r}: use one of {', '.join(SUMMARY_METHODS)}")
+    streaming = summary == "streaming" or (summary == "auto" and n > EXACT_MAX_INSTANCES)
     st = setup or prepare(lens, spec, fields_deg=fields_deg, object_distance=object_distance,
                           wavelength=wavelength, grid_rings=grid_rings,
-                          grid_azimuths=grid_azimuths, radial_terms=radial_terms)  # fmt: skip
+                          grid_azimuths=grid_azimuths, radial_terms=radial_terms,
+                          g_object_distance=g_object_distance)  # fmt: skip
+    lims = tuple((float(a), float(b)) for a, b in limits)
+    for _, deg in lims:
+        interpolation_weights(st.fields_deg, deg)  # ValueError now, not after the run
     lh = lens_hash(lens, spec, st.wavelength)
     sh = spec_hash(spec)
     chunks = [(k, k * cs, min(n, (k + 1) * cs)) for k in range(math.ceil(n / cs))]
     results: dict[int, dict] = {}
+    acc = None
+    if streaming:
+        acc = StreamingSummary(n, st.fields_deg, st.radial_terms, lims, block=summary_block,
+                               bins=summary_bins)  # fmt: skip
     store = None
+    on_disk: set[int] = set()
     if out_dir is not None:
         manifest = {"format": FORMAT, "lens": lens.name, "lens_hash": lh, "spec_hash": sh,
                     "settings_hash": _settings_hash(st), "seed": seed, "n": n,
                     "chunk_size": cs, "generator": GENERATOR,
                     "compensator": spec.compensator.type}  # fmt: skip
         store = _Store(out_dir, manifest, resume, overwrite)
-        for k in sorted(store.done):
-            results[k] = store.load(k)
-    resumed = len(results)
-    todo = [c for c in chunks if c[0] not in results]
-    done_count = sum(b - a for k, a, b in chunks if k in results)
+        on_disk = set(store.done)
+    resumed = len(on_disk)
+    done_count = sum(b - a for k, a, b in chunks if k in on_disk)
     if progress is not None and done_count:
         progress(done_count, n)
 
+    def feed(k: int, a: int, d: dict) -> None:
+        """A chunk's arrays into the summary (streaming) or the gathered results (exact)."""
+        if acc is not None:
+            acc.add(a, d)
+        else:
+            results[k] = d
+
     def finish(k: int, a: int, b: int, d: dict) -> None:
         nonlocal done_count
-        results[k] = d
         if store is not None:
             store.save(k, d)
+        feed(k, a, d)
         done_count += b - a
         if progress is not None:
             progress(done_count, n)
 
+    # the chunks that hold block 0 of a streamed summary come first (its range fixes the
+    # histograms); then every chunk in order (local) or as workers finish them (Dask)
+    block0 = summary_block if streaming else 0
+    first = [c for c in chunks if c[1] < block0]
+    rest = [c for c in chunks if c[1] >= block0]
     if executor in (None, "local"):
-        for k, a, b in todo:
-            finish(k, a, b, run_chunk(st, seed, a, b, parallel=True))
-    elif todo:
-        client, close = _dask_client(executor)
+        for k, a, b in first + rest:
+            if k in on_disk:
+                feed(k, a, store.load(k))
+            else:
+                finish(k, a, b, run_chunk(st, seed, a, b, parallel=True))
+    else:
+        client, close = (None, None)
+        if any(k not in on_disk for k, _, _ in chunks):
+            client, close = _dask_client(executor)
         try:
-            from distributed import as_completed
-
-            shared = client.scatter(st, broadcast=True)
-            futs = {client.submit(run_chunk, shared, seed, a, b, False, pure=False): (k, a, b)
-                    for k, a, b in todo}  # fmt: skip
-            try:
-                for fut in as_completed(futs):
-                    k, a, b = futs[fut]
-                    finish(k, a, b, fut.result())
-            except BaseException:
-                for fut in futs:
-                    fut.cancel()
-                raise
+            shared = client.scatter(st, broadcast=True) if client is not None else None
+            for group in (first, rest):
+                for k, a, _ in group:
+                    if k in on_disk:
+                        feed(k, a, store.load(k))
+                todo = [c for c in group if c[0] not in on_disk]
+                if todo:
+                    _run_dask(client, shared, seed, todo, finish)
         finally:
             if close is not None:
                 close()
-    parts = [results[k] for k, _, _ in chunks]
-    allv = {key: np.concatenate([p[key] for p in parts], axis=0) for key in parts[0]}
-    values = allv.pop("values")
-    outs = ToleranceOutputs.from_arrays(st.fields_deg, allv)
     nom = evaluate(st, np.zeros((1, spec.n_items)), parallel=False)
     q = np.asarray(percentiles, dtype=float)
-    ok = outs.ok.astype(bool)
-    stats = {k: _stats(getattr(outs, k)[ok]) for k in SCALARS}
-    for i in range(outs.K.shape[1]):
-        stats[f"K{i + 1}"] = _stats(outs.K[ok, i])
+    has_g = st.g is not None
+    names = [k for k in SCALARS if k != "g" or has_g]
+    if acc is not None:
+        ss = acc.result()
+        outs = values = None
+        stats = {k: ss.stats(k) for k in names}
+        for i in range(st.radial_terms):
+            stats[f"K{i + 1}"] = ss.stats(f"K{i + 1}")
+        if has_g:
+            stats["g"]["n"] = float(ss.count[ss.index("g")])
+        F = st.fields_deg.size
+        env = np.stack([ss.percentiles(f"D_um[{j}]", q) for j in range(F)], axis=1)
+        envc = np.stack([ss.percentiles(f"D_cal_um[{j}]", q) for j in range(F)], axis=1)
+    else:
+        ss = None
+        parts = [results[k] for k, _, _ in chunks]
+        allv = {key: np.concatenate([p[key] for p in parts], axis=0) for key in parts[0]}
+        values = allv.pop("values")
+        outs = ToleranceOutputs.from_arrays(st.fields_deg, allv)
+        ok = outs.ok.astype(bool)
+        stats = {k: _stats(getattr(outs, k)[ok]) for k in names}
+        for i in range(outs.K.shape[1]):
+            stats[f"K{i + 1}"] = _stats(outs.K[ok, i])
+        if has_g:
+            stats["g"]["n"] = float(np.count_nonzero(np.isfinite(outs.g[ok])))
+        env = _envelope(outs.D_um, ok, q)
+        envc = _envelope(outs.D_cal_um, ok, q)
     res = MonteCarloResult(
         outputs=outs,
         values=values,
@@ -462,16 +616,63 @@ def monte_carlo(
         compensator=spec.compensator.type,
         fields_deg=st.fields_deg,
         percentiles=q,
-        envelope_um=_envelope(outs.D_um, ok, q),
-        envelope_cal_um=_envelope(outs.D_cal_um, ok, q),
+        envelope_um=env,
+        envelope_cal_um=envc,
         stats=stats,
         elapsed_s=time.perf_counter() - t_start,
         resumed_chunks=resumed,
         out_dir=None if out_dir is None else str(out_dir),
         lens_hash=lh,
         spec_hash=sh,
+        g_object_distance=None if st.g is None else st.g.object_distance,
+        summary_method="streaming" if streaming else "exact",
+        streamed=ss,
+        limits=lims,
     )
     if store is not None:
         write_atomic(store.dir / "summary.json", json.dumps(res.summary(), indent=1) + "\n",
                      overwrite=True)  # fmt: skip
     return res
+
+
+#: chunks in flight per Dask worker (a sliding window: results are taken and released as they
+#: finish, so neither the cluster nor the client holds the outputs of the whole run)
+DASK_WINDOW_PER_WORKER = 4
+
+
+def _run_dask(client, shared, seed: int, todo: list, finish) -> None:
+    """Run the chunks ``todo`` [(k, start, stop), ...] on ``client`` with at most
+    :data:`DASK_WINDOW_PER_WORKER` per worker in flight; ``finish(k, start, stop, arrays)`` for
+    each as it completes (in any order)."""
+    from distributed import as_completed
+
+    workers = max(1, len(client.scheduler_info().get("workers", {})))
+    window = DASK_WINDOW_PER_WORKER * workers
+    pending = iter(todo)
+    futs = {}
+
+    def submit() -> bool:
+        nxt = next(pending, None)
+        if nxt is None:
+            return False
+        k, a, b = nxt
+        f = client.submit(run_chunk, shared, seed, a, b, False, pure=False)
+        futs[f] = nxt
+        ac.add(f)
+        return True
+
+    ac = as_completed()
+    try:
+        for _ in range(window):
+            if not submit():
+                break
+        for fut in ac:
+            k, a, b = futs.pop(fut)
+            d = fut.result()
+            fut.release()
+            finish(k, a, b, d)
+            submit()
+    except BaseException:
+        for fut in futs:
+            fut.cancel()
+        raise

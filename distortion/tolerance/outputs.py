@@ -17,7 +17,10 @@ Per instance ``i`` (docs/tolerance.md; units in :class:`ToleranceOutputs`):
    (rings × azimuths, symmetric about the axis, so that a centred lens gives x0 = y0 = P = S = 0);
    ``D_cal = y' − y0 − c tan α`` (what a calibration absorbs — camera constant and principal
    point — removed). The **raw** decentering ``P1_raw``, ``P2_raw`` comes from the same model
-   with c held at ``K0_i`` and the principal point at (0, 0).
+   with c held at ``K0_i`` and the principal point at (0, 0);
+6. when asked for (``g_object_distance``), Fraser & Shortis's variation factor g_ss' for the
+   lens focused at the run's object distance and the object plane at ``g_object_distance``
+   (:mod:`.gfactor`: one more kernel launch aims the chief rays at s').
 
 The fit uses one pseudo-inverse for all instances (the ideal coordinates t of the fields are the
 same for every instance), applied without BLAS so that an instance's numbers do not depend on how
@@ -47,6 +50,7 @@ from raytrace.tolerance import (
 from ..errors import DataError
 from ..grid.decompose import basis_columns
 from .compensators import image_planes, pupil_bundle
+from .gfactor import GSetup, instance_g, prepare_g, resolve_g_distance
 
 #: default number of curve fields (0 .. the lens's max field)
 DEFAULT_FIELDS = 50
@@ -54,7 +58,7 @@ DEFAULT_RINGS = (0.2, 0.4, 0.6, 0.8, 1.0)
 DEFAULT_AZIMUTHS = 8
 #: fields of :class:`ToleranceOutputs` with one value per instance
 SCALARS = ("efl", "image_z", "focus_shift", "k0", "c", "x0", "y0", "P1", "P2", "S1", "S2",
-           "P1_raw", "P2_raw", "fit_rms_um")  # fmt: skip
+           "P1_raw", "P2_raw", "fit_rms_um", "g")  # fmt: skip
 #: fields with one value per instance and curve field
 CURVES = ("D_um", "Dx_um", "D_cal_um")
 
@@ -81,7 +85,11 @@ class ToleranceOutputs:
     S1, S2 : (I,) thin prism, mm^-1 (calibrated fit).
     P1_raw, P2_raw : (I,) decentering with c = K0 and (x0, y0) = (0, 0) held, mm^-1.
     fit_rms_um : (I,) RMS residual of the calibrated fit, µm.
-    ok : (I,) bool, every chief ray of the instance traced.
+    g : (I,) Fraser & Shortis's variation factor g_ss' (Eq. 6; dimensionless) for the lens
+        focused at the run's object distance s and the object plane s' = ``g_object_distance``
+        (:mod:`distortion.tolerance.gfactor`); NaN when not requested, or where undetermined.
+    ok : (I,) bool, every chief ray of the curve and the fit traced (the rays at s' of g are
+        not part of it: a failure there makes only g NaN).
     """
 
     fields_deg: np.ndarray
@@ -103,6 +111,7 @@ class ToleranceOutputs:
     P1_raw: np.ndarray
     P2_raw: np.ndarray
     fit_rms_um: np.ndarray
+    g: np.ndarray
     ok: np.ndarray
 
     @property
@@ -127,6 +136,9 @@ class ToleranceOutputs:
 
     @staticmethod
     def from_arrays(fields_deg, d: dict) -> ToleranceOutputs:
+        d = dict(d)
+        if "g" not in d:  # chunk files written before g existed
+            d["g"] = np.full(np.asarray(d["efl"]).shape[0], np.nan)
         return ToleranceOutputs(fields_deg=np.asarray(fields_deg), **{k: d[k] for k in d})
 
     def __repr__(self) -> str:
@@ -160,6 +172,7 @@ class ToleranceSetup:
     nominal_image_z: float
     grid_rings: tuple
     grid_azimuths: int
+    g: GSetup | None = None  # the object plane s' of g_ss' (None: g not computed)
 
     @property
     def n_curve(self) -> int:
@@ -215,10 +228,15 @@ def prepare(
     grid_rings=DEFAULT_RINGS,
     grid_azimuths: int = DEFAULT_AZIMUTHS,
     radial_terms: int = 3,
+    g_object_distance=None,
 ) -> ToleranceSetup:
     """The :class:`ToleranceSetup` of a sensitivity or Monte Carlo run (arguments as
-    :func:`distortion.tolerance.monte_carlo`). Raises ToleranceSpecError for a spec that does
-    not fit the lens, TraceError when a nominal chief ray fails."""
+    :func:`distortion.tolerance.monte_carlo`). ``g_object_distance``: the object plane s' of
+    Fraser & Shortis's g_ss' (mm from the object plane to the first vertex, ``inf``, a length
+    string such as ``"2m"`` or an image scale ``"10x"``); None takes the spec's ``[outputs]
+    g_object_distance``, and without one g is not computed. Raises ToleranceSpecError for a spec
+    that does not fit the lens, TraceError when a nominal chief ray fails, DataError when g
+    cannot be defined (:func:`distortion.tolerance.gfactor.prepare_g`)."""
     check_against_lens(spec, lens)
     fd = default_fields(lens) if fields_deg is None else np.asarray(fields_deg, dtype=float).ravel()
     if fd.size == 0 or not np.all(np.isfinite(fd)) or np.any(np.abs(fd) >= 90.0):
@@ -254,9 +272,18 @@ def prepare(
     bundle = None
     if spec.compensator.type == "best-focus":
         bundle = pupil_bundle(par, od, spec.compensator.rings)
+    gsetup = None
+    if g_object_distance is None:
+        g_object_distance = spec.outputs.get("g_object_distance")
+        where = f"{spec.path or 'tolerance spec'}: [outputs] g_object_distance"
+    else:
+        where = "g_object_distance"
+    if g_object_distance is not None:
+        od2 = resolve_g_distance(lens, g_object_distance, wl, where)
+        gsetup = prepare_g(lens, spec, fd, od, od2, wl)
     setup = ToleranceSetup(lens, spec, fd, P, od, wl, object_per_t, aim, t, int(radial_terms),
                            fit, As, pinv, sc, Ar, pinvr, scr, bundle, 0.0, rings,
-                           int(grid_azimuths))  # fmt: skip
+                           int(grid_azimuths), gsetup)  # fmt: skip
     nom = evaluate(setup, np.zeros((1, spec.n_items)), parallel=False)
     if not nom.ok[0]:
         raise TraceError(f"{lens.name}: the nominal lens's chief rays or image plane fail")
@@ -309,10 +336,15 @@ def evaluate(
         x0 = y0 = c = P1 = P2 = S1 = S2 = P1r = P2r = rms = nan
         K = np.full((I, nk), np.nan)
         Dcal = np.full((I, F), np.nan)
+    if setup.g is not None:
+        g = instance_g(setup.g, spec.compensator.type, arr, z, xy[:, :, 1], k0, tan_a,
+                       parallel=parallel)  # fmt: skip
+    else:
+        g = nan
     dz = z - setup.nominal_image_z
     out = dict(efl=pb.efl, image_z=z, focus_shift=dz, k0=k0, D_um=D, Dx_um=Dx, D_cal_um=Dcal,
                c=c, x0=x0, y0=y0, K=K, P1=P1, P2=P2, S1=S1, S2=S2, P1_raw=P1r, P2_raw=P2r,
-               fit_rms_um=rms)  # fmt: skip
+               fit_rms_um=rms, g=g)  # fmt: skip
     bad = ~ok
     res = {}
     for k, v in out.items():

@@ -35,6 +35,8 @@ class SensitivityResult:
     fields_deg : (F,) curve fields, degrees.
     compensator : str
     lens_name : str
+    g_object_distance : the object plane s' of g_ss' (mm from the first vertex), None when g was
+        not computed (then the ``g`` outputs are NaN).
     """
 
     names: list
@@ -48,6 +50,7 @@ class SensitivityResult:
     fields_deg: np.ndarray
     compensator: str
     lens_name: str
+    g_object_distance: float | None = None
 
     def _value(self, outputs: ToleranceOutputs, output: str, field_deg):
         v = getattr(outputs, output)
@@ -121,13 +124,15 @@ def sensitivity(
     grid_rings=DEFAULT_RINGS,
     grid_azimuths: int = DEFAULT_AZIMUTHS,
     radial_terms: int = 3,
+    g_object_distance=None,
     setup=None,
 ) -> SensitivityResult:
     """Each item of ``spec`` alone at its min and at its max (module docstring). Arguments as
     :func:`distortion.tolerance.monte_carlo`; ``setup`` a :class:`ToleranceSetup` to reuse."""
     st = setup or prepare(lens, spec, fields_deg=fields_deg, object_distance=object_distance,
                           wavelength=wavelength, grid_rings=grid_rings,
-                          grid_azimuths=grid_azimuths, radial_terms=radial_terms)  # fmt: skip
+                          grid_azimuths=grid_azimuths, radial_terms=radial_terms,
+                          g_object_distance=g_object_distance)  # fmt: skip
     vals, _ = one_at_a_time(spec, which)
     nom = evaluate(st, np.zeros((1, spec.n_items)), parallel=False)
     out = evaluate(st, vals, parallel=False)
@@ -143,4 +148,5 @@ def sensitivity(
         fields_deg=st.fields_deg,
         compensator=spec.compensator.type,
         lens_name=lens.name,
+        g_object_distance=None if st.g is None else st.g.object_distance,
     )

@@ -170,6 +170,8 @@ def cmd_tolerance(args) -> int:
                 f"field {top:g} deg; give a field inside it"
             )
     kw = {} if fields is None else {"fields_deg": fields}
+    if args.g_object_distance is not None:
+        kw["g_object_distance"] = _g_distance(args.g_object_distance)
     run_mc = not args.sensitivity or args.samples is not None
     if run_mc:
         _run_size(args, spec)
@@ -212,6 +214,16 @@ def cmd_tolerance(args) -> int:
     return 0
 
 
+def _g_distance(text: str):
+    """--g-object-distance as the API takes it: a number is mm, ``inf``, a length with a unit
+    (``2m``) or an image scale (``10x``) stay text (resolved against the lens by the API)."""
+    t = text.strip()
+    try:
+        return float(t) if t.lower() not in ("inf", "infinity") else t
+    except ValueError:
+        return t
+
+
 def _executor(text: str | None):
     """--dask → the API's executor: ``local`` alone is a LocalCluster of one worker per CPU
     (the API's ``"local"`` means this process)."""
@@ -252,6 +264,8 @@ def _monte_carlo(args, lens, spec, kw, limits):
             overwrite=args.force,
             executor=_executor(args.dask),
             progress=prog,
+            limits=limits,
+            summary=args.summary,
             **kw,
         )
     except KeyboardInterrupt:
@@ -280,7 +294,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "run of --samples perturbed lenses (instance i is the same lens whatever the "
             "chunking or workers): percentile envelopes of the distortion curve along +y, "
             "spreads of F0, Fc, principal point and P1/P2 — raw, and after removing what a "
-            "calibration absorbs — and the yield against --limit. With -o DIR the chunks and a "
+            "calibration absorbs — Fraser & Shortis's g_ss' with --g-object-distance, and the "
+            "yield against --limit. With -o DIR the chunks and a "
             "manifest are written as they finish: Ctrl-C (exit status 130) keeps them and the "
             "same command resumes. Progress: a bar on a terminal, plain lines otherwise."
         ),
@@ -336,6 +351,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "from 0 to the lens's field).",
     )
     q.add_argument(
+        "--g-object-distance",
+        metavar="D",
+        help="Also compute Fraser & Shortis's variation factor g_ss' of every lens (Eq. 6): the "
+        "lens focused at its object distance s by the compensator, the object plane s' at D "
+        "(mm from the object plane to the first vertex; or 2m, inf, or an image scale such as "
+        "10x). Its spread, histogram and sensitivity are reported. Default: the spec's "
+        "[outputs] g_object_distance, else g is not computed.",
+    )
+    q.add_argument(
         "--compensator",
         choices=COMPENSATORS,
         help="Override the spec's compensator (paraxial-refocus, best-focus, fixed-sensor).",
@@ -351,6 +375,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--plot",
         metavar="FILE",
         help="Draw the envelope, histograms and sensitivity bars (.png, .svg, .pdf).",
+    )
+    q.add_argument(
+        "--summary",
+        choices=("auto", "exact", "streaming"),
+        default="auto",
+        help="How the statistics are taken: exact (every lens gathered in memory), streaming "
+        "(chunk by chunk, for very large runs: percentiles from 4096-bin histograms, within one "
+        "bin width), or auto (exact up to 100,000 lenses; default).",
     )
     q.add_argument("--json", action="store_true", help="Print JSON (keys carry units).")
     q.add_argument("--quiet", action="store_true", help="No progress display.")

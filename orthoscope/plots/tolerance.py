@@ -53,14 +53,21 @@ def plot_envelope(mc, *, calibrated: bool = False, limits=(), ax=None, title=Non
     return fig
 
 
-def plot_histogram(values, *, label: str, nominal: float | None = None, ax=None, title=None):
-    """Histogram of one per-lens output (``values``: finite entries are counted), with the
-    nominal value marked. Returns the Figure."""
+def plot_histogram(values=None, *, label: str, nominal: float | None = None, hist=None, ax=None,
+                   title=None):  # fmt: skip
+    """Histogram of one per-lens output, with the nominal value marked: ``values`` (finite
+    entries are counted) or ``hist`` = (counts, edges) already binned (a streamed Monte Carlo
+    summary, :meth:`MonteCarloResult.histogram`). Returns the Figure."""
     fig, ax = figure_and_axes(ax)
-    v = np.asarray(values, dtype=float)
-    v = v[np.isfinite(v)]
-    if v.size:
-        ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color="C0", alpha=0.75)
+    if hist is not None:
+        counts, edges = (np.asarray(a) for a in hist)
+        if counts.size:
+            ax.stairs(counts, edges, fill=True, color="C0", alpha=0.75)
+    else:
+        v = np.asarray(values, dtype=float)
+        v = v[np.isfinite(v)]
+        if v.size:
+            ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color="C0", alpha=0.75)
     if nominal is not None and np.isfinite(nominal):
         ax.axvline(nominal, color="k", ls="--", lw=1.0, label="nominal")
         ax.legend(fontsize=8, frameon=False)
@@ -91,25 +98,31 @@ def plot_sensitivity(rows, *, label: str, top: int = 15, ax=None, title=None):
     return fig
 
 
+#: the histogram panels of a run: (output, label, factor from the output's unit)
+HISTOGRAMS = (
+    ("P1", "P1 (1e-6 / mm)", 1e6),
+    ("P2", "P2 (1e-6 / mm)", 1e6),
+    ("P1_raw", "P1 raw (1e-6 / mm)", 1e6),
+    ("P2_raw", "P2 raw (1e-6 / mm)", 1e6),
+    ("c", "calibrated camera constant Fc (mm)", 1.0),
+    ("k0", "F0 of the refocused plane (mm)", 1.0),
+    ("g", "variation factor g_ss' (Fraser & Shortis)", 1.0),
+)
+
+
 def _hist_panels(mc):
-    """(values, label, nominal) of the histograms of a run: P1, P2 (calibrated and raw), Fc, g."""
-    o, n = mc.outputs, mc.nominal
-    scale = 1e6  # P in 1e-6 / mm
+    """((counts, edges), label, nominal) of the histograms of a run — P1, P2 (calibrated and
+    raw), Fc, F0, g — for the outputs the run has values of (from the run's own histograms, so
+    a streamed run draws them too)."""
     out = []
-    for key, lab in (("P1", "P1"), ("P2", "P2"), ("P1_raw", "P1 raw"), ("P2_raw", "P2 raw")):
-        v = getattr(o, key, None)
-        if v is not None and np.any(np.isfinite(v)):
-            out.append((np.asarray(v) * scale, f"{lab} (1e-6 / mm)",
-                        float(np.asarray(getattr(n, key)).reshape(-1)[0]) * scale))  # fmt: skip
-    c = getattr(o, "c", None)
-    if c is not None and np.any(np.isfinite(c)):
-        out.append((np.asarray(c), "calibrated camera constant Fc (mm)",
-                    float(np.asarray(n.c).reshape(-1)[0])))  # fmt: skip
-    out.append((np.asarray(o.k0), "F0 of the refocused plane (mm)",
-                float(np.asarray(n.k0).reshape(-1)[0])))  # fmt: skip
-    g = getattr(o, "g", None)
-    if g is not None and np.any(np.isfinite(g)):
-        out.append((np.asarray(g), "variation factor g", float(np.asarray(n.g).reshape(-1)[0])))
+    for key, lab, fac in HISTOGRAMS:
+        if key == "g" and key not in mc.stats:
+            continue
+        counts, edges = mc.histogram(key)
+        if counts.size == 0 or counts.sum() == 0:
+            continue
+        nom = float(np.asarray(getattr(mc.nominal, key)).reshape(-1)[0]) * fac
+        out.append(((counts, np.asarray(edges) * fac), lab, nom))
     return out
 
 
@@ -137,8 +150,8 @@ def plot_tolerance(mc=None, sens=None, *, limits=()):
             plot_sensitivity(sens.table("D_cal_um", fmax), label=f"ΔD_c at {fmax:g}° (µm)",
                              ax=ax)  # fmt: skip
         else:
-            v, lab, nom = p[1]
-            plot_histogram(v, label=lab, nominal=nom, ax=ax)
+            h, lab, nom = p[1]
+            plot_histogram(hist=h, label=lab, nominal=nom, ax=ax)
     for ax in axs[len(panels) :]:
         ax.remove()
     return fig

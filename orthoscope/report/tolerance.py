@@ -35,7 +35,10 @@ SENS_COLUMNS = (
     ("P1", False, "ΔP1 e-6/mm", 1e6),
     ("P2", False, "ΔP2 e-6/mm", 1e6),
 )
-#: the outputs of the sensitivity JSON besides the curves at the largest field
+#: the column of g_ss' (when the run computed it)
+G_COLUMN = ("g", False, "Δg", 1.0)
+#: the outputs of the sensitivity JSON besides the curves at the largest field (and g when the
+#: run computed it)
 SENS_SCALARS = ("efl", "k0", "focus_shift", "c", "x0", "y0", "P1", "P2", "P1_raw", "P2_raw")
 MAX_TEXT_FIELDS = 11
 
@@ -74,6 +77,8 @@ def sensitivity_to_dict(sens) -> dict:
     changes (the predicted Monte Carlo standard deviation)."""
     fmax = float(np.max(sens.fields_deg))
     keys = [("D_cal_um", fmax), ("D_um", fmax)] + [(k, None) for k in SENS_SCALARS]
+    if _has_g(sens):
+        keys.append(("g", None))
     outputs = {}
     for name, field in keys:
         label = name if field is None else f"{name}@{fmax:g}deg"
@@ -94,13 +99,23 @@ def sensitivity_to_dict(sens) -> dict:
                 for r in sens.table(name, field)
             ],
         }
-    return {
+    out = {
         "lens": sens.lens_name,
         "compensator": sens.compensator,
         "fields_deg": np.asarray(sens.fields_deg).tolist(),
         "ranked_by": f"D_cal_um@{fmax:g}deg",
         "outputs": outputs,
     }
+    if _has_g(sens):
+        od = float(sens.g_object_distance)
+        out["g_object_distance_mm"] = od if math.isfinite(od) else "inf"
+        out["nominal_g"] = _f(np.asarray(sens.nominal.g).reshape(-1)[0])
+    return out
+
+
+def _has_g(sens) -> bool:
+    """Whether a SensitivityResult computed g_ss' (``g_object_distance`` set)."""
+    return getattr(sens, "g_object_distance", None) is not None
 
 
 def format_sensitivity(sens) -> str:
@@ -112,15 +127,23 @@ def format_sensitivity(sens) -> str:
     rows = sens.table(key, fmax)
     cols = [
         (name, fmax if at_field else None, lab.format(f=f"{fmax:g}"), fac)
-        for name, at_field, lab, fac in SENS_COLUMNS
+        for name, at_field, lab, fac in SENS_COLUMNS + ((G_COLUMN,) if _has_g(sens) else ())
     ]
     worst = {
         name: {r["name"]: _worst(r) for r in sens.table(name, field)} for name, field, _, _ in cols
     }
     nw = max([len("item")] + [len(r["name"]) for r in rows])
+    gnote = ""
+    if _has_g(sens):
+        od = float(sens.g_object_distance)
+        gnote = (
+            f"; Δg: Fraser & Shortis's g_ss' for the object plane at "
+            f"{'infinity' if not math.isfinite(od) else f'{od:g} mm'} (nominal "
+            f"{float(np.asarray(sens.nominal.g).reshape(-1)[0]):.4f})"
+        )
     lines = [
         f"Sensitivity of {sens.lens_name}: each tolerance alone at its min and max, compensator "
-        f"{sens.compensator}; ranked by the calibrated distortion D_c at {fmax:g}°",
+        f"{sens.compensator}; ranked by the calibrated distortion D_c at {fmax:g}°{gnote}",
         f"{'item':<{nw}} {'min':>9} {'max':>9} "
         + " ".join(f"{lab:>13}" for _, _, lab, _ in cols)
         + f" {'share':>7}",
@@ -183,14 +206,13 @@ def _text_fields(f: np.ndarray) -> np.ndarray:
 def format_monte_carlo(mc, limits=(), lens_name: str = "") -> str:
     """The Monte Carlo summary as text: the run, the envelope of D along +y (raw and
     calibrated), the spreads of the per-lens outputs and the yields."""
-    o = mc.outputs
-    ok = np.asarray(o.ok, dtype=bool)
     lines = [
         f"Monte Carlo of {lens_name or 'the lens'}: {mc.n} lenses "
-        f"({int(ok.sum())} traced in full), seed {mc.seed}, compensator {mc.compensator}, "
+        f"({mc.n_ok} traced in full), seed {mc.seed}, compensator {mc.compensator}, "
         f"chunks of {mc.chunk_size}" + (f" ({mc.resumed_chunks} resumed)" if mc.resumed_chunks
                                          else "") + f", {mc.elapsed_s:.2f} s",
         f"generator: {mc.generator}",
+        _summary_note(mc),
         "",
     ]  # fmt: skip
     f = np.asarray(mc.fields_deg, dtype=float)
@@ -224,11 +246,50 @@ def format_monte_carlo(mc, limits=(), lens_name: str = "") -> str:
             f"{vals[3]:>12.6g}"
         )
     if "g" not in mc.stats:
-        lines.append("variation factor g: not computed by this run")
+        lines.append(
+            "variation factor g: not computed by this run (--g-object-distance, or [outputs] "
+            "g_object_distance in the spec)"
+        )
+    else:
+        lines += _g_lines(mc)
     if limits:
         lines.append("")
         lines += [y["text"] for y in yields(mc, limits)]
     return "\n".join(lines)
+
+
+def _g_lines(mc) -> list[str]:
+    """g_ss': its object plane, how many lenses determine it, and percentiles over them."""
+    od = float(mc.g_object_distance)
+    where = "infinity" if not math.isfinite(od) else f"{od:g} mm from the first vertex"
+    st = mc.stats["g"]
+    n = int(st.get("n", 0))
+    out = [
+        "",
+        f"variation factor g_ss' (Fraser & Shortis Eq. 6): lens focused at its object distance "
+        f"by the compensator, object plane s' at {where}; determined for {n} of {mc.n_ok} lenses",
+    ]
+    if n:
+        lev = (0.5, 2.5, 16.0, 50.0, 84.0, 97.5, 99.5)
+        q = mc.percentile_values("g", lev)
+        out.append("  " + "  ".join(f"p{p:g} {v:.4f}" for p, v in zip(lev, q, strict=True)))
+        counts, edges = mc.histogram("g", 12)
+        out.append(
+            f"  histogram {edges[0]:.4f}..{edges[-1]:.4f} in {counts.size} bins: "
+            + " ".join(str(int(c)) for c in counts)
+        )
+    return out
+
+
+def _summary_note(mc) -> str:
+    """How the statistics were taken (exact, or streamed with histogram percentiles)."""
+    if getattr(mc, "summary_method", "exact") != "streaming":
+        return "statistics: exact, over all lenses gathered in memory"
+    ss = mc.streamed
+    return (
+        f"statistics: streamed chunk by chunk (blocks of {ss.block} lenses merged in order; "
+        f"percentiles from {ss.bins}-bin histograms, within one bin width)"
+    )
 
 
 __all__ = [

@@ -19,9 +19,10 @@ Geometry (the conventions of :mod:`raytrace.frames`: frames ``(R, o)``, moves co
 * the surface frame of surface j is ``S_j = E_j ∘ T(zv_j) ∘ own_j`` (``E_j`` the composed moves
   of the elements containing j, identity for none); its axis frame ``S_j ∘ T(−zv_j)``.
 
-Shape: TRAD ``R' = R + ΔR``; TCUR ``c' = c + Δc``; TFRN: the sphere through the same rim point
-with the sag at the semi-diameter h changed by ``N λ_test / 2``: with ``z = c h²/(1 +
-√(1 − c² h²))``, ``c' = 2 z'/(z'² + h²)``, ``z' = z + N λ/2``; TCON ``k + Δk``; TASP adds to
+Shape: TRAD ``R' = R + ΔR``; TCUR ``c' = c + Δc``; TFRN: the sphere through the vertex whose
+sag at the semi-diameter h is changed by ``N λ_test / 2`` (one fringe of a double-pass test
+plate is λ/2 of sag): with ``z = c h²/(1 + √(1 − c² h²))``, ``c' = 2 z'/(z'² + h²)``,
+``z' = z + N λ/2`` (to first order Δc = N λ / h²); TCON ``k + Δk``; TASP adds to
 the coefficient of r^term; TIRR adds the irregularity ``Zs ρ⁴ + Za ρ_y²`` (ρ = r/sd, ρ_y =
 y/sd) with ``Zs = Za = N λ_test / 4`` (half spherical, half astigmatism; Δsag N λ/2 in all — our
 reading of OpticStudio's TIRR, not checked against OpticStudio).

@@ -85,6 +85,9 @@ ITEM_KEYS = ("type", "surface", "surfaces", "adjust", "min", "max", "limit", "di
              "sigma", "term", "pivot", "label")  # fmt: skip
 COMPENSATOR_KEYS = ("type", "rings")
 MC_KEYS = ("samples", "seed", "chunk")
+#: the ``[outputs]`` keys (read by :mod:`distortion.tolerance`): the object plane s' of
+#: Fraser & Shortis's g_ss' (mm, a length such as "2m", "inf", or an image scale "10x")
+OUTPUT_KEYS = ("g_object_distance",)
 
 
 class ToleranceSpecError(OrthoscopeError):
@@ -198,7 +201,8 @@ class ToleranceSpec:
     lens : str
         The lens the spec is for (bundled name or path), ``""`` when not stated.
     outputs : dict
-        The ``[outputs]`` table as written (read by :mod:`distortion.tolerance`).
+        The ``[outputs]`` table as written (keys :data:`OUTPUT_KEYS`, read and checked against
+        the lens by :mod:`distortion.tolerance`).
     monte_carlo : dict
         ``samples``, ``seed``, ``chunk`` defaults of a Monte Carlo run.
     path : str or None
@@ -449,6 +453,7 @@ def spec_from_dict(d: dict, *, path: str | None = None) -> ToleranceSpec:
     outputs = d.get("outputs", {})
     if not isinstance(outputs, dict):
         raise ToleranceSpecError(f"{where}: [outputs] must be a table")
+    _keys(outputs, OUTPUT_KEYS, f"{where}: [outputs]")
     mc = _monte_carlo(d.get("monte_carlo", {}), f"{where}: [monte_carlo]")
     return ToleranceSpec(items, comp, float(wl), d.get("name", ""), d.get("notes", ""),
                          d.get("lens", ""), dict(outputs), mc, path)  # fmt: skip
@@ -486,7 +491,7 @@ def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
           { type = "TETX", surfaces = [1, 2], limit = 0.02, pivot = 0.0 },
           { type = "TIND", surface = 1, min = -0.0005, max = 0.0005, distribution = "uniform" },
         ]
-        [outputs]                        # read by distortion.tolerance (fields, limits, ...)
+        [outputs]                        # optional: g_object_distance = "10x" (g_ss' per lens)
         [monte_carlo]
         samples = 1000
         seed = 1
