@@ -771,12 +771,19 @@ def check_file_lens(lens: Lens) -> None:
     thickness): glass of zero or negative centre thickness. Raises :class:`LensError` naming the
     surface."""
     direction = 1.0
-    for i, s in enumerate(lens.surfaces[:-1], start=1):
+    surfs = lens.surfaces
+    for i, s in enumerate(surfs[:-1], start=1):
         if s.mirror:
             direction = -direction  # after a mirror the thicknesses are negative (Zemax, CODE V)
         if s.coordinate_break:
             continue
-        if s.thickness * direction <= 0.0 and not s.material.is_air:
+        # the glass runs on through the coordinate breaks that follow (a fold mirror inside a
+        # prism: thickness 0 on the mirror, the path on the break after it)
+        t, k = s.thickness, i
+        while k < len(surfs) - 1 and surfs[k].coordinate_break:
+            t += surfs[k].thickness
+            k += 1
+        if t * direction <= 0.0 and not s.material.is_air:
             sign = "positive" if direction > 0 else "negative (after an odd number of mirrors)"
             raise LensError(
                 f"{lens.name}: surface {i}: the glass after it has thickness {s.thickness:g} mm; "

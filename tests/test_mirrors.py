@@ -180,3 +180,31 @@ def test_paraxial_refuses_a_lens_that_is_not_centred_in_one_line():
     q = paraxial(_singlet(False))
     assert p.efl == pytest.approx(q.efl, rel=1e-14)
     assert p.gaussian_image_distance == pytest.approx(-q.gaussian_image_distance, rel=1e-12)
+
+
+def test_fold_mirror_inside_a_prism_reads_and_traces_like_optiland():
+    # zospy's "Prism using total internal reflection.zmx" (tests/data/corpus/SOURCES.md): a
+    # right-angle prism whose hypotenuse is a MIRROR in BK7 with thickness 0, the glass path
+    # (-50 mm) carried by the coordinate break after it — Zemax's fold pattern inside glass.
+    # The glass runs on through the break, so the file reads; real rays at the image against
+    # optiland 0.6.3's reading of the same file (global image frame: y' = global z − 182)
+    pytest.importorskip("optiland")
+    from optiland.fileio import load_zemax_file
+
+    from raytrace.packing import pack
+
+    path = CORPUS / "zospy" / "Prism using total internal reflection.zmx"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lens = read_lens_file(path)
+        op = load_zemax_file(str(path))
+    pupil = np.array([(0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.3, -0.4), (-0.7, 0.2)])
+    epd = lens.aperture.value
+    o = np.column_stack([pupil * epd / 2, np.zeros(len(pupil))])
+    d = np.tile([0.0, 0.0, 1.0], (len(pupil), 1))
+    x, y = trace_rays(lens, o, d).at_plane(pack(lens).z_image)
+    for i, (px, py) in enumerate(pupil):
+        r = op.trace_generic(0.0, 0.0, px, py, lens.wavelength / 1000.0)
+        assert abs(x[i] - float(np.ravel(r.x)[0])) <= 1e-9
+        assert abs(y[i] - (float(np.ravel(r.z)[0]) - 182.0)) <= 1e-9
+        assert abs(float(np.ravel(r.y)[0]) - 100.0) <= 1e-9  # the folded image plane, y = 100
