@@ -14,9 +14,13 @@ Measured per revision:
 * bulk throughput: 1e6 random rays through the Cooke triplet (``cooke-triplet-f4``), 1 and 2
   threads, best of 5 calls inside the process, in M ray-surfaces/s (6 refracting surfaces);
 * the 50-field chief-ray curve (Cooke, 0–20°): median of 300 calls, ms;
-* CLI wall time, warm: ``distortion topogon-like-pestrecov`` and ``paraxial cooke-triplet-f4``
-  (the console entry of each revision: ``python -m distortion.cli`` before the reorganisation,
-  ``python -m orthoscope`` after), with byte-compiled sources.
+* CLI wall time and CPU time (user + system of the child, ``os.wait4``: a busy machine inflates
+  it far less than the wall time), warm: ``distortion topogon-like-pestrecov``, ``paraxial
+  cooke-triplet-f4`` and ``paraxial`` of a .zmx with catalog glasses
+  (tests/data/corpus/optiland/lens_thorlabs_iso_8859_1.zmx of this checkout; ``nan`` for a
+  revision that cannot read it) (the console entry of each revision: ``python -m
+  distortion.cli`` before the reorganisation, ``python -m orthoscope`` after), with
+  byte-compiled sources. ``benchmarks/startup.py`` measures the start-up of this checkout alone.
 
 Prints a table with the ratio B/A and writes benchmarks/results/ab.json.
 """
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -130,17 +135,29 @@ def _run_child(tree: Path, tmp: Path) -> dict:
     return json.loads(r.stdout.split("RESULT", 1)[1])
 
 
-def _cli(tree: Path, tmp: Path, args: list[str]) -> float:
+def _cli(tree: Path, tmp: Path, args: list[str], must: bool = True) -> tuple[float, float]:
+    """(wall s, CPU s of the child) of one warm CLI run; (nan, nan) for a failed run when not
+    ``must``."""
     env = _env(tree, tmp)
     mod = "orthoscope" if _is_new(tree) else "distortion.cli"
     t0 = time.perf_counter()
-    r = subprocess.run(
-        [sys.executable, "-S", "-m", mod, *args], env=env, capture_output=True, text=True, cwd=tmp
+    p = subprocess.Popen(
+        [sys.executable, "-S", "-m", mod, *args],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        cwd=tmp,
     )
+    err = p.stderr.read()
+    _, status, usage = os.wait4(p.pid, 0)
     dt = time.perf_counter() - t0
-    if r.returncode:
-        raise RuntimeError(r.stderr[-2000:])
-    return dt
+    p.stderr.close()
+    p.returncode = os.waitstatus_to_exitcode(status)
+    if p.returncode:
+        if must:
+            raise RuntimeError(err[-2000:].decode(errors="replace"))
+        return math.nan, math.nan
+    return dt, usage.ru_utime + usage.ru_stime
 
 
 def main() -> None:
@@ -160,21 +177,25 @@ def main() -> None:
                 ]
                 subprocess.run([sys.executable, "-m", "compileall", "-q", *pkgs], check=False)
                 _run_child(t, tmp)
-            cli_cmds = {
-                "cli_distortion_s": ["distortion", "topogon-like-pestrecov"],
-                "cli_paraxial_s": ["paraxial", "cooke-triplet-f4"],
+            zmx = ROOT / "tests/data/corpus/optiland/lens_thorlabs_iso_8859_1.zmx"
+            cli_cmds = {  # key: (arguments, must succeed)
+                "cli_distortion": (["distortion", "topogon-like-pestrecov"], True),
+                "cli_paraxial": (["paraxial", "cooke-triplet-f4"], True),
+                "cli_paraxial_zmx": (["paraxial", str(zmx)], False),
             }
             for t in trees.values():
-                for c in cli_cmds.values():
-                    _cli(t, tmp, c)
+                for c, must in cli_cmds.values():
+                    _cli(t, tmp, c, must)
             rows: dict[str, dict[str, list[float]]] = {"A": {}, "B": {}}
             load0 = os.getloadavg()
             for _ in range(args.rounds):
                 for key, t in trees.items():
                     for k, v in _run_child(t, tmp).items():
                         rows[key].setdefault(k, []).append(v)
-                    for k, c in cli_cmds.items():
-                        rows[key].setdefault(k, []).append(_cli(t, tmp, c))
+                    for k, (c, must) in cli_cmds.items():
+                        wall, cpu = _cli(t, tmp, c, must)
+                        rows[key].setdefault(f"{k}_s", []).append(wall)
+                        rows[key].setdefault(f"{k}_cpu_s", []).append(cpu)
             load1 = os.getloadavg()
         finally:
             subprocess.run(

@@ -117,3 +117,18 @@ def test_tolerance_benchmark_toy_size(tmp_path, capsys):
     assert res["orthoscope"]["ok_fraction"] == 1.0
     assert res["orthoscope"]["instances_per_s_per_core"] > 0
     assert "instances/s/core" in capsys.readouterr().out
+
+
+def test_startup_benchmark_one_round(tmp_path):
+    """benchmarks/startup.py at one round on the paraxial command: wall and CPU time measured,
+    the warm-up ran, the probe saw no kernels and no numba; the summary prints the target."""
+    spec = importlib.util.spec_from_file_location("bench_startup", BENCH / "startup.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    cmd = [("paraxial", ["paraxial", "cooke-triplet-f4"], 0.35)]
+    res = mod.measure(1, commands=cmd, breakdown=False, log=lambda m: None)
+    r = res["commands"]["paraxial"]
+    assert r["rc"] == 0 and not r["notice_after_warm_up"]
+    assert 0 < r["cpu_median_s"] and 0 < r["wall_median_s"]
+    assert r["loaded"]["kernels"] == {} and not r["loaded"]["imported"]["numba"]
+    assert "<= 0.35" in "\n".join(mod.summarize(res))

@@ -26,9 +26,11 @@ Sources
 
 Every spreadsheet column is located by its header label and checked, so a changed file fails
 loudly instead of shifting columns. Output: one zip archive of JSON members (``index.json``
-with names, nd, vd and status of every material; one member per catalog with the full records;
-``sources.json`` with file, package, version, sha256 and catalog date of every source). The
-archive is deterministic: same inputs and ``--date`` give byte-identical output.
+with names, nd, vd and status of every material; one JSON-lines member per catalog,
+``CATALOG.jsonl``, with the full records, one material a line in index order, so that a reader
+parses only the glasses it needs; ``meta.json`` with file, package, version, sha256 and catalog
+date of every source). The archive is deterministic: same inputs and ``--date`` give
+byte-identical output.
 
 Usage::
 
@@ -55,7 +57,7 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "raytrace" / "glass" / "data" / "catalogs.zip"
-FORMAT = 1
+FORMAT = 2  # 1: one JSON array per catalog (CATALOG.json); 2: JSON lines (CATALOG.jsonl)
 
 # Spectral lines (nm, in air) by the labels the vendors print. Schott TIE-29 / the
 # Hikari and Hoya sheets give the same values; A' and He-Cd from the Ohara / Hikari sheets.
@@ -1175,7 +1177,7 @@ def build(date: str) -> dict[str, bytes]:
 
     members = {"meta.json": dump(meta), "index.json": dump(index)}
     for cat, recs in catalogs.items():
-        members[f"{cat}.json"] = dump(recs)
+        members[f"{cat}.jsonl"] = b"".join(dump(r) + b"\n" for r in recs)
     return members
 
 

@@ -54,6 +54,15 @@ def _version() -> str:
     return __version__
 
 
+class _VersionAction(argparse._VersionAction):
+    """``--version``: the version is read when asked for (importlib.metadata costs about 20 ms
+    of every run otherwise)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        self.version = f"orthoscope {_version()}"
+        super().__call__(parser, namespace, values, option_string)
+
+
 class HelpFormatter(argparse.HelpFormatter):
     """Help with the defaults shown (where there is one) and text with line breaks (the examples
     of an epilog) kept as written; other paragraphs are wrapped."""
@@ -108,7 +117,28 @@ def signed_values(argv: Sequence[str]) -> list[str]:
     return out
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_of(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` runs, when that is plain without parsing: the first word after
+    the global options ``--allow-large`` and ``--threads N``, and one of :data:`COMMANDS`.
+    None otherwise (any other option first, such as ``--help``, or no such word)."""
+    i = 0
+    while i < len(argv):
+        tok = argv[i]
+        if tok == "--threads":
+            i += 2
+        elif tok == "--allow-large" or tok.startswith("--threads="):
+            i += 1
+        elif tok.startswith("-"):
+            return None
+        else:
+            return tok if tok in COMMANDS else None
+    return None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The command-line parser. With ``command`` (a name of :data:`COMMANDS`, see
+    :func:`command_of`) only that command's module is imported and registered: parsing that
+    command is the same, and the other modules' imports are saved."""
     p = Parser(
         prog="orthoscope",
         description=(
@@ -120,7 +150,7 @@ def build_parser() -> argparse.ArgumentParser:
         ),
         epilog="Run 'orthoscope COMMAND --help' for each command's options.",
     )
-    p.add_argument("--version", action="version", version=f"orthoscope {_version()}")
+    p.add_argument("--version", action=_VersionAction)
     p.add_argument(
         "--allow-large",
         action="store_true",
@@ -135,8 +165,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
-    for name in COMMANDS:
+    names = COMMANDS if command is None else (command,)
+    for name in names:
         importlib.import_module(f"{__name__}.{name}").register(sub)
+    if command is not None and command not in sub.choices:  # a module of another name
+        for name in COMMANDS:
+            if name != command:
+                importlib.import_module(f"{__name__}.{name}").register(sub)
     return p
 
 
@@ -159,15 +194,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"orthoscope: error: {bad}", file=sys.stderr)
         return EXIT_USAGE
     try:
-        parser = build_parser()
+        words = signed_values(sys.argv[1:] if argv is None else list(argv))
+        parser = build_parser(command_of(words))
         try:
-            args = parser.parse_args(signed_values(sys.argv[1:] if argv is None else list(argv)))
+            args = parser.parse_args(words)
         except SystemExit as e:  # --help, --version, or a usage error already printed
             return e.code if isinstance(e.code, int) else EXIT_USAGE
         command = f"orthoscope {args.command}"
         if args.threads is not None:
             _set_threads(args.threads)
         if args.command not in NO_KERNELS:
+            _numba_without_blas_probe()
             _compile_notice()
         return int(args.func(args) or 0)
     except KeyboardInterrupt:
@@ -255,42 +292,71 @@ def _silence_stdout() -> None:
         pass
 
 
-def _numba_without_blas_probe() -> None:
-    """Import numba's numpy support without its BLAS probe.
+class _NoBlasProbe:
+    """Import hook (``sys.meta_path``) that runs ``numba.np.arraymath``'s module code with
+    ``scipy.linalg.cython_blas`` absent, whenever numba imports it (before a compilation, or
+    for a cached kernel that refers to it)."""
 
-    numba checks at import whether SciPy's BLAS is available (for ``np.dot`` in jitted code) by
-    importing ``scipy.linalg.cython_blas`` — a quarter of a second on every run. The kernels of
-    this project use no BLAS, and the command line compiles no other code, so the probe is
-    answered "absent" for numba alone; SciPy itself imports normally afterwards.
+    def find_spec(self, name, path=None, target=None):
+        if name != "numba.np.arraymath":
+            return None
+        from importlib.machinery import PathFinder
+
+        spec = PathFinder.find_spec(name, path)
+        loader = getattr(spec, "loader", None)
+        if loader is None or not hasattr(loader, "exec_module"):
+            return None  # not a plain source module: the usual import
+        run = loader.exec_module
+
+        def exec_module(module) -> None:
+            key = "scipy.linalg.cython_blas"
+            had = key in sys.modules
+            if not had:
+                sys.modules[key] = None  # type: ignore[assignment]
+            try:
+                run(module)
+            finally:
+                if not had:
+                    sys.modules.pop(key, None)
+
+        loader.exec_module = exec_module
+        return spec
+
+
+def _numba_without_blas_probe() -> None:
+    """Let numba import its numpy support without its BLAS probe.
+
+    numba checks at import of ``numba.np.arraymath`` whether SciPy's BLAS is available (for
+    ``np.dot`` in jitted code) by importing ``scipy.linalg.cython_blas`` — a quarter of a second.
+    The kernels of this project use no BLAS, and the command line compiles no other code, so the
+    probe is answered "absent" for numba alone; SciPy itself imports normally afterwards. The
+    module is imported only when numba needs it (a compilation, or a cached kernel whose
+    environment names it): a warm run of most commands never loads it (``raytrace.kernels.jit``).
     """
-    if "numba.np.arraymath" in sys.modules:
+    if "numba.np.arraymath" in sys.modules or any(
+        isinstance(f, _NoBlasProbe) for f in sys.meta_path
+    ):
         return
-    key = "scipy.linalg.cython_blas"
-    had = key in sys.modules
-    if not had:
-        sys.modules[key] = None  # type: ignore[assignment]
-    try:
-        import numba.np.arraymath  # noqa: F401
-    except Exception:  # noqa: BLE001 - a speed-up only: never fail because of it
-        pass
-    finally:
-        if not had:
-            sys.modules.pop(key, None)
+    sys.meta_path.insert(0, _NoBlasProbe())
 
 
 def _compile_notice() -> None:
     """One line on stderr when the ray-tracing kernels are not in the numba cache yet."""
-    _numba_without_blas_probe()
-    from raytrace.kernels import aim, bulk
+    from raytrace.kernels import aim
     from raytrace.kernels.jit import cache_is_warm
 
     # the first run of any tracing command compiles its kernels; a later command that needs one
     # more kernel compiles only that one (seconds), which is not worth a notice
-    if not any(cache_is_warm(k) for k in (aim.aim_chief, bulk.trace_batch_serial)):
-        print(
-            "orthoscope: compiling the ray-tracing kernels (first run only, about a minute)",
-            file=sys.stderr,
-        )
+    if cache_is_warm(aim.aim_chief):
+        return
+    from raytrace.kernels import bulk
+
+    if cache_is_warm(bulk.trace_batch_serial):
+        return
+    print(
+        "orthoscope: compiling the ray-tracing kernels (first run only, about a minute)",
+        file=sys.stderr,
+    )
 
 
 def _set_threads(n: int) -> None:
