@@ -2,6 +2,7 @@
 
     python benchmarks/ab.py                      # against f4081fc (before the reorganisation)
     python benchmarks/ab.py --ref HEAD~3 --rounds 5
+    python benchmarks/ab.py --also 43d74ce       # + the general geometry, before the backward test
 
 For each revision a git worktree is made in a temporary folder; every measurement runs in a fresh
 Python process with that tree first on ``sys.path``, in the order A B A B ... (``--rounds``
@@ -12,7 +13,8 @@ includes compilation.
 Measured per revision:
 
 * bulk throughput: 1e6 random rays through the Cooke triplet (``cooke-triplet-f4``), 1 and 2
-  threads, best of 5 calls inside the process, in M ray-surfaces/s (6 refracting surfaces);
+  threads, best of 5 calls inside the process, in M ray-surfaces/s (6 refracting surfaces); for
+  one thread also per CPU-second of the process (``bulk_mrs_1t_cpu``: steadier on a busy machine);
 * the 50-field chief-ray curve (Cooke, 0–20°): median of 300 calls, ms;
 * CLI wall time and CPU time (user + system of the child, ``os.wait4``: a busy machine inflates
   it far less than the wall time), warm: ``distortion topogon-like-pestrecov``, ``paraxial
@@ -22,7 +24,7 @@ Measured per revision:
   distortion.cli`` before the reorganisation, ``python -m orthoscope`` after), with
   byte-compiled sources. ``benchmarks/startup.py`` measures the start-up of this checkout alone.
 
-Prints a table with the ratio B/A and writes benchmarks/results/ab.json.
+Prints a table with the ratios B/A (B/A2, ...) and writes benchmarks/results/ab.json.
 """
 
 from __future__ import annotations
@@ -70,11 +72,16 @@ for th in (1, 2):
     if th > numba.config.NUMBA_NUM_THREADS:
         continue
     tr(p, rays, th)
-    best = 1e9
+    best = best_cpu = 1e9
     for _ in range(5):
-        t0 = time.perf_counter(); rb = tr(p, rays, th); rb.at_plane(p.z_image)
+        t0 = time.perf_counter(); c0 = time.process_time()
+        rb = tr(p, rays, th); rb.at_plane(p.z_image)
         best = min(best, time.perf_counter() - t0)
+        if th == 1:
+            best_cpu = min(best_cpu, time.process_time() - c0)
     out[f"bulk_mrs_{{th}}t"] = 6 * n / best / 1e6
+    if th == 1:
+        out["bulk_mrs_1t_cpu"] = 6 * n / best_cpu / 1e6
 f = np.linspace(0.0, 20.0, 50)
 cr(lens, f)
 ts = []
@@ -163,13 +170,21 @@ def _cli(tree: Path, tmp: Path, args: list[str], must: bool = True) -> tuple[flo
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--ref", default="f4081fc", help="the A revision (default: f4081fc)")
+    ap.add_argument(
+        "--also",
+        action="append",
+        default=[],
+        metavar="REV",
+        help="a further revision measured in the same rounds (A2, A3, ...), e.g. an "
+        "intermediate commit that isolates one change",
+    )
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
+    refs = {"A": args.ref, **{f"A{i + 2}": r for i, r in enumerate(args.also)}}
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
-        a = _tree(args.ref, tmp)
-        b = ROOT
-        trees = {"A": a, "B": b}
+        trees = {key: _tree(ref, tmp) for key, ref in refs.items()}
+        trees["B"] = ROOT
         try:
             for t in trees.values():  # compile once, byte-compile the sources: warm caches
                 pkgs = [
@@ -186,7 +201,7 @@ def main() -> None:
             for t in trees.values():
                 for c, must in cli_cmds.values():
                     _cli(t, tmp, c, must)
-            rows: dict[str, dict[str, list[float]]] = {"A": {}, "B": {}}
+            rows: dict[str, dict[str, list[float]]] = {k: {} for k in trees}
             load0 = os.getloadavg()
             for _ in range(args.rounds):
                 for key, t in trees.items():
@@ -198,21 +213,26 @@ def main() -> None:
                         rows[key].setdefault(f"{k}_cpu_s", []).append(cpu)
             load1 = os.getloadavg()
         finally:
-            subprocess.run(
-                ["git", "-C", str(ROOT), "worktree", "remove", "--force", str(a)],
-                capture_output=True,
-            )
+            for key in refs:
+                subprocess.run(
+                    ["git", "-C", str(ROOT), "worktree", "remove", "--force", str(trees[key])],
+                    capture_output=True,
+                )
     med = {k: {m: statistics.median(v) for m, v in r.items()} for k, r in rows.items()}
-    print(f"A = {args.ref}, B = this checkout; {args.rounds} interleaved rounds, medians; ")
+    names = ", ".join(f"{k} = {r}" for k, r in refs.items())
+    print(f"{names}, B = this checkout; {args.rounds} interleaved rounds, medians; ")
     print(f"numba caches warm (each tree run once before); load average {load0} -> {load1}")
-    print(f"{'measurement':24} {'A':>10} {'B':>10} {'B/A':>7}")
+    print(f"{'measurement':24}" + "".join(f"{k:>10}" for k in trees)
+          + "".join(f"{'B/' + k:>8}" for k in refs))  # fmt: skip
     for m in med["A"]:
-        va, vb = med["A"][m], med["B"].get(m, float("nan"))
-        print(f"{m:24} {va:10.4g} {vb:10.4g} {vb / va:7.3f}")
+        vals = [med[k].get(m, float("nan")) for k in trees]
+        vb = vals[-1]
+        print(f"{m:24}" + "".join(f"{v:10.4g}" for v in vals)
+              + "".join(f"{vb / med[k].get(m, float('nan')):8.3f}" for k in refs))  # fmt: skip
     out = HERE / "results"
     out.mkdir(exist_ok=True)
     (out / "ab.json").write_text(
-        json.dumps({"ref": args.ref, "rounds": rows, "median": med, "load": [load0, load1]})
+        json.dumps({"refs": refs, "rounds": rows, "median": med, "load": [load0, load1]})
     )
     print(f"wrote {out / 'ab.json'}")
 

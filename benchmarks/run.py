@@ -27,7 +27,6 @@ import argparse
 import json
 import math
 import os
-import platform
 import resource
 import shutil
 import statistics
@@ -48,6 +47,7 @@ sys.path.insert(0, str(HERE))
 import handwritten_numba as hw  # noqa: E402
 import numpy_tracer as npt  # noqa: E402
 import optiland_adapter as ola  # noqa: E402
+from machine import load, machine_info  # noqa: E402
 
 from raytrace.files.library import load_lens  # noqa: E402
 from raytrace.lens import Lens, Surface  # noqa: E402
@@ -787,26 +787,7 @@ def main(argv=None) -> int:
     ok, ver = (False, "disabled") if args.no_optiland else ola.available()
     if not ok:
         print(f"optiland not available ({ver}): its columns are skipped (pip install '.[bench]')")
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    res = {
-        "machine": {
-            "platform": platform.platform(),
-            "cpu": cpu,
-            "cpus": os.cpu_count(),
-            "numba": numba.__version__,
-            "numpy": np.__version__,
-            "numba_threads": numba.config.NUMBA_NUM_THREADS,
-            "load_start": [round(v, 2) for v in os.getloadavg()],
-            "optiland": ver if ok else None,
-        }
-    }
+    res = {"machine": {**machine_info(), "optiland": ver if ok else None}}
     sizes = [10**3, 10**4, 10**5] if args.quick else [10**k for k in range(3, 8)]
     sizes = [n for n in sizes if n <= args.max_rays]
     log(" bulk")
@@ -817,7 +798,7 @@ def main(argv=None) -> int:
     res["optimizer"] = optimizer(log)
     res["cli"] = cli(args.quick, log)
     res["memory"] = memory(10**5 if args.quick else int(args.max_rays), log)
-    res["machine"]["load_end"] = [round(v, 2) for v in os.getloadavg()]
+    res["machine"]["load_end"] = load()
     res["targets"] = targets(res)
     res["wall_s"] = time.perf_counter() - t_start
     res["peak_rss_mb_suite"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024

@@ -48,7 +48,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import sys
 import time
@@ -385,7 +384,6 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if "numba" not in sys.modules:
         os.environ["NUMBA_NUM_THREADS"] = str(args.threads)
-    import numba
     import numpy as np
 
     if args.quick:
@@ -398,24 +396,11 @@ def main(argv=None) -> int:
     def log(msg):
         print(f"[{time.perf_counter() - t_start:6.1f} s]{msg}", file=sys.stderr, flush=True)
 
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    sys.path.insert(0, str(HERE))
+    from machine import load, machine_info
+
     res: dict = {
-        "machine": {
-            "platform": platform.platform(),
-            "cpu": cpu,
-            "cpus": os.cpu_count(),
-            "numba": numba.__version__,
-            "numpy": np.__version__,
-            "numba_threads": numba.config.NUMBA_NUM_THREADS,
-            "load_start": [round(v, 2) for v in os.getloadavg()],
-        },
+        "machine": machine_info(),
         "workload": (
             f"topogon-like-pestrecov, TEDX/TEDY +/-{DECENTER_MM} mm and TETX/TETY "
             f"+/-{TILT_DEG} deg on elements {', '.join(f'{a}-{b}' for a, b in ELEMENTS)} "
@@ -463,7 +448,7 @@ def main(argv=None) -> int:
             d = dask_run(lens, spec, n, 2, local_s, local_summary, log)
             d["local_s"] = local_s
             res["dask"].append(d)
-    res["machine"]["load_end"] = [round(v, 2) for v in os.getloadavg()]
+    res["machine"]["load_end"] = load()
     res["wall_s"] = time.perf_counter() - t_start
     print("\n".join(summarize(res)))
     res["orthoscope"].pop("summary", None)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support import CAMERA_H, CAMERA_W, australis_camera, metashape_camera
 
 from distortion.camera import (
     OPENCV_ORDERS,
@@ -25,7 +26,7 @@ from distortion.camera import (
 from distortion.errors import DataError
 from raytrace.errors import OutputError
 
-W, H = 3001, 1999
+W, H = CAMERA_W, CAMERA_H
 
 
 def _opencv(n=14):
@@ -180,24 +181,7 @@ def test_pycolmap_written_cameras_txt_reads_back(tmp_path):
 
 
 def test_metashape_xml_current_and_photoscan_legacy(tmp_path):
-    cam = CameraModel.create(
-        "metashape",
-        W,
-        H,
-        f=3200.0,
-        cx=23.4,
-        cy=-11.7,
-        b1=12.0,
-        b2=1.5,
-        k1=-0.08,
-        k2=0.02,
-        k3=-0.003,
-        k4=2e-4,
-        p1=-6e-4,
-        p2=4e-4,
-        p3=0.1,
-        p4=-0.1,
-    )
+    cam = metashape_camera()
     write_calibration(cam, tmp_path / "m.xml")
     assert read_calibration(tmp_path / "m.xml") == cam
     text = format_calibration(cam.replace(p3=0.0, p4=0.0, k4=0.0), "photoscan")
@@ -241,22 +225,7 @@ def test_metashape_calibration_inside_a_chunk_xml(tmp_path):
 
 
 def test_australis_text_round_trip_and_errors(tmp_path):
-    cam = CameraModel.create(
-        "australis",
-        W,
-        H,
-        pixel_size_mm=(0.0078, 0.0079),
-        c=25.0,
-        xp=0.05,
-        yp=-0.04,
-        K1=8e-5,
-        K2=-6e-8,
-        K3=7e-11,
-        P1=1e-5,
-        P2=-2e-5,
-        b1=1e-4,
-        b2=-5e-5,
-    )
+    cam = australis_camera()
     write_calibration(cam, tmp_path / "cam.txt", format="australis")
     assert read_calibration(tmp_path / "cam.txt") == cam  # detected by its 'format' line
     (tmp_path / "bad.aus").write_text("format orthoscope-australis 1\nimage_width 10\nQ1 3\n")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support import CAMERA_H, CAMERA_W, australis_camera, metashape_camera
 
 from distortion.camera import (
     OPENCV_ORDERS,
@@ -25,7 +26,7 @@ from distortion.camera import (
 )
 from distortion.errors import DataError
 
-W, H = 3001, 1999
+W, H = CAMERA_W, CAMERA_H
 
 
 def _cv(**kw):
@@ -91,40 +92,8 @@ TRUTHS = [
     CameraModel.create(
         "colmap:EUCM", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, alpha=0.5, beta=1.1
     ),
-    CameraModel.create(
-        "metashape",
-        W,
-        H,
-        f=3200.0,
-        cx=23.4,
-        cy=-11.7,
-        b1=12.0,
-        b2=1.5,
-        k1=-0.08,
-        k2=0.02,
-        k3=-0.003,
-        k4=2e-4,
-        p1=-6e-4,
-        p2=4e-4,
-        p3=0.1,
-        p4=-0.1,
-    ),
-    CameraModel.create(
-        "australis",
-        W,
-        H,
-        pixel_size_mm=(0.0078, 0.0079),
-        c=25.0,
-        xp=0.05,
-        yp=-0.04,
-        K1=8e-5,
-        K2=-6e-8,
-        K3=7e-11,
-        P1=1e-5,
-        P2=-2e-5,
-        b1=1e-4,
-        b2=-5e-5,
-    ),
+    metashape_camera(),
+    australis_camera(),
 ]
 
 

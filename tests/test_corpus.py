@@ -10,12 +10,11 @@ How many of them read (the baseline fraction and the refusal groups) is measured
 from __future__ import annotations
 
 import re
-import signal
 import warnings
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
+from support import Hang, time_limit
 
 import orthoscope as osc
 from raytrace.errors import PrescriptionError
@@ -32,33 +31,6 @@ FILES = sorted(p for p in CORPUS.rglob("*") if p.is_file() and p.suffix.lower() 
 #: corpus -> the bug. Each is an xfail(strict=True), so a fix makes the test fail until it is
 #: removed from here. Empty: no file crashes the reader today.
 KNOWN_CRASHES: dict[str, str] = {}
-
-
-class _Hang(Exception):
-    pass
-
-
-@contextmanager
-def _time_limit(seconds: float):
-    """Fail a read that takes longer than ``seconds`` (POSIX main thread; no limit otherwise)."""
-    if not hasattr(signal, "setitimer"):
-        yield
-        return
-
-    def handler(signum, frame):
-        raise _Hang
-
-    try:
-        old = signal.signal(signal.SIGALRM, handler)
-    except ValueError:  # not in the main thread
-        yield
-        return
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def _rel(p: Path) -> str:
@@ -85,13 +57,13 @@ def test_corpus_present():
 @pytest.mark.parametrize("path", list(_params()))
 def test_reads_or_refuses_cleanly(path):
     try:
-        with warnings.catch_warnings(), _time_limit(TIME_LIMIT_S):
+        with warnings.catch_warnings(), time_limit(TIME_LIMIT_S):
             warnings.simplefilter("ignore")  # skipped-command warnings are not the subject here
             lens = osc.load_lens(path)
     except PrescriptionError as e:
         assert str(e).strip(), "a refusal must say why"
         return
-    except _Hang:
+    except Hang:
         pytest.fail(f"reading {_rel(path)} took more than {TIME_LIMIT_S:g} s")
     assert isinstance(lens, osc.Lens)
     assert len(lens.surfaces) >= 1

@@ -29,8 +29,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import singlet, singlet_spec
 
-from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index
+from raytrace import AIR, Aperture, Field, Lens, Surface
 from raytrace.files.library import load_lens
 from raytrace.glass import lookup_glass
 from raytrace.optimize import (
@@ -52,27 +53,7 @@ from raytrace.trace import trace_rays
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def singlet(n=1.5, f=100.0, t=0.3, fnum=20.0):
-    c = 1.0 / (2.0 * (n - 1.0) * f)  # equiconvex start
-    return Lens(
-        "singlet",
-        (Surface(c, t, fixed_index(n), stop=True), Surface(-c, f, AIR)),
-        Aperture("fnumber", fnum),
-        Field("angle", 1.0),
-        image_solve=None,
-    )
-
-
-SINGLET_SPEC = DesignSpec(
-    start="(built in test)",
-    variables=(Variable("curvature", 1), Variable("curvature", 2)),
-    operands=(
-        Operand("efl", 100.0, 100.0),
-        Operand("rms_spot", 0.0, 1000.0, {"field": 0.0, "plane": "best"}),
-    ),
-    max_evaluations=400,
-    search=SearchSettings(starts=4, hops=1, perturbation=0.5),
-)
+SINGLET_SPEC = singlet_spec(search=SearchSettings(starts=4, hops=1, perturbation=0.5))
 
 
 # --------------------------------------------------------------------------- small problems

@@ -8,13 +8,12 @@ from __future__ import annotations
 
 import codecs
 import random
-import signal
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import time_limit
 
 from raytrace.errors import PrescriptionError
 from raytrace.files.codev import parse_seq
@@ -72,28 +71,10 @@ VOCAB_SEQ = (
 ).split()
 
 
-class _Hang(BaseException):  # not an Exception: no reader may swallow it
-    pass
-
-
-@contextmanager
-def _time_limit(seconds: float):
-    def handler(signum, frame):
-        raise _Hang(f"reader took more than {seconds} s")
-
-    old = signal.signal(signal.SIGALRM, handler)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-
-
 def _check(reader, data: bytes, path: str) -> str:
     """Run one reader; return "ok" or "error", failing the test on anything else."""
     try:
-        with _time_limit(PER_FILE_LIMIT_S):
+        with time_limit(PER_FILE_LIMIT_S):
             res = reader(data, path=path)
     except PrescriptionError as e:
         assert e.line is not None, f"no line number: {e}"

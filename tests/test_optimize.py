@@ -3,9 +3,9 @@
 from pathlib import Path
 
 import pytest
+from support import singlet, singlet_spec
 
 from orthoscope.cli import main
-from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index
 from raytrace.optimize import (
     DesignSpec,
     Operand,
@@ -19,33 +19,13 @@ from raytrace.optimize import (
 from raytrace.paraxial import paraxial
 
 
-def singlet(n=1.5, f=100.0, t=0.3, fnum=20.0):
-    c = 1.0 / (2.0 * (n - 1.0) * f)  # equiconvex start
-    return Lens(
-        "singlet",
-        (Surface(c, t, fixed_index(n), stop=True), Surface(-c, f, AIR)),
-        Aperture("fnumber", fnum),
-        Field("angle", 1.0),
-        image_solve=None,
-    )
-
-
 def test_singlet_bent_for_minimum_spherical_aberration():
     # Classical third-order result (e.g. Kingslake, Lens Design Fundamentals, ch. 4; Welford,
     # Aberrations of Optical Systems §7.2): a thin singlet with its object at infinity has the least
     # spherical aberration at the Coddington shape factor K = (c1 + c2)/(c1 - c2) = 2(n²-1)/(n+2).
     n = 1.5
     lens = singlet(n)
-    spec = DesignSpec(
-        start="(built in test)",
-        variables=(Variable("curvature", 1), Variable("curvature", 2)),
-        operands=(
-            Operand("efl", 100.0, 100.0),
-            Operand("rms_spot", 0.0, 1000.0, {"field": 0.0, "plane": "best"}),
-        ),
-        max_evaluations=400,
-    )
-    res = optimize(lens, spec)
+    res = optimize(lens, singlet_spec())
     c1, c2 = res.lens.surfaces[0].curvature, res.lens.surfaces[1].curvature
     K = (c1 + c2) / (c1 - c2)
     K_classical = 2 * (n * n - 1) / (n + 2)  # 0.7143 for n = 1.5 (R1/R2 = -1/6)

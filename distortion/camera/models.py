@@ -1355,6 +1355,38 @@ def _centre_point(cam, fn):
     return np.atleast_1d(a), np.atleast_1d(b)
 
 
+def _explicit(camera: CameraModel, a: np.ndarray, b: np.ndarray, invalid=None):
+    """The model's explicit direction at (a, b): (N, 2) points, status OK / INVALID (INVALID
+    where a value is not finite or ``invalid``; those points NaN) and residual (0 / NaN)."""
+    with np.errstate(all="ignore"):
+        u, v, _j = camera.spec.evaluate(camera.as_dict(), a, b, camera)
+    good = np.isfinite(u) & np.isfinite(v)
+    if invalid is not None:
+        good &= ~invalid
+    status = np.where(good, OK, INVALID).astype(np.int8)
+    pts = np.stack([np.where(status == OK, u, np.nan), np.where(status == OK, v, np.nan)], 1)
+    return pts, status, np.where(status == OK, 0.0, np.nan)
+
+
+def _newton(camera: CameraModel, a, b, ga, gb, image_side: str, tol_px: float, max_iter: int):
+    """The direction opposite to the explicit one: :func:`_solve` for target (a, b) from the
+    guess (ga, gb)."""
+    spec = camera.spec
+    p = camera.as_dict()
+    with np.errstate(all="ignore"):
+        return _solve(
+            camera,
+            lambda s, t: spec.evaluate(p, s, t, camera),
+            a,
+            b,
+            np.asarray(ga, float),
+            np.asarray(gb, float),
+            image_side,
+            tol_px,
+            max_iter,
+        )
+
+
 def project(
     camera: CameraModel,
     ideal,
@@ -1387,28 +1419,13 @@ def project(
     p = camera.as_dict()
     x, y, behind = _as_ideal(ideal)
     if spec.explicit == "forward":
-        with np.errstate(all="ignore"):
-            u, v, _j = spec.evaluate(p, x, y, camera)
-        status = np.where(np.isfinite(u) & np.isfinite(v) & ~behind, OK, INVALID).astype(np.int8)
-        pts = np.stack([np.where(status == OK, u, np.nan), np.where(status == OK, v, np.nan)], 1)
-        resid = np.where(status == OK, 0.0, np.nan)
+        pts, status, resid = _explicit(camera, x, y, behind)
         it = 0
     else:
         x = np.where(behind, np.nan, x)
         y = np.where(behind, np.nan, y)
         ga, gb = spec.guess(p, x, y, camera)
-        with np.errstate(all="ignore"):
-            u, v, status, resid, it = _solve(
-                camera,
-                lambda a, b: spec.evaluate(p, a, b, camera),
-                x,
-                y,
-                np.asarray(ga, float),
-                np.asarray(gb, float),
-                "step",
-                tol_px,
-                max_iter,
-            )
+        u, v, status, resid, it = _newton(camera, x, y, ga, gb, "step", tol_px, max_iter)
         pts = np.stack([u, v], 1)
     frame = spec.frame if pixels == "native" else pixels
     return MappedPoints(native_to_frame(camera, pts, pixels), status, resid, frame, it)
@@ -1430,25 +1447,11 @@ def unproject(
     pts = frame_to_native(camera, _as_image(image), pixels)
     a, b = pts[:, 0], pts[:, 1]
     if spec.explicit == "inverse":
-        with np.errstate(all="ignore"):
-            x, y, _j = spec.evaluate(p, a, b, camera)
-        status = np.where(np.isfinite(x) & np.isfinite(y), OK, INVALID).astype(np.int8)
-        resid = np.where(status == OK, 0.0, np.nan)
-        out = np.stack([np.where(status == OK, x, np.nan), np.where(status == OK, y, np.nan)], 1)
+        out, status, resid = _explicit(camera, a, b)
         return MappedPoints(out, status, resid, "ideal", 0)
     with np.errstate(all="ignore"):
         ga, gb = spec.guess(p, a, b, camera)
-        x, y, status, resid, it = _solve(
-            camera,
-            lambda s, t: spec.evaluate(p, s, t, camera),
-            a,
-            b,
-            np.asarray(ga, float),
-            np.asarray(gb, float),
-            "residual",
-            tol_px,
-            max_iter,
-        )
+    x, y, status, resid, it = _newton(camera, a, b, ga, gb, "residual", tol_px, max_iter)
     return MappedPoints(np.stack([x, y], 1), status, resid, "ideal", it)
 
 

@@ -43,7 +43,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from raytrace.errors import OrthoscopeError
 from raytrace.lens import Lens
@@ -62,7 +61,7 @@ from raytrace.units import UnitError, length_mm
 from ..errors import DataError
 from ..variation.analysis import estimate_g
 from ..variation.models import WEAK_THRESHOLD_UM
-from ..variation.traced import DEFAULT_N_R
+from ..variation.traced import DEFAULT_N_R, leading_run, resample_spline
 from .compensators import image_planes, pupil_bundle
 
 #: what g is, in one line (summary JSON, reports)
@@ -181,24 +180,18 @@ def _profile(y: np.ndarray, k0: np.ndarray, tan_a: np.ndarray):
     return r, (r - k0[:, None] * tan_a[None, :]) * 1e3
 
 
-def _leading(r: np.ndarray, d: np.ndarray):
-    ok = np.isfinite(r) & np.isfinite(d)
-    n = int(np.argmin(ok)) if not ok.all() else ok.size
-    return r[:n], d[:n]
-
-
 def g_of_profiles(profiles, n_r: int, threshold_um: float, method: str) -> float:
     """g of one instance from its three profiles ``[(r_s, δr_s), (r_s', δr_s'), (r_ss',
     δr_ss')]`` (module docstring); NaN when a profile has fewer than 4 traced fields, is not
     increasing in r, or g is undetermined."""
-    prof = [_leading(np.asarray(r), np.asarray(d)) for r, d in profiles]
+    prof = [leading_run(np.asarray(r), np.asarray(d)) for r, d in profiles]
     if any(r.size < 4 or not np.all(np.diff(r) > 0) for r, _ in prof):
         return math.nan
     r_hi = min(float(r[-1]) for r, _ in prof)
     if not r_hi > 0:
         return math.nan
     grid = np.linspace(r_hi / n_r, r_hi, n_r)
-    a, b, c = (CubicSpline(r, d)(grid) for r, d in prof)
+    a, b, c = (resample_spline(r, d, grid, "") for r, d in prof)  # checked above: no raise
     return float(estimate_g(grid, a, b, c, threshold_um=threshold_um, method=method).g)
 
 

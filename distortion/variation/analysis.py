@@ -207,6 +207,12 @@ def summarize_g(values: Sequence[float]) -> GSummary:
     return GSummary(mean, sd, sd / math.sqrt(n) if n > 1 else math.nan, n)
 
 
+def _misfit(predicted: np.ndarray, measured: np.ndarray) -> tuple[float, float]:
+    """RMS and largest |predicted − measured| over the radii (units of the inputs)."""
+    d = predicted - measured
+    return float(np.sqrt(np.mean(d**2))), float(np.max(np.abs(d)))
+
+
 def rms_error_eq6(dr_s: np.ndarray, dr_s_prime: np.ndarray, dr_ss_prime: np.ndarray, g: float):
     """RMS (µm) of δr_ss' − [δr_s + g(δr_s' − δr_s)] over the given radii (Tables 2–3 'e')."""
     d = fs_predict(dr_s, dr_s_prime, g) - np.asarray(dr_ss_prime, dtype=float)
@@ -454,18 +460,8 @@ def analyze_variation(
                 if r.size:
                     meas = resample(p, r)
                     pred = brown_predict(resample(g_sp, r), gamma)
-                    d = pred - meas
                     brown.append(
-                        BrownComparison(
-                            p.focus,
-                            p.obj,
-                            gamma,
-                            r,
-                            meas,
-                            pred,
-                            float(np.sqrt(np.mean(d**2))),
-                            float(np.max(np.abs(d))),
-                        )
+                        BrownComparison(p.focus, p.obj, gamma, r, meas, pred, *_misfit(pred, meas))
                     )
             missing = []
             if g_s is None:
@@ -582,18 +578,9 @@ def _interpolation_checks(gaussians: list[Profile], f, r_min, r_max) -> list[Int
         alpha = brown_alpha_scales(n, n1, n2)
         meas = resample(p, r)
         pred = brown_interpolate(resample(p1, r), resample(p2, r), alpha)
-        d = pred - meas
         out.append(
             InterpolationCheck(
-                p.focus,
-                p1.focus,
-                p2.focus,
-                alpha,
-                r,
-                meas,
-                pred,
-                float(np.sqrt(np.mean(d**2))),
-                float(np.max(np.abs(d))),
+                p.focus, p1.focus, p2.focus, alpha, r, meas, pred, *_misfit(pred, meas)
             )
         )
     return out

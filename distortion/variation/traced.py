@@ -223,9 +223,15 @@ class TracedSetting:
 
     def valid(self) -> tuple[np.ndarray, np.ndarray]:
         """(r, δr) of the leading run of successfully traced fields (a failure ends the profile)."""
-        ok = np.isfinite(self.r_mm) & np.isfinite(self.dr_um)
-        n = int(np.argmin(ok)) if not ok.all() else ok.size
-        return self.r_mm[:n], self.dr_um[:n]
+        return leading_run(self.r_mm, self.dr_um)
+
+
+def leading_run(r: np.ndarray, dr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(r, δr) up to the first field where either is not finite (a failed ray ends a traced
+    profile): the part of a profile that :func:`resample_spline` may interpolate."""
+    ok = np.isfinite(r) & np.isfinite(dr)
+    n = int(np.argmin(ok)) if not ok.all() else ok.size
+    return r[:n], dr[:n]
 
 
 def _same(a: Conjugate, b: Conjugate) -> bool:
@@ -331,7 +337,10 @@ def _field_limit(lens: Lens, max_field_deg: float | None) -> float:
     return float(math.degrees(math.atan(abs(lens.field.value / par.p0))))
 
 
-def _resample_spline(r: np.ndarray, dr: np.ndarray, grid: np.ndarray, label: str) -> np.ndarray:
+def resample_spline(r: np.ndarray, dr: np.ndarray, grid: np.ndarray, label: str) -> np.ndarray:
+    """δr of a traced profile (module docstring, "Radial profiles") on the radii ``grid`` (mm): a
+    not-a-knot cubic spline of δr against r. ``r`` must hold at least 4 radii, increasing;
+    ``label`` names the profile in the DataError otherwise."""
     if r.size < 4:
         raise DataError(f"profile {label}: fewer than 4 traced fields before the first failure")
     if not np.all(np.diff(r) > 0):
@@ -413,7 +422,7 @@ def trace_variation(
         raise DataError(f"radial range {lo:g}–{r_hi:g} mm is empty or starts at r <= 0")
     grid = np.linspace(lo, r_hi, n_r)
     profiles = tuple(
-        Profile(s.focus, s.obj, grid.copy(), _resample_spline(r, d, grid, s.label))
+        Profile(s.focus, s.obj, grid.copy(), resample_spline(r, d, grid, s.label))
         for s, (r, d) in zip(settings, valid, strict=True)
     )
     notes = (

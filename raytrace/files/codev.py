@@ -75,6 +75,7 @@ from .text import (
     lens_error,
     number,
     read_bytes,
+    solve_paraxial_image,
 )
 
 #: CODE V treats an object distance of 1e10 or more as infinite.
@@ -826,21 +827,16 @@ class _SeqParser(LineParser):
         return replace(lens, field=fld)
 
     def solve_image(self, lens: Lens, line: int, lines: list[int]) -> Lens:
-        from ..paraxial import paraxial
-
-        try:
-            d = float(paraxial(lens.with_image_distance(0.0)).gaussian_image_distance)
-        except (LensError, ValueError, ArithmeticError) as e:
-            raise lens_error(self.err, e, lines, line) from None
-        if not (math.isfinite(d) and d * lens.image_direction >= 0.0):
-            raise self.err(
+        return solve_paraxial_image(
+            lens,
+            self.err,
+            lines,
+            line,
+            lambda d: (
                 f"PIM: the paraxial image is {'at infinity' if not math.isfinite(d) else 'virtual'}"
-                "; give the image distance as the last thickness instead",
-                line,
-            )
-        s = list(lens.surfaces)
-        s[-1] = replace(s[-1], thickness=d)
-        return replace(lens, surfaces=tuple(s), image_solve="gaussian")
+                "; give the image distance as the last thickness instead"
+            ),
+        )
 
 
 def parse_seq(text: str | bytes, *, path: str | Path | None = None) -> ImportResult:

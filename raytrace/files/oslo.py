@@ -33,7 +33,7 @@ short is refused (``check_complete``: the closing ``END`` and the surface counts
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
@@ -48,6 +48,7 @@ from .text import (
     lens_error,
     number,
     read_bytes,
+    solve_paraxial_image,
 )
 
 #: OSLO treats a thickness of 1e10 or more on the object surface as an object at infinity
@@ -395,17 +396,13 @@ class _LenParser(LineParser):
         return ImportResult(lens, tuple(self.warnings))
 
     def solve_image(self, lens: Lens, line: int, lines: list[int]) -> Lens:
-        from ..paraxial import paraxial
-
-        try:
-            d = float(paraxial(lens.with_image_distance(0.0)).gaussian_image_distance)
-        except (LensError, ValueError, ArithmeticError) as e:
-            raise lens_error(self.err, e, lines, line) from None
-        if not (math.isfinite(d) and d * lens.image_direction >= 0.0):
-            raise self.err("PY 0: the paraxial image is virtual or at infinity", line)
-        s = list(lens.surfaces)
-        s[-1] = replace(s[-1], thickness=d)
-        return replace(lens, surfaces=tuple(s), image_solve="gaussian")
+        return solve_paraxial_image(
+            lens,
+            self.err,
+            lines,
+            line,
+            lambda d: "PY 0: the paraxial image is virtual or at infinity",
+        )
 
 
 def _count(args: list[str]) -> int | None:

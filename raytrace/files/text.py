@@ -8,11 +8,12 @@ import codecs
 import math
 import re
 import warnings
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
-from ..errors import PrescriptionError
+from ..errors import LensError, PrescriptionError
 from ..lens import Lens
 
 
@@ -174,6 +175,28 @@ def lens_error(err, e: Exception, surface_lines: list[int], default_line: int | 
         no = int(m.group(1))
         return err(f"invalid lens: {msg[m.end() :]}", surface_lines[no - 1], no)
     return err(f"invalid lens: {msg}", default_line)
+
+
+def solve_paraxial_image(
+    lens: Lens,
+    err,
+    surface_lines: list[int],
+    line: int,
+    refusal: Callable[[float], str],
+) -> Lens:
+    """The lens with its image plane at the paraxial image of its own object: a file's paraxial
+    image solve (CODE V ``PIM``, OSLO ``PY 0``). A paraxial trace that fails raises through
+    :func:`lens_error`; an image at infinity or virtual (before the last vertex) raises
+    ``err(refusal(d), line)``, ``d`` the distance from the last vertex (mm)."""
+    from ..paraxial import paraxial
+
+    try:
+        d = float(paraxial(lens.with_image_distance(0.0)).gaussian_image_distance)
+    except (LensError, ValueError, ArithmeticError) as e:
+        raise lens_error(err, e, surface_lines, line) from None
+    if not (math.isfinite(d) and d * lens.image_direction >= 0.0):
+        raise err(refusal(d), line)
+    return replace(lens.with_image_distance(d), image_solve="gaussian")
 
 
 def emit_warnings(result: ImportResult, path: str | None) -> Lens:

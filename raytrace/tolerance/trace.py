@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import TraceError
 from ..kernels.codes import STATUS_OK
 from ..lens import Lens
+from ..trace.chief import transfer
 from ..trace.chief2d import aim_2d
 from ..trace.rays import PARALLEL_LOCK
 from .model import InstanceArrays, pack_instances
@@ -142,9 +143,9 @@ class InstanceChiefRays:
         """(I, F, 2) points (x', y') in mm on the planes z = ``z_planes`` ((I,) or a scalar;
         absolute z in the image frame) by analytic transfer of the final segments."""
         zp = np.broadcast_to(np.asarray(z_planes, dtype=float), (self.last.shape[0],))
-        dz = zp[:, None] - self.last[:, 2, :]
-        x = self.last[:, 0, :] + dz * (self.last[:, 3, :] / self.last[:, 5, :])
-        y = self.last[:, 1, :] + dz * (self.last[:, 4, :] / self.last[:, 5, :])
+        s = self.last
+        x = transfer(s[:, 0, :], s[:, 2, :], s[:, 3, :] / s[:, 5, :], zp[:, None])
+        y = transfer(s[:, 1, :], s[:, 2, :], s[:, 4, :] / s[:, 5, :], zp[:, None])
         return np.stack([x, y], axis=-1)
 
 

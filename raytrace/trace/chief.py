@@ -45,6 +45,14 @@ AIM_CHUNK = 8192
 AIM_TOL = 1e-12
 
 
+def transfer(h: np.ndarray, z0: np.ndarray, slope: np.ndarray, z) -> np.ndarray:
+    """Height (mm) on the plane(s) ``z`` of the straight ray segment through ``(z0, h)`` with
+    slope ``dh/dz`` (a direction cosine ratio L/N or M/N): ``h + (z − z0)·slope``, broadcast.
+    The one analytic transfer of a final segment to an image plane (docs/design.md, "Data
+    flow")."""
+    return h + (z - z0) * slope
+
+
 @dataclass(frozen=True, eq=False)
 class _AimSetup:
     packed: PackedLens  # at the wavelengths of the call
@@ -205,8 +213,8 @@ class ChiefRays:
         zp = np.asarray(z_planes, dtype=np.float64)
         t = self.M_last / self.N_last
         if zp.ndim == 0:
-            return self.y_last + (float(zp) - self.z_last) * t
-        return self.y_last[None, :] + (zp.reshape(-1)[:, None] - self.z_last[None, :]) * t
+            return transfer(self.y_last, self.z_last, t, float(zp))
+        return transfer(self.y_last[None, :], self.z_last[None, :], t, zp.reshape(-1)[:, None])
 
     def __len__(self) -> int:
         return int(self.fields.size)

@@ -42,7 +42,7 @@ from ..lens import Lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
-from .chief import aim_start, aim_tolerance, checked_aim_request
+from .chief import aim_start, aim_tolerance, checked_aim_request, transfer
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,11 +154,14 @@ class ChiefRays2D:
         tx = self.L_last / self.N_last
         ty = self.M_last / self.N_last
         if zp.ndim == 0:
-            dz = float(zp) - self.z_last
-            return np.stack([self.x_last + dz * tx, self.y_last + dz * ty], axis=-1)
-        zz = zp.reshape((-1,) + (1,) * len(self.shape))
-        dz = zz - self.z_last[None]
-        return np.stack([self.x_last[None] + dz * tx[None], self.y_last[None] + dz * ty[None]], -1)
+            z, z0 = float(zp), self.z_last
+            return np.stack(
+                [transfer(self.x_last, z0, tx, z), transfer(self.y_last, z0, ty, z)], -1
+            )
+        z = zp.reshape((-1,) + (1,) * len(self.shape))
+        z0 = self.z_last[None]
+        x = transfer(self.x_last[None], z0, tx[None], z)
+        return np.stack([x, transfer(self.y_last[None], z0, ty[None], z)], -1)
 
     def __len__(self) -> int:
         return int(self.status.size)
