@@ -10,7 +10,9 @@ Surface sag (even asphere, which contains the plane, sphere and conic as special
 
     z(r) = c r² / (1 + sqrt(1 - (1 + k) c² r²)) + A4 r⁴ + A6 r⁶ + ...
 
-with ``c`` the curvature (1/mm), ``k`` the conic constant and ``aspheric = (A4, A6, ...)``.
+with ``c`` the curvature (1/mm), ``k`` the conic constant and ``aspheric = (A4, A6, ...)``. A
+Forbes Q-type surface (``Surface.qtype``, :mod:`.qtype`) adds its polynomial departure to the
+base conic (c, k) instead; its paraxial curvature is ``Surface.vertex_curvature``.
 """
 
 from __future__ import annotations
@@ -23,8 +25,9 @@ import numpy as np
 
 from .errors import LensError
 from .frames import AFTER_MODES, Placement
-from .kernels.codes import KIND_ASPHERE, KIND_PLANE, KIND_QUADRIC
+from .kernels.codes import KIND_ASPHERE, KIND_PLANE, KIND_QBFS, KIND_QCON, KIND_QUADRIC
 from .materials import AIR, LAMBDA_D, Material
+from .qtype import QType, departure, vertex_curvature
 
 #: shapes of a :class:`ClearAperture`
 APERTURE_SHAPES = ("circle", "rectangle", "ellipse")
@@ -126,6 +129,9 @@ class Surface:
                    (curvature 0, no aperture, the medium continues).
     aperture:      an extra hard :class:`ClearAperture` (rectangle, ellipse, off-axis circle) in
                    the surface frame; None = only ``semi_diameter``.
+    qtype:         Forbes Q-type terms (:class:`raytrace.qtype.QType`: Qbfs or Qcon, ρ_max, a_m;
+                   Zemax ``QED_TYPE``) added to the base conic ``curvature`` / ``conic``; None =
+                   none. Not together with ``aspheric``.
     """
 
     curvature: float
@@ -142,6 +148,7 @@ class Surface:
     mirror: bool = False
     coordinate_break: bool = False
     aperture: ClearAperture | None = None
+    qtype: QType | None = None
 
     def __post_init__(self) -> None:
         if (
@@ -150,8 +157,11 @@ class Surface:
             and self.aperture is None
             and self.mirror is False
             and self.coordinate_break is False
+            and self.qtype is None
         ):
             return  # a surface on the axis (the common case): nothing to check
+        if self.qtype is not None and not isinstance(self.qtype, QType):
+            raise ValueError(f"qtype must be a QType or None, got {type(self.qtype).__name__}")
         p = self.placement
         if p is not None and not isinstance(p, Placement):
             raise ValueError(f"placement must be a Placement or None, got {type(p).__name__}")
@@ -185,7 +195,20 @@ class Surface:
         return math.inf if self.curvature == 0.0 else 1.0 / self.curvature
 
     @property
+    def vertex_curvature(self) -> float:
+        """The paraxial curvature at the vertex (1/mm): ``curvature``, except for a Qbfs surface
+        (:func:`raytrace.qtype.vertex_curvature`)."""
+        if self.qtype is None:
+            return self.curvature
+        return vertex_curvature(self.qtype, self.curvature)
+
+    @property
     def kind(self) -> int:
+        """The kernels' surface kind (:mod:`raytrace.kernels.codes`); a Q-type surface whose
+        terms are all 0 is its base conic (KIND_QUADRIC / KIND_PLANE)."""
+        q = self.qtype
+        if q is not None and not q.is_zero:
+            return KIND_QBFS if q.form == "qbfs" else KIND_QCON
         if any(a != 0.0 for a in self.aspheric):
             return KIND_ASPHERE
         if self.curvature == 0.0:
@@ -201,6 +224,8 @@ class Surface:
             parts.append(f"k={self.conic:.6g}")
         if any(self.aspheric):
             parts.append(f"asph={len(self.aspheric)} terms")
+        if self.qtype is not None:
+            parts.append(f"{self.qtype.form} {len(self.qtype.terms)} terms")
         if self.stop:
             parts.append("stop")
         if self.mirror:
@@ -226,6 +251,8 @@ class Surface:
         for a in self.aspheric:
             z = z + a * p
             p = p * r2
+        if self.qtype is not None and not self.qtype.is_zero:
+            z = z + departure(self.qtype, c, k, r)
         return z
 
 
@@ -580,6 +607,7 @@ class Lens:
                 thickness=s.thickness * factor,
                 semi_diameter=s.semi_diameter * factor,
                 aspheric=tuple(a * factor ** (1 - 2 * (j + 2)) for j, a in enumerate(s.aspheric)),
+                qtype=None if s.qtype is None else s.qtype.scaled(factor),
                 placement=_scaled_placement(s.placement, factor),
                 after=_scaled_placement(s.after, factor),
                 aperture=None
@@ -687,6 +715,11 @@ def validate(lens: Lens) -> None:
                 raise LensError(f"{lens.name}: surface {i}: {name} must be finite, got {v}")
         if any(not math.isfinite(a) for a in s.aspheric):
             raise LensError(f"{lens.name}: surface {i}: aspheric coefficients must be finite")
+        if s.qtype is not None and any(s.aspheric):
+            raise LensError(
+                f"{lens.name}: surface {i}: a Q-type surface has no even-asphere terms; give "
+                "either qtype or aspheric"
+            )
         if not (s.semi_diameter > 0.0):
             raise LensError(
                 f"{lens.name}: surface {i}: semi-diameter must be positive, got {s.semi_diameter}"
@@ -714,7 +747,14 @@ def validate(lens: Lens) -> None:
                 f"it ({medium_before.describe()}), got {s.material.describe()}"
             )
         if s.coordinate_break:
-            if s.mirror or s.stop or s.curvature != 0.0 or any(s.aspheric) or s.conic:
+            if (
+                s.mirror
+                or s.stop
+                or s.curvature != 0.0
+                or any(s.aspheric)
+                or s.conic
+                or s.qtype is not None
+            ):
                 raise LensError(
                     f"{lens.name}: surface {i} is a coordinate break: it cannot be curved, a "
                     "mirror or the stop (it is not traced)"

@@ -2,8 +2,9 @@
 ``lens._repr_html_()`` and ``orthoscope prescription LENS`` show.
 
 One row per surface: number, radius (mm, ``inf`` for a plane), thickness to the next vertex (mm),
-the medium after the surface, semi-diameter (mm, ``-`` when not limited), conic, aspheric terms,
-stop mark and label; then the first-order summary (EFL, BFL, EPD, f-number, pupils, m_e) at the
+the medium after the surface, semi-diameter (mm, ``-`` when not limited), conic, aspheric terms
+(a Q-type surface: its form, ρ_max and a_m, on the base radius and conic of the row), stop mark
+and label; then the first-order summary (EFL, BFL, EPD, f-number, pupils, m_e) at the
 lens's wavelength. Plain floats, units in the headers.
 """
 
@@ -32,6 +33,8 @@ def surface_rows(lens: Lens) -> list[list[str]]:
         if i == lens.n_surfaces and lens.image_solve == "gaussian":
             thick += " (Gaussian)"
         asph = ", ".join(f"{a:.4g}" for a in s.aspheric) if any(s.aspheric) else ""
+        if s.qtype is not None:
+            asph = s.qtype.describe()
         rows.append(
             [
                 tag,

@@ -16,6 +16,12 @@ segments must be turned into an image frame other than the last surface's axis f
 tilt after the last surface, a tilted image surface), one pseudo-surface is appended (flags
 ``F_SKIP | F_FRAME``): ``n_surfaces`` is then one more than the lens's
 (:attr:`PackedLens.n_lens_surfaces`).
+
+Q-type aspheres (:mod:`raytrace.qtype`; kinds ``KIND_QBFS``, ``KIND_QCON``) keep their row of
+``asph`` as :meth:`raytrace.qtype.QType.packed_row` (1/ρ_max², then the coefficients of the
+sum in the basis P_m) and are flagged ``F_SCALAR`` in the placement table: the bulk trace sends
+flagged surfaces through the scalar surface step, which holds their sag (the vectorised passes
+do not), and such a lens is not marked ``L_COAXIAL``.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ from .kernels.codes import (
     F_FRAME,
     F_GENERAL,
     F_MIRROR,
+    F_SCALAR,
     F_SKIP,
     G_ABS,
     G_ABST,
@@ -40,11 +47,16 @@ from .kernels.codes import (
     G_RELT,
     G_ZV,
     KIND_PLANE,
+    KIND_QBFS,
+    KIND_QCON,
     L_COAXIAL,
     L_SYMMETRIC,
     NGEO,
 )
 from .lens import Lens
+
+#: kinds the vectorised bulk passes do not hold (flagged ``F_SCALAR``)
+SCALAR_KINDS = (KIND_QBFS, KIND_QCON)
 
 
 def coaxial_geo(zv: np.ndarray, symmetric: bool = True) -> np.ndarray:
@@ -64,9 +76,10 @@ def coaxial_geo(zv: np.ndarray, symmetric: bool = True) -> np.ndarray:
 class PackedLens:
     """Contiguous float64/int64 arrays the numba kernels read (one entry per surface).
 
-    kind:   int64 surface kind (KIND_PLANE, KIND_QUADRIC, KIND_ASPHERE)
-    c, k:   curvature (1/mm) and conic constant
-    asph:   (n, m) even-asphere coefficients of r⁴, r⁶, ... (m >= 1, zero padded)
+    kind:   int64 surface kind (KIND_PLANE, KIND_QUADRIC, KIND_ASPHERE, KIND_QBFS, KIND_QCON)
+    c, k:   curvature (1/mm) and conic constant (of the base conic for a Q-type surface)
+    asph:   (n, m) even-asphere coefficients of r⁴, r⁶, ... (m >= 1, zero padded); for a
+            Q-type surface its packed row (module docstring)
     zv:     vertex z (mm), first vertex at 0
     n_in:   index before each surface; n_out: index after it (at ``wavelength``, the first of
             ``wavelengths``)
@@ -146,6 +159,13 @@ class PackedLens:
         return not np.any(self.geo[:, G_FLAGS] != 0.0)
 
 
+def _asph_row(s) -> tuple[float, ...]:
+    """The row of ``asph`` for surface ``s`` (module docstring)."""
+    if s.qtype is None or s.qtype.is_zero:
+        return s.aspheric
+    return s.qtype.packed_row()
+
+
 def pack(lens: Lens, wavelength: float | None = None, *, wavelengths=None) -> PackedLens:
     """Pack ``lens`` into contiguous arrays at ``wavelength`` nm (default: the lens's reference
     wavelength), or at several ``wavelengths`` (nm; the 1-D ``n_in`` / ``n_out`` are then at the
@@ -160,10 +180,11 @@ def pack(lens: Lens, wavelength: float | None = None, *, wavelengths=None) -> Pa
             raise ValueError("wavelengths: give at least one")
     ss = lens.surfaces
     n = len(ss)
-    m = max([1] + [len(s.aspheric) for s in ss])
+    rows = [_asph_row(s) for s in ss]
+    m = max([1] + [len(r) for r in rows])
     asph = np.zeros((n, m))
-    for i, s in enumerate(ss):
-        asph[i, : len(s.aspheric)] = s.aspheric
+    for i, r in enumerate(rows):
+        asph[i, : len(r)] = r
     idx = lens.indices(wl)  # (w, n + 1): object space, then after each surface
     n_in_w = np.ascontiguousarray(idx[:, :-1])
     n_out_w = np.ascontiguousarray(idx[:, 1:])
@@ -207,11 +228,13 @@ def placement_table(lens: Lens) -> tuple[np.ndarray, bool]:
     image-frame pseudo-surface as its last row."""
     ss = lens.surfaces
     zv = np.asarray(lens.vertex_z, dtype=np.float64)
+    scalar = [s.kind in SCALAR_KINDS for s in ss]
     if (
         lens.is_centred
         and not lens.has_mirrors
         and all(s.aperture is None for s in ss)
         and not any(s.coordinate_break for s in ss)
+        and not any(scalar)
     ):
         return coaxial_geo(zv), False
     fr = surface_frames(lens)
@@ -239,6 +262,8 @@ def placement_table(lens: Lens) -> tuple[np.ndarray, bool]:
                 flags |= F_MIRROR
             if general:
                 flags |= F_GENERAL
+            if scalar[j]:
+                flags |= F_SCALAR
             if s.aperture is not None:
                 a = s.aperture
                 row[G_AP : G_AP + 5] = (a.code, a.half_x, a.half_y, a.x0, a.y0)

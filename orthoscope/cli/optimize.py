@@ -399,7 +399,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
         epilog="Examples: orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
         "-o my-twinplex.toml;  orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
-        "--global --starts 2 --time 5s --seed 1 -o my-global.toml",
+        "--global --starts 2 --seed 1 -o my-global.toml",
     )
     q.add_argument("spec", metavar="SPEC.toml", help="Design spec file (docs/spec.md).")
     q.add_argument(

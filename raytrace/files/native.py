@@ -32,8 +32,9 @@ the medium after the surface: ``glass = "nd/vd"`` (model glass), ``n = 1.5`` (fi
 nothing / ``glass = "air"``; a glass defined here: ``glass = "NAME", catalog = "private",
 formula = 2, coefficients = [...]`` (a formula id of :mod:`raytrace.glass.formulas`, λ in µm;
 optional ``range_nm = [min, max]``); ``sd`` (semi-diameter, mm); ``stop = true``; ``k`` (conic);
-``asph = [A4, A6, ...]``; ``label``. ``[object]`` may also carry ``glass`` / ``n`` for an
-immersed object space.
+``asph = [A4, A6, ...]``; ``qtype = { form = "qbfs" | "qcon", norm_radius = ρ_max, a = [a0, a1,
+...] }`` (a Forbes Q-type asphere on the conic r, k: :mod:`raytrace.qtype`; ρ_max and a_m in
+mm); ``label``. ``[object]`` may also carry ``glass`` / ``n`` for an immersed object space.
 
 Placement and mirrors (:mod:`raytrace.frames` states the conventions; ``lenses/README.md`` for
 users): per surface ``decenter = [x, y]`` or ``[x, y, z]`` (mm), ``tilt = [a, b, c]`` (degrees,
@@ -73,6 +74,7 @@ from ..errors import LensError, PrescriptionError
 from ..frames import AFTER_MODES, ORDERS, Placement
 from ..lens import APERTURE_KINDS, IMAGE_FIELDS, Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
+from ..qtype import FORMS, QType
 from .output import write_atomic
 from .text import decode_text, read_bytes
 
@@ -95,6 +97,7 @@ _SURFACE_KEYS: dict[str, tuple[str, ...]] = {
     "sd": ("sd", "semi_diameter"),
     "k": ("k", "conic"),
     "asph": ("asph", "aspheric"),
+    "qtype": ("qtype",),
     "stop": ("stop",),
     "label": ("label",),
     "decenter": ("decenter",),
@@ -107,6 +110,7 @@ _SURFACE_KEYS: dict[str, tuple[str, ...]] = {
 }
 _PLACEMENT_KEYS = ("decenter", "tilt", "order")
 _CLEAR_APERTURE_KEYS = ("circle", "rectangle", "ellipse", "center")
+_QTYPE_KEYS = ("form", "norm_radius", "a")
 _TOP_KEYS = (
     "name",
     "source",
@@ -913,6 +917,15 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
             _number(src, a, f"asph[{j}] (A{4 + 2 * j})", line, no) for j, a in enumerate(av)
         )
 
+    qtype = None
+    qv = _one_of(src, e, "qtype", K, line, no)
+    if qv is not None:
+        qtype = _qtype(src, qv, line, no)
+        if asph:
+            raise src.error(
+                "give either asph or qtype (a Q-type surface has no even terms)", line, no
+            )
+
     stop = e.get("stop", False)
     if not isinstance(stop, bool):
         raise src.error(f"stop must be true or false, got {stop!r}", line, no)
@@ -920,7 +933,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
     if not isinstance(label, str):
         raise src.error(f"label must be a string, got {label!r}", line, no)
 
-    if math.isfinite(sd) and math.isnan(float(_sag(curvature, conic, asph, sd))):
+    if math.isfinite(sd) and math.isnan(float(_sag(curvature, conic, asph, sd, qtype))):
         raise src.error(
             f"sd = {sd!r} is larger than the surface allows (|r| = {abs(1.0 / curvature)!r})",
             line,
@@ -949,7 +962,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
     if kind not in ("surface", "coordinate_break"):
         raise src.error(f'type must be "surface" or "coordinate_break", got {kind!r}', line, no)
     cb = kind == "coordinate_break"
-    if cb and (curvature != 0.0 or mirror or stop or conic or asph or math.isfinite(sd)):
+    if cb and (curvature != 0.0 or mirror or stop or conic or asph or qtype or math.isfinite(sd)):
         raise src.error(
             "a coordinate break has only decenter, tilt, order and t (it is not traced)", line, no
         )
@@ -964,6 +977,7 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
         stop=stop,
         conic=conic,
         aspheric=asph,
+        qtype=qtype,
         label=label,
         line=line,
         placement=placement,
@@ -974,8 +988,31 @@ def _surface(src: _Source, e: dict[str, Any], line: int | None, no: int, last: b
     )
 
 
-def _sag(c: float, k: float, asph: tuple[float, ...], r: np.ndarray | float) -> np.ndarray:
-    return Surface(c, 0.0, conic=k, aspheric=asph).sag(r)
+def _sag(
+    c: float, k: float, asph: tuple[float, ...], r: np.ndarray | float, qtype: QType | None = None
+) -> np.ndarray:
+    return Surface(c, 0.0, conic=k, aspheric=asph, qtype=qtype).sag(r)
+
+
+def _qtype(src: _Source, value: Any, line, no) -> QType:
+    """``qtype = { form = "qbfs" | "qcon", norm_radius = mm, a = [a0, a1, ...] }``."""
+    want = 'qtype = { form = "qbfs" or "qcon", norm_radius = mm, a = [a0, a1, ...] }'
+    if not isinstance(value, dict):
+        raise src.error(f"expected {want}, got {value!r}", line, no)
+    _check_keys(src, value, {k: (k,) for k in _QTYPE_KEYS}, "qtype", line, no)
+    form = value.get("form")
+    if form not in FORMS:
+        raise src.error(f'qtype form must be "qbfs" or "qcon", got {form!r}', line, no)
+    if "norm_radius" not in value:
+        raise src.error(f"qtype needs norm_radius (mm): {want}", line, no)
+    rn = _number(src, value["norm_radius"], "qtype norm_radius (mm)", line, no)
+    if not rn > 0.0:
+        raise src.error(f"qtype norm_radius must be positive (mm), got {rn!r}", line, no)
+    a = value.get("a", [])
+    if not isinstance(a, list):
+        raise src.error(f"qtype a must be a list [a0, a1, ...] (mm), got {a!r}", line, no)
+    terms = tuple(_number(src, v, f"qtype a[{j}] (mm)", line, no) for j, v in enumerate(a))
+    return QType(form, rn, terms)
 
 
 def _lens_error(src: _Source, lens_name: str, err: Exception, default_line: int | None):
@@ -1089,6 +1126,8 @@ _COLUMNS = """\
 #           model glass; n = fixed index; omitted = air
 #   sd      semi-diameter, mm (omitted = unlimited)
 #   k       conic constant;  asph = [A4, A6, ...] even-asphere coefficients of r^4, r^6, ...
+#   qtype   Forbes Q-type asphere on the conic r, k: { form = "qbfs" | "qcon", norm_radius =
+#           mm, a = [a0, a1, ...] mm }
 #   stop    true on the aperture stop (exactly one);  label = optional name
 #   decenter, tilt, order, after, mirror, type, aperture: placement (mm, degrees right-handed
 #           about x, y, z), mirrors and coordinate breaks, clear apertures (lenses/README.md)
@@ -1221,6 +1260,11 @@ def _geometry_cells(s: Surface) -> list[tuple[str, str] | None]:
     return cells
 
 
+def _qtype_text(q: QType) -> str:
+    terms = ", ".join(repr(float(a)) for a in q.terms)
+    return f'{{ form = "{q.form}", norm_radius = {q.norm_radius!r}, a = [{terms}] }}'
+
+
 def _surface_cells(s: Surface, last: bool, solve: str | None) -> list[tuple[str, str] | None]:
     t = '"gaussian"' if (last and solve == "gaussian") else _fnum(s.thickness)
     own_medium = not (s.mirror or s.coordinate_break)
@@ -1231,6 +1275,7 @@ def _surface_cells(s: Surface, last: bool, solve: str | None) -> list[tuple[str,
         ("sd", _fnum(s.semi_diameter)) if math.isfinite(s.semi_diameter) else None,
         ("k", repr(float(s.conic))) if s.conic != 0.0 else None,
         ("asph", "[" + ", ".join(repr(float(a)) for a in s.aspheric) + "]") if s.aspheric else None,
+        ("qtype", _qtype_text(s.qtype)) if s.qtype is not None else None,
         ("stop", "true") if s.stop else None,
         ("label", _toml_str(s.label)) if s.label else None,
         *_geometry_cells(s),

@@ -1,7 +1,8 @@
 """Zemax OpticStudio ``.zmx`` files: read (ASCII, UTF-8 or UTF-16) and write.
 
 Reading (:func:`read_zmx`, :func:`loads_zmx`, :func:`parse_zmx`) supports a sequential lens made
-of ``STANDARD`` and ``EVENASPH`` surfaces, coordinate breaks and mirrors:
+of ``STANDARD``, ``EVENASPH`` and ``QED_TYPE`` (Q-type asphere) surfaces, coordinate breaks and
+mirrors:
 
 * ``SURF n`` blocks in order; surface 0 is the object, the last one the image, the ones between
   are the lens. ``CURV`` (curvature, 1/lens unit), ``DISZ`` (thickness to the next vertex;
@@ -12,6 +13,12 @@ of ``STANDARD`` and ``EVENASPH`` surfaces, coordinate breaks and mirrors:
 * ``EVENASPH``: Zemax's sag is ``c r²/(1+√(1−(1+k)c²r²)) + α1 r² + α2 r⁴ + … + α8 r¹⁶`` in lens
   units (not normalized), with ``PARM i`` = αi. So ``PARM 2`` = A4, ``PARM 3`` = A6, …,
   ``PARM 8`` = A16. ``PARM 1`` (the r² term) must be 0: orthoscope models r⁴ and higher only.
+* ``QED_TYPE`` (OpticStudio's Q-type asphere, :mod:`raytrace.qtype`): the Qbfs form on the
+  base conic (``CURV``, ``CONI``), its parameters in the extra data: ``XDAT 1`` = 0 (the only
+  value read: every Q-type file we have holds 0, and its Qbfs reading is confirmed by the
+  Thorlabs ASL5040-UV file, tests/test_qtype.py; another value is refused), ``XDAT 2`` = the
+  number of terms n, ``XDAT 3`` = the normalization radius ρ_max, ``XDAT 4 .. 3+n`` = a_0 ..
+  a_(n−1) (lens units). A ``PARM`` on it is refused (no file here shows one).
 * The image surface's ``DISZ`` is irrelevant: the last lens surface's ``DISZ`` is the image
   distance. A curved image surface is reported and read as flat.
 * ``GLAS``: ``GLAS ___BLANK 1 0 nd vd dPgF …`` (a model glass; fields 4 and 5 after the command
@@ -73,6 +80,7 @@ from ..frames import ORDERS, Placement
 from ..glass import lookup_glass, parse_glass_code, printed_nd_vd, resolve_glass
 from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
+from ..qtype import QType
 from .output import write_atomic
 from .text import (
     ImportResult,
@@ -140,6 +148,7 @@ class _ZSurf:
     clap: float = math.inf
     coni: float = 0.0
     parm: dict[int, tuple[float, int]] = field(default_factory=dict)
+    xdat: dict[int, tuple[float, int]] = field(default_factory=dict)
     glas: tuple[list[str], int] | None = None
     stop: bool = False
     comm: str = ""
@@ -319,7 +328,7 @@ class _ZmxParser(LineParser):
         no = cur.number
         if cmd == "TYPE":
             t = args[0].upper() if args else ""
-            if t in ("STANDARD", "EVENASPH", "COORDBRK"):
+            if t in ("STANDARD", "EVENASPH", "COORDBRK", "QED_TYPE"):
                 cur.type, cur.type_line = t, line
                 return
             hint = ""
@@ -327,8 +336,9 @@ class _ZmxParser(LineParser):
                 hint = " (gradient-index media are not supported)"
             raise self.err(
                 f"TYPE {t or '(none)'}: unsupported surface type{hint}; orthoscope reads "
-                "STANDARD and EVENASPH surfaces only — convert the surface in OpticStudio (e.g. "
-                "an even asphere without the r² term) or replace it by a standard surface",
+                "STANDARD, EVENASPH and QED_TYPE (Q-type) surfaces only — convert the surface in "
+                "OpticStudio (e.g. an even asphere without the r² term) or replace it by a "
+                "standard surface",
                 line,
                 no,
             )
@@ -359,9 +369,7 @@ class _ZmxParser(LineParser):
             cur.parm[i] = (self.num(args, 1, "PARM", line), line)
         elif cmd == "XDAT":
             i = self.integer(args, 0, "XDAT", line)
-            v = self.num(args, 1, "XDAT", line)
-            if v != 0.0:
-                self.warn(f"line {line}: XDAT {i} {v} (extra data) ignored on a {cur.type} surface")
+            cur.xdat[i] = (self.num(args, 1, "XDAT", line), line)
         elif cmd == "GLAS":
             if not args:
                 raise self.err("GLAS needs a glass name", line, no)
@@ -450,8 +458,68 @@ class _ZmxParser(LineParser):
             self.warn(f"line {line}: {r.warning}")
         return r.material
 
+    def extra_data(self, z: _ZSurf, scale: float) -> QType | None:
+        """The Q-type terms of a ``QED_TYPE`` surface (module docstring); on other surfaces the
+        extra data are ignored with a warning."""
+        if z.type != "QED_TYPE":
+            for i, (v, line) in sorted(z.xdat.items()):
+                if v != 0.0:
+                    self.warn(
+                        f"line {line}: XDAT {i} {v} (extra data) ignored on a {z.type} surface"
+                    )
+            return None
+        for i, (v, line) in sorted(z.parm.items()):
+            if v != 0.0:
+                raise self.err(
+                    f"QED_TYPE PARM {i} = {v!r}: a parameter on a Q-type surface is not read "
+                    "(orthoscope reads its extra data XDAT 1..3+n only); set it to 0 in "
+                    "OpticStudio or convert the surface to an even asphere",
+                    line,
+                    z.number,
+                )
+
+        def xd(i: int) -> tuple[float, int]:
+            return z.xdat.get(i, (0.0, z.type_line))
+
+        mode, line = xd(1)
+        if mode != 0.0:
+            raise self.err(
+                f"QED_TYPE extra data 1 = {mode!r}: only 0 is read (the Qbfs form, which every "
+                "Q-type file checked holds; lenses/INTEROP.md); convert the surface to an even "
+                "asphere or write the lens as TOML with qtype = { form = ... }",
+                line,
+                z.number,
+            )
+        nt, line = xd(2)
+        if nt != int(nt) or not 0 <= nt <= 1000:
+            raise self.err(
+                f"QED_TYPE extra data 2 (the number of terms) = {nt!r}: expected a whole number "
+                "from 0 to 1000",
+                line,
+                z.number,
+            )
+        n = int(nt)
+        for i, (v, line) in sorted(z.xdat.items()):
+            if (i < 1 or i > 3 + n) and v != 0.0:
+                self.warn(
+                    f"line {line}: XDAT {i} {v} ignored: the QED_TYPE surface has {n} terms "
+                    "(extra data 2), in XDAT 4 to 3+n"
+                )
+        rn, line = xd(3)
+        if n == 0 and not rn > 0.0:
+            return None  # no terms: the base conic
+        if not (math.isfinite(rn) and rn > 0.0):
+            raise self.err(
+                f"QED_TYPE extra data 3 (the normalization radius) = {rn!r}: must be positive",
+                line,
+                z.number,
+            )
+        return QType("qbfs", rn * scale, tuple(xd(4 + m)[0] * scale for m in range(n)))
+
     def aspheric(self, z: _ZSurf, scale: float) -> tuple[float, ...]:
         if z.type != "EVENASPH":
+            if z.type == "QED_TYPE":
+                return ()  # its PARMs are checked by extra_data
             for i, (v, line) in sorted(z.parm.items()):
                 if v != 0.0:
                     self.warn(f"line {line}: PARM {i} = {v} ignored on a STANDARD surface")
@@ -686,9 +754,14 @@ class _ZmxParser(LineParser):
             )
         out: list[Surface] = []
         mirrors = 0
+        for z in (obj, img):
+            if z.type == "QED_TYPE":
+                z.type = "STANDARD"  # the object and image surfaces are read as planes
+            self.extra_data(z, scale)
         for k, z in enumerate(body):
             before = object_material if not out else out[-1].material
             if z.type == "COORDBRK":
+                self.extra_data(z, scale)
                 out.append(self.coordinate_break(z, scale, before))
                 continue
             if z.mirror and z.glas is not None:
@@ -731,6 +804,7 @@ class _ZmxParser(LineParser):
                     stop=z.stop or (not stops and k == 0),
                     conic=z.coni,
                     aspheric=self.aspheric(z, scale),
+                    qtype=self.extra_data(z, scale),
                     label=z.comm,
                     line=z.line,
                     placement=placement,
@@ -1065,12 +1139,20 @@ def dumps_zmx(lens: Lens) -> str:
                 "EVENASPH surface holds A4 to A16 (7 terms)",
                 surface=i,
             )
+        q = s.qtype
+        if q is not None and q.form != "qbfs":
+            raise PrescriptionError(
+                "a Qcon surface cannot be written to .zmx: orthoscope reads and writes "
+                "OpticStudio's QED_TYPE in its Qbfs form only; write the lens as .toml instead",
+                surface=i,
+            )
         before, after_cb, after_tab = _tab_moves(s)
         if before is not None and not _tab_ok(before):
             coordbrk(before, 0.0)
             before = None
         surf()
-        out.append(f"  TYPE {'EVENASPH' if asph else 'STANDARD'}")
+        kind = "QED_TYPE" if q is not None else "EVENASPH" if asph else "STANDARD"
+        out.append(f"  TYPE {kind}")
         if s.label:
             out.append(f"  COMM {_one_line(s.label)}")
         out.append(f'  CURV {_r(s.curvature)} 0 0 0 0 ""')
@@ -1099,6 +1181,10 @@ def dumps_zmx(lens: Lens) -> str:
             out.append("  PARM 1 0")
             for j in range(2, 9):
                 out.append(f"  PARM {j} {_r(asph[j - 2]) if j - 2 < len(asph) else '0'}")
+        if q is not None:  # QED_TYPE extra data (module docstring)
+            xdat = (0.0, float(len(q.terms)), q.norm_radius, *q.terms)
+            for j, v in enumerate(xdat, start=1):
+                out.append(f'  XDAT {j} {_r(v)} 0 0 1 0 0 ""')
         a = s.aperture
         if a is not None:
             if a.shape == "circle":

@@ -9,7 +9,11 @@ would have to travel against its direction to reach the surface: the surface lie
 point where the ray met the previous one, so the two overlap; see :mod:`.surface`).
 
 Surface kind codes (:func:`raytrace.packing.pack`): ``KIND_PLANE`` 0, ``KIND_QUADRIC`` 1 (sphere
-or conic, closed-form intersection), ``KIND_ASPHERE`` 2 (even asphere, Newton iteration).
+or conic, closed-form intersection), ``KIND_ASPHERE`` 2 (even asphere, Newton iteration),
+``KIND_QBFS`` 4 and ``KIND_QCON`` 5 (Forbes Q-type aspheres, :mod:`raytrace.qtype`; Newton
+iteration, traced by the scalar :func:`raytrace.kernels.surface.surface_step` only: packing
+flags them ``F_SCALAR``). 3 is the tolerancing kernels' irregular surface
+(:data:`raytrace.kernels.instances.KIND_IRREGULAR`).
 """
 
 STATUS_OK = 0
@@ -57,6 +61,8 @@ def status_message(status: int, surface: int = 0) -> str:
 KIND_PLANE = 0
 KIND_QUADRIC = 1
 KIND_ASPHERE = 2
+KIND_QBFS = 4
+KIND_QCON = 5
 
 # ---- per-surface placement table ``geo`` (:func:`raytrace.packing.pack`, float64, one row per
 # packed surface, NGEO columns; :mod:`raytrace.frames` for the frames). Column offsets:
@@ -75,6 +81,9 @@ F_MIRROR = 2  #: reflect instead of refracting
 F_SKIP = 4  #: not traced (a coordinate break, or the image-frame pseudo-surface at the end)
 F_APERTURE = 8  #: clip with the clear aperture of columns G_AP..G_AP+4 too
 F_GENERAL = 16  #: rays may meet the surface travelling toward -z (mirrors, tilts)
+#: traced ray by ray by :func:`raytrace.kernels.surface.surface_step` in the bulk trace too (a
+#: surface kind without a vectorised pass: the Q-type aspheres)
+F_SCALAR = 32
 
 L_SYMMETRIC = 1  #: rotationally symmetric lens: a negative meridional field mirrors a positive one
 L_COAXIAL = 2  #: no surface has a flag: the kernels run the coaxial code only

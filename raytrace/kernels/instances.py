@@ -6,7 +6,9 @@ Each instance ``i`` has its own rows of the lens arrays of :class:`raytrace.pack
 normalisation radius per surface) for irregular surfaces (kind :data:`KIND_IRREGULAR`: the
 surface's quadric / even asphere plus ``Zs ρ⁴ + Za ρ_y²``, ρ = r/rn, ρ_y = y/rn, intersected by
 Newton's method along the ray from the quadric root, normal ``(−∂z/∂x, −∂z/∂y, 1)``). Every other
-surface goes through the shared :func:`raytrace.kernels.surface.surface_step`; frames as
+surface goes through the shared :func:`raytrace.kernels.surface.surface_step` (compiled without
+Q-type surfaces, ``qtype=False``: tolerancing refuses Q-type lenses,
+:func:`raytrace.tolerance.check_against_lens`); frames as
 :mod:`raytrace.kernels.surface` describes (``F_FRAME`` moves the ray into the surface's axis
 frame; the last row of every instance is the image-frame row, ``F_SKIP | F_FRAME``).
 
@@ -139,7 +141,7 @@ def _span(kind, c, k, asph, geo, n_in, n_out, sd, irr, j0, j1, clip, x, y, z, L,
             )  # fmt: skip
         else:
             st, x, y, z, L, M, N = surface_step(
-                kind[j], c[j], k[j], asph, geo, j, mu, sd[j], clip, x, y, z, L, M, N
+                kind[j], c[j], k[j], asph, geo, j, mu, sd[j], clip, x, y, z, L, M, N, qtype=False
             )
         if st != STATUS_OK:
             return st, j + 1, x, y, z, L, M, N

@@ -33,9 +33,14 @@ Intersection (cancellation-free curvature form)
     ``B = N − c (x1 L + y1 M)``, ``C = c (x1² + y1²)``; the root continuous with the vertex is
     ``s = C / (B + sqrt(B² − A C))`` — no subtraction of nearly equal numbers, exact for c → 0
     (plane). Negative discriminant → MISSED; a root on the far sheet of the quadric
-    (``1 − c (1 + k) z <= 0``) → MISSED. Even aspheres: Newton iteration on
+    (``1 − c (1 + k) z <= 0``) → MISSED. Even aspheres and Q-type aspheres: Newton iteration on
     ``z − sag(x² + y²) = 0`` along the ray, started at the conic solution, stopped when the step
-    is below 1e-14 mm × (1 + |x| + |y| + |z|); more than ``NEWTON_MAX`` steps → MISSED.
+    is below 1e-14 mm × (1 + |x| + |y| + |z|); more than ``NEWTON_MAX`` steps → MISSED. A Q-type
+    surface (kinds ``KIND_QBFS``, ``KIND_QCON``; :mod:`raytrace.qtype`) goes through
+    :func:`qtype_newton`, a compiled function of its own, called, not inlined, so that the many
+    kernels that inline this step grow by one call and one linked copy of it (numba compile
+    time); the vectorised bulk passes (:mod:`.bulk`) do not hold it — packing flags Q-type
+    surfaces ``F_SCALAR``, which sends them through this step there too.
 
 Refraction (vector Snell)
     With the unit normal n̂ oriented along the ray (cos I = d·n̂ >= 0) and μ = n/n':
@@ -89,7 +94,9 @@ from .codes import (
     G_REL,
     G_RELT,
     G_ZV,
+    KIND_ASPHERE,
     KIND_PLANE,
+    KIND_QCON,
     KIND_QUADRIC,
     L_COAXIAL,
     STATUS_BACKWARD,
@@ -98,6 +105,7 @@ from .codes import (
     STATUS_OK,
     STATUS_TIR,
 )
+from .forbes import qbfs_sum
 from .jit import kernel
 
 NEWTON_MAX = 60
@@ -157,6 +165,66 @@ def asphere_sag(c, k, asph, j, rho):
         dz += (m + 2) * a * pw
         pw *= rho
     return z, dz, True
+
+
+_qbfs_sum = kernel(error_model="numpy", inline="always")(qbfs_sum)
+
+
+@kernel(error_model="numpy", inline="always")
+def qtype_sag(con, c, k, coef, j, rho):
+    """Q-type sag z and dz/dρ at ρ = x² + y² (mm²) (:mod:`raytrace.qtype`) on the base conic
+    (c, k): Qbfs (``con`` False) or Qcon (True), with row j of ``coef`` = (1/ρ_max²,
+    coefficients of the sum in the basis P_m, :meth:`raytrace.qtype.QType.packed_row`); ok False
+    outside the conic's domain. Departure E(x) Φ(ρ) S(x) with, for Qbfs, E = x(1 − x) and
+    Φ = √(1 + z_conic'²), for Qcon E = x² and Φ = 1 (blended, not branched: one code path)."""
+    cc = c * c
+    arg = 1.0 - (1.0 + k) * cc * rho
+    if not (arg > 0.0):
+        return 0.0, 0.0, False
+    q = math.sqrt(arg)
+    w = coef[j, 0]
+    x = rho * w  # u²
+    s, ds = _qbfs_sum(coef, j, x)
+    f = 1.0 if con else 0.0
+    g = 1.0 - f
+    e = x * (f * x + g * (1.0 - x))
+    de = f * 2.0 * x + g * (1.0 - 2.0 * x)
+    phi = math.sqrt((1.0 - k * cc * rho) / arg)  # √(1 + z_conic'²): along the conic's normal
+    ph = f + g * phi
+    dph = g * 0.5 * cc / (phi * arg * arg)  # dφ/dρ = c² / (2 φ arg²)
+    z = c * rho / (1.0 + q) + e * ph * s
+    dz = 0.5 * c / q + w * ph * (de * s + e * ds) + e * s * dph
+    return z, dz, True
+
+
+@kernel(error_model="numpy")
+def qtype_newton(con, c, k, coef, j, x, y, zl, L, M, N):
+    """The intersection with a Q-type surface (:func:`qtype_sag`) by the Newton iteration of the
+    even-asphere branch of :func:`surface_step` (same step, stopping rule and ``NEWTON_MAX``),
+    from the point (x, y, zl) on the ray (surface frame, zl from the vertex). Returns (ok, x, y,
+    zl, dz/dρ at the point); ok False when it leaves the conic's domain, stalls or does not
+    converge. A compiled function of its own, called, not inlined, with one sag evaluation in
+    its loop (the one after the last step gives the normal): numba links a copy of it into
+    every kernel that calls :func:`surface_step`, so its size is compile time (module
+    docstring)."""
+    done = False
+    for it in range(NEWTON_MAX + 1):
+        sag, dsag, ok = qtype_sag(con, c, k, coef, j, x * x + y * y)
+        if not ok:
+            return False, x, y, zl, 0.0
+        if done:
+            return True, x, y, zl, dsag
+        if it == NEWTON_MAX:
+            break
+        gp = N - 2.0 * dsag * (x * L + y * M)
+        if gp == 0.0 or not math.isfinite(gp):
+            return False, x, y, zl, 0.0
+        ds = -(zl - sag) / gp
+        x += ds * L
+        y += ds * M
+        zl += ds * N
+        done = abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl))
+    return False, x, y, zl, 0.0
 
 
 @kernel(error_model="numpy", inline="always")
@@ -221,7 +289,25 @@ def outside_aperture(geo, j, x, y):
 
 @kernel(error_model="numpy", inline="always")
 def surface_step(
-    kind, c, k, asph, geo, j, mu, sdj, clip, x, y, z, L, M, N, coaxial=False, t_before=0.0, check=-1
+    kind,
+    c,
+    k,
+    asph,
+    geo,
+    j,
+    mu,
+    sdj,
+    clip,
+    x,
+    y,
+    z,
+    L,
+    M,
+    N,
+    coaxial=False,
+    t_before=0.0,
+    check=-1,
+    qtype=True,
 ):
     """Intersect surface j and refract (or reflect). The ray is in surface j's axis frame
     (module docstring). Returns (status, x, y, z, L, M, N) with the point on the surface (axis
@@ -233,7 +319,10 @@ def surface_step(
 
     ``coaxial=True`` (a literal at the call site, for a lens without any flag: lens flag
     ``L_COAXIAL``) skips reading the surface's flags; after inlining the branches it leaves are
-    compiled away, so the coaxial path costs what it did before placements existed."""
+    compiled away, so the coaxial path costs what it did before placements existed.
+    ``qtype=False`` (a literal, for kernels that never see a Q-type surface: the tolerancing
+    instance kernels, whose lenses :func:`raytrace.tolerance.check_against_lens` refuses) leaves
+    :func:`qtype_newton` out of the compiled kernel; a Q-type surface is then MISSED."""
     fl = 0 if coaxial else int(geo[j, G_FLAGS])
     zvj = geo[j, G_ZV]
     if (fl & F_GENERAL) != 0:
@@ -273,25 +362,34 @@ def surface_step(
             x = x + s * L
             y = y + s * M
             zl = s * N
-            converged = False
-            for _ in range(NEWTON_MAX):
+            if kind == KIND_ASPHERE:
+                converged = False
+                for _ in range(NEWTON_MAX):
+                    sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
+                    if not ok:
+                        return STATUS_MISSED, x, y, z, L, M, N
+                    gp = N - 2.0 * dsag * (x * L + y * M)
+                    if gp == 0.0 or not math.isfinite(gp):
+                        return STATUS_MISSED, x, y, z, L, M, N
+                    ds = -(zl - sag) / gp
+                    x += ds * L
+                    y += ds * M
+                    zl += ds * N
+                    if abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl)):
+                        converged = True
+                        break
+                if not converged:
+                    return STATUS_MISSED, x, y, z, L, M, N
                 sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
                 if not ok:
                     return STATUS_MISSED, x, y, z, L, M, N
-                gp = N - 2.0 * dsag * (x * L + y * M)
-                if gp == 0.0 or not math.isfinite(gp):
+            elif qtype:
+                ok, x, y, zl, dsag = qtype_newton(
+                    kind == KIND_QCON, c, k, asph, j, x, y, zl, L, M, N
+                )
+                if not ok:
                     return STATUS_MISSED, x, y, z, L, M, N
-                ds = -(zl - sag) / gp
-                x += ds * L
-                y += ds * M
-                zl += ds * N
-                if abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl)):
-                    converged = True
-                    break
-            if not converged:
-                return STATUS_MISSED, x, y, z, L, M, N
-            sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
-            if not ok:
+            else:
                 return STATUS_MISSED, x, y, z, L, M, N
             nx = -2.0 * x * dsag
             ny = -2.0 * y * dsag

@@ -143,10 +143,11 @@ def _shift(origin: float, d: float | np.ndarray) -> float | np.ndarray:
 
 
 def _system(lens: Lens, wavelength: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Curvatures, thicknesses (between vertices), indices before and after each surface; after
-    an odd number of mirrors the indices are negative (n' = −n at a mirror; module docstring)."""
+    """Curvatures at the vertices (a Q-type surface's paraxial one, ``Surface.vertex_curvature``),
+    thicknesses (between vertices), indices before and after each surface; after an odd number
+    of mirrors the indices are negative (n' = −n at a mirror; module docstring)."""
     ss = lens.surfaces
-    c = np.array([s.curvature for s in ss], dtype=float)
+    c = np.array([s.vertex_curvature for s in ss], dtype=float)
     t = np.array([s.thickness for s in ss[:-1]], dtype=float)
     idx = np.array(lens.indices(wavelength)[0])  # object space, then after each surface
     if lens.has_mirrors:

@@ -541,6 +541,13 @@ def check_against_lens(spec: ToleranceSpec, lens) -> None:
             f"{lens.name}: tolerancing needs a centred lens without mirrors or coordinate breaks "
             "(the perturbations are applied to the centred design); use lens.nominal()"
         )
+    q = next((i for i, s in enumerate(lens.surfaces, start=1) if s.qtype is not None), None)
+    if q is not None:
+        raise ToleranceSpecError(
+            f"{lens.name}: surface {q} is a Q-type (Forbes) asphere: tolerancing does not model "
+            "Q-type surfaces (the perturbation model and the instance kernels hold spheres, "
+            "conics and even aspheres)"
+        )
     for it in spec.items:
         w = it.where or it.name
         for s in (it.surface, it.last, it.adjust):
