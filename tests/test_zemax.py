@@ -184,8 +184,14 @@ def _zmx_with(surface_line: str, after: str = "  DISZ 6.0") -> str:
 @pytest.mark.parametrize(
     ("edit", "needle"),
     [
-        (lambda t: t.replace("TYPE STANDARD", "TYPE TOROIDAL", 2), "STANDARD, EVENASPH and QED_TYPE"),
-        (lambda t: t.replace("TYPE STANDARD", "TYPE DGRATING", 2), "STANDARD, EVENASPH and QED_TYPE"),
+        (
+            lambda t: t.replace("TYPE STANDARD", "TYPE TOROIDAL", 2),
+            "STANDARD, EVENASPH and QED_TYPE",
+        ),
+        (
+            lambda t: t.replace("TYPE STANDARD", "TYPE DGRATING", 2),
+            "STANDARD, EVENASPH and QED_TYPE",
+        ),
         (lambda t: t.replace("TYPE STANDARD", "TYPE GRINSUR1", 2), "gradient-index"),
         (lambda t: t.replace("MODE SEQ", "MODE NSC"), "only sequential"),
         (lambda t: t.replace("FTYP 0", "FTYP 5"), r"Paraxial Image Height \(2\)"),
