@@ -16,7 +16,8 @@ measured along the conic's normal, φ = √(1 + z_conic'²) — the form optilan
 ``QED_TYPE`` file of the Thorlabs ASL5040-UV (``CONI −0.676``; tests/test_qtype.py): the
 catalog EFL of 40.000 mm and a focus corrected to 0.1 µm over its 45.72 mm pupil, where the
 k = 0 factor misses by millimetres. The Qcon form is Forbes 2007's (the conic carries the
-base; Q^con_m(x) = P_m^(0,4)(2x − 1)).
+base; Q^con_m(x) = P_m^(0,4)(2x − 1)). Beyond ρ_max the polynomials are evaluated as they are
+(optiland 0.6.3 sets the departure to 0 there; what OpticStudio does is not known here).
 
 The Qbfs sum is evaluated by Clenshaw's method in :mod:`raytrace.kernels.forbes` (the kernels
 and this module share it). The Qbfs coefficients are first changed to the basis P_m (Forbes 2010,
