@@ -170,12 +170,17 @@ def display_path(path: Path) -> str:
 
 
 @contextlib.contextmanager
-def _time_limit(seconds: float):
-    """Raise :class:`ReadTimeout` after ``seconds`` (main thread, POSIX; no limit otherwise)."""
+def time_limit(seconds: float, error: BaseException | type[BaseException] = ReadTimeout):
+    """Raise ``error`` (an exception or its class) in the block after ``seconds`` (main thread,
+    POSIX; no limit otherwise). The tests' time limit too (tests/support.py)."""
+
+    def handler(signum, frame):  # noqa: ARG001 - signal handler signature
+        raise error
+
     usable = seconds > 0 and hasattr(signal, "setitimer")
     if usable:
         try:
-            old = signal.signal(signal.SIGALRM, _raise_timeout)
+            old = signal.signal(signal.SIGALRM, handler)
         except ValueError:  # not the main thread
             usable = False
     if not usable:
@@ -187,10 +192,6 @@ def _time_limit(seconds: float):
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
-
-
-def _raise_timeout(signum, frame):  # noqa: ARG001 - signal handler signature
-    raise ReadTimeout
 
 
 def read_one(
@@ -207,7 +208,7 @@ def read_one(
     t0 = time.perf_counter()
     status, category, message, exc_type, tb = "read", None, "", "", None
     try:
-        with warnings.catch_warnings(record=True) as caught, _time_limit(timeout):
+        with warnings.catch_warnings(record=True) as caught, time_limit(timeout):
             warnings.simplefilter("always")
             loader(path)
     except ReadTimeout:
@@ -389,7 +390,7 @@ def run_referees(files: list[Path], timeout: float = 60.0) -> list[dict[str, Any
         row: dict[str, Any] = {"path": display_path(f), "orthoscope_efl": orthoscope_efl(f)}
         for name, fn in (("optiland", referee_optiland), ("rayoptics", referee_rayoptics)):
             try:
-                with _quiet(), _time_limit(timeout):
+                with _quiet(), time_limit(timeout):
                     row[name] = fn(f)
             except ImportError as e:
                 row[name] = {"status": "not installed", "error": str(e)}

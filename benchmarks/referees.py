@@ -170,6 +170,15 @@ def rayoptics_open(path: str | Path):
     return opm, scale
 
 
+def _field_point(infinite: bool, x, y, scale: float = 1.0) -> tuple[float, float]:
+    """A field point of :func:`grid` as the referee takes it: the direction tangents
+    tan(x), tan(y) of field angles in degrees (object at infinity), or the object point
+    (x, y) mm in the referee's length unit (``scale`` mm per unit)."""
+    if infinite:
+        return math.tan(math.radians(x)), math.tan(math.radians(y))
+    return x / scale, y / scale
+
+
 def rayoptics_grid(path, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, float]:
     """ray-optics' chief-ray points (…, 2) on the image surface (mm) and the largest stop
     residual of its aim (mm), for the fields of :func:`ours_grid`."""
@@ -195,10 +204,7 @@ def rayoptics_grid(path, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray
     out = np.empty(X.shape + (2,))
     worst = 0.0
     for i in np.ndindex(X.shape):
-        if infinite:
-            tx, ty = math.tan(math.radians(X[i])), math.tan(math.radians(Y[i]))
-        else:
-            tx, ty = X[i] / scale, Y[i] / scale
+        tx, ty = _field_point(infinite, X[i], Y[i], scale)
 
         def run(u, tx=tx, ty=ty):
             if infinite:
@@ -268,10 +274,7 @@ def optiland_grid(op, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, f
     out = np.empty(X.shape + (2,))
     worst = 0.0
     for i in np.ndindex(X.shape):
-        if infinite:
-            tx, ty = math.tan(math.radians(X[i])), math.tan(math.radians(Y[i]))
-        else:
-            tx, ty = X[i], Y[i]
+        tx, ty = _field_point(infinite, X[i], Y[i])
 
         def run(u, tx=tx, ty=ty):
             if infinite:

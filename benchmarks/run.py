@@ -684,6 +684,26 @@ def targets(res: dict) -> list:
     return out
 
 
+def _finish_axes(ax, xlabel: str, ylabel: str, title: str) -> None:
+    """Axis labels, title, a log-log grid and the legend of one benchmark panel."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+
+def _save(fig, path_prefix: Path, suffix: str) -> str:
+    """Write ``fig`` to ``path_prefix`` + ``suffix`` (PNG, 110 dpi), close it; the path."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    f = str(path_prefix) + suffix
+    fig.savefig(f, dpi=110)
+    plt.close(fig)
+    return f
+
+
 def plots(res: dict, path_prefix: Path) -> list[str]:
     import matplotlib
 
@@ -708,16 +728,10 @@ def plots(res: dict, path_prefix: Path) -> list[str]:
                     "o-",
                     label=f"{lens} {impl} {thr}t",
                 )
-    ax.set_xlabel("rays per call")
-    ax.set_ylabel("rays / s")
-    ax.set_title("Bulk trace throughput (incl. transfer to the image plane)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    f = str(path_prefix) + "_throughput.png"
-    fig.savefig(f, dpi=110)
-    files.append(f)
-    plt.close(fig)
+    _finish_axes(
+        ax, "rays per call", "rays / s", "Bulk trace throughput (incl. transfer to the image plane)"
+    )
+    files.append(_save(fig, path_prefix, "_throughput.png"))
 
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 5))
     for kind in ("angle", "height"):
@@ -746,11 +760,9 @@ def plots(res: dict, path_prefix: Path) -> list[str]:
         ms=12,
         label=f"through-focus map {m['planes']} planes x {m['fields']} fields",
     )
-    ax.set_xlabel("number of fields")
-    ax.set_ylabel("time per call (ms)")
-    ax.set_title("Distortion-curve latency, Cooke triplet")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    _finish_axes(
+        ax, "number of fields", "time per call (ms)", "Distortion-curve latency, Cooke triplet"
+    )
     sw = m.get("planes_sweep_200_fields", [])
     ax2.loglog(
         [r["planes"] for r in sw],
@@ -758,16 +770,13 @@ def plots(res: dict, path_prefix: Path) -> list[str]:
         "o-",
         label="characteristic_distortion, 200 fields",
     )
-    ax2.set_xlabel("number of image planes (one trace, analytic transfer)")
-    ax2.set_ylabel("time per call (ms)")
-    ax2.set_title("Through-focus map, Cooke triplet")
-    ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=7)
-    fig.tight_layout()
-    f = str(path_prefix) + "_latency.png"
-    fig.savefig(f, dpi=110)
-    files.append(f)
-    plt.close(fig)
+    _finish_axes(
+        ax2,
+        "number of image planes (one trace, analytic transfer)",
+        "time per call (ms)",
+        "Through-focus map, Cooke triplet",
+    )
+    files.append(_save(fig, path_prefix, "_latency.png"))
     return files
 
 

@@ -2,25 +2,26 @@
 image plane and compensation; Fraser & Shortis (1992) variation with object distance; radial
 distortion coefficients. Imports :mod:`raytrace`, never the CLI or the report layer."""
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from raytrace.lazy import lazy_names
 
 #: public name -> submodule; loaded on first use, so that importing one submodule (e.g. the
 #: names of the definitions for the command line's choices) does not load the others
 _NAMES: dict[str, str] = {
-    "METHODS": "calibration",
-    "CalibrationResult": "calibration",
-    "calibrate": "calibration",
-    "REFERENCES": "characteristic",
-    "CharacteristicDistortion": "characteristic",
-    "characteristic_distortion": "characteristic",
-    "CompensationResult": "compensation",
-    "compensate": "compensation",
-    "DistortionCurve": "curve",
-    "make_curve": "curve",
-    "CalibrationError": "errors",
-    "DataError": "errors",
-    "read_distortion_table": "tablefile",
+    "METHODS": ".calibration",
+    "CalibrationResult": ".calibration",
+    "calibrate": ".calibration",
+    "REFERENCES": ".characteristic",
+    "CharacteristicDistortion": ".characteristic",
+    "characteristic_distortion": ".characteristic",
+    "CompensationResult": ".compensation",
+    "compensate": ".compensation",
+    "DistortionCurve": ".curve",
+    "make_curve": ".curve",
+    "CalibrationError": ".errors",
+    "DataError": ".errors",
+    "read_distortion_table": ".tablefile",
 }
 
 if TYPE_CHECKING:
@@ -32,14 +33,7 @@ if TYPE_CHECKING:
     from .tablefile import read_distortion_table
 
 
-def __getattr__(name: str) -> Any:
-    mod = _NAMES.get(name)
-    if mod is None:
-        raise AttributeError(f"module 'distortion' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{mod}", __name__), name)
-    globals()[name] = value
-    return value
-
+__getattr__, __dir__ = lazy_names(__name__, _NAMES)
 
 __all__ = [
     "METHODS",

@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .curve import DistortionCurve
+from .curve import DistortionCurve, require_choice
 from .errors import CalibrationError
 
 if TYPE_CHECKING:
@@ -130,10 +130,7 @@ def fit_scale(
     """
     x = np.asarray(x, dtype=float)
     r = np.asarray(r, dtype=float)
-    if method not in METHODS:
-        raise CalibrationError(
-            f"unknown calibration method {method!r}; expected one of {', '.join(METHODS)}"
-        )
+    require_choice(method, METHODS, "calibration method", CalibrationError)
     if method == "given":
         if given is None or not math.isfinite(given) or given == 0.0:
             raise CalibrationError("method 'given' needs a finite nonzero calibrated constant")
@@ -292,10 +289,7 @@ def calibrate(
     """
     curve = _as_curve(distortion, plane, at)
     what = f"calibration ({method})"
-    if method not in METHODS:
-        raise CalibrationError(
-            f"unknown calibration method {method!r}; expected one of {', '.join(METHODS)}"
-        )
+    require_choice(method, METHODS, "calibration method", CalibrationError)
     if curve.fields.size < 2:
         raise CalibrationError(f"{what}: a curve needs at least two field points")
     need = {"two-point": 2, "zero-at": 1}.get(method, 0)

@@ -53,8 +53,9 @@ from raytrace.paraxial import (
     ImagePlane,
     ParaxialResult,
     orthoscopy_abscissa,
-    pestrecov_constants,
+    orthoscopy_constants,
 )
+from raytrace.trace.results import field_unit, object_words
 
 from .curve import (
     ANGLE,
@@ -64,6 +65,7 @@ from .curve import (
     fields_and_abscissa,
     plane_label,
     relative_distortion,
+    require_choice,
 )
 
 REFERENCES = ("characteristic", "distortion-focal-length", "real-chief-transport")
@@ -128,8 +130,7 @@ class CharacteristicDistortion(FieldKindMixin):
         return plane_label(self.s_prime[i], self.defocus[i])
 
     def __repr__(self) -> str:
-        unit = "mm" if self.field_kind == HEIGHT else "deg"
-        obj = "inf" if math.isinf(self.object_distance) else f"{self.object_distance:g} mm"
+        unit, obj = field_unit(self.field_kind), object_words(self.object_distance)
         planes = ", ".join(f"{v:.4g}" for v in self.s_prime[:4]) + (
             ", ..." if self.n_planes > 4 else ""
         )
@@ -261,12 +262,8 @@ def characteristic_distortion(
     )
     from raytrace.trace import aim
 
-    if reference not in REFERENCES:
-        raise TraceError(
-            f"unknown distortion reference {reference!r}; expected one of {', '.join(REFERENCES)}"
-        )
-    if scale not in SCALES:
-        raise TraceError(f"unknown scale {scale!r}; expected one of {', '.join(SCALES)}")
+    require_choice(reference, REFERENCES, "distortion reference")
+    require_choice(scale, SCALES, "scale")
     chromatic = wavelengths is not None
     if chromatic and wavelength is not None:
         raise TraceError("give wavelength= or wavelengths=, not both")
@@ -327,7 +324,7 @@ def _build(
     infinite = par.infinite
     yobj = np.full(f.shape, np.nan) if kind == ANGLE else x
     sp = np.asarray(par.s_prime_of(z), dtype=float)
-    K0 = np.array([pestrecov_constants(par, float(v)).scale for v in sp])
+    K0 = orthoscopy_constants(par, sp)
     KG = par.efl if infinite else par.m0
     n = f.size
     status = cr.status[:n].copy()
@@ -419,13 +416,9 @@ class ChromaticDistortion:
 
     def at(self, wavelength: float) -> CharacteristicDistortion:
         """The result at ``wavelength`` (nm; one of :attr:`wavelengths`)."""
-        hit = np.nonzero(self.wavelengths == float(wavelength))[0]
-        if hit.size == 0:
-            raise TraceError(
-                f"{wavelength:g} nm is not one of the wavelengths "
-                f"({', '.join(f'{w:g}' for w in self.wavelengths)} nm)"
-            )
-        return self.results[int(hit[0])]
+        from raytrace.trace.chief import wavelength_index
+
+        return self.results[wavelength_index(self.wavelengths, wavelength, "the wavelengths")]
 
     def _stack(self, name: str) -> np.ndarray:
         return np.stack([getattr(r, name) for r in self.results])

@@ -45,7 +45,7 @@ from raytrace.lens import Lens
 from raytrace.materials import LAMBDA_C, LAMBDA_F
 
 from .characteristic import ChromaticDistortion, characteristic_distortion
-from .curve import relative_distortion
+from .curve import relative_distortion, require_choice
 
 FOCUS_KINDS = ("paraxial", "best-focus")
 #: default sampling of the focal-shift curve when the lens has fewer than three wavelengths (nm)
@@ -265,8 +265,7 @@ def focal_shift(
     from raytrace.paraxial import paraxial, resolve_object_distance
     from raytrace.trace.chief import resolve_wavelengths
 
-    if kind not in FOCUS_KINDS:
-        raise TraceError(f"unknown focus kind {kind!r}; expected one of {', '.join(FOCUS_KINDS)}")
+    require_choice(kind, FOCUS_KINDS, "focus kind")
     if wavelengths is None:
         wls = tuple(float(w) for w in default_curve_wavelengths(lens))
     else:

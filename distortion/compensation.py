@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .calibration import METHODS, fit_scale, match_fields
-from .curve import DistortionCurve
+from .curve import DistortionCurve, require_choice
 from .errors import CalibrationError, DataError
 
 
@@ -117,8 +117,7 @@ def compensate(
     """
     if camera.finite:
         raise DataError("the camera curve must be for an object at infinity (field angles, F1)")
-    if method not in METHODS:
-        raise CalibrationError(f"unknown method {method!r}; expected one of {', '.join(METHODS)}")
+    require_choice(method, METHODS, "method", CalibrationError)
     F1, M2 = camera.constant, printer.constant
     y1 = camera.y0p
     yp = camera.yp

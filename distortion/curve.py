@@ -10,6 +10,7 @@ in the paper. Curves come from a trace (:mod:`distortion.characteristic`) or fro
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -26,6 +27,15 @@ ANGLE = "angle"
 HEIGHT = "height"
 NOMINAL_ANGLE = "nominal-angle"
 FIELD_KINDS = (ANGLE, HEIGHT, NOMINAL_ANGLE)
+
+
+def require_choice(
+    value: object, choices: Collection[str], what: str, error: type[Exception] = TraceError
+) -> None:
+    """Raise ``error`` with the one wording of a bad choice, ``unknown <what> <value!r>;
+    expected one of <choices>``, unless ``value`` is one of ``choices`` (names, in order)."""
+    if value not in choices:
+        raise error(f"unknown {what} {value!r}; expected one of {', '.join(choices)}")
 
 
 def relative_distortion(

@@ -59,7 +59,7 @@ from raytrace.errors import TraceError
 from raytrace.lens import Lens
 from raytrace.paraxial import ImagePlane
 
-from .curve import plane_label, relative_distortion
+from .curve import plane_label, relative_distortion, require_choice
 
 FOCALS = ("paraxial", "least-squares")
 
@@ -144,12 +144,8 @@ DEFINITIONS: dict[str, Definition] = {
 
 def definition(name: str) -> Definition:
     """The registry entry ``name``; a one-line :class:`TraceError` naming the choices otherwise."""
-    try:
-        return DEFINITIONS[name]
-    except KeyError:
-        raise TraceError(
-            f"unknown distortion definition {name!r}; expected one of {', '.join(DEFINITIONS)}"
-        ) from None
+    require_choice(name, DEFINITIONS, "distortion definition")
+    return DEFINITIONS[name]
 
 
 # ------------------------------------------------------------------ the formula layer (arrays)
@@ -158,10 +154,7 @@ def definition(name: str) -> Definition:
 def projection_heights(projection: str, theta_rad: npt.ArrayLike) -> np.ndarray:
     """``g(θ)`` of ``projection`` (a key of :data:`PROJECTIONS`) at θ in radians: the reference
     height per unit focal length."""
-    if projection not in PROJECTIONS:
-        raise TraceError(
-            f"unknown projection {projection!r}; expected one of {', '.join(PROJECTIONS)}"
-        )
+    require_choice(projection, PROJECTIONS, "projection")
     return PROJECTIONS[projection].g(np.asarray(theta_rad, dtype=float))
 
 

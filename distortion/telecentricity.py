@@ -37,8 +37,9 @@ import numpy.typing as npt
 
 from raytrace.lens import Lens
 from raytrace.paraxial import ParaxialResult
+from raytrace.trace.results import field_unit, object_words
 
-from .curve import HEIGHT, FieldKindMixin, fields_and_abscissa
+from .curve import FieldKindMixin, fields_and_abscissa
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,23 +84,27 @@ class PupilAnalysis(FieldKindMixin):
     @property
     def max_abs_cra_deg(self) -> float:
         """Largest |CRA| over the traced fields (deg): 0 for an image-side telecentric lens."""
-        v = self.cra_deg[np.isfinite(self.cra_deg)]
-        return float(np.max(np.abs(v))) if v.size else math.nan
+        return _max_abs_finite(self.cra_deg)
 
     @property
     def max_abs_viewpoint_offset(self) -> float:
-        v = self.viewpoint_offset[np.isfinite(self.viewpoint_offset)]
-        return float(np.max(np.abs(v))) if v.size else math.nan
+        """Largest |viewpoint offset| over the traced fields (mm)."""
+        return _max_abs_finite(self.viewpoint_offset)
 
     def __repr__(self) -> str:
-        unit = "mm" if self.field_kind == HEIGHT else "deg"
-        obj = "inf" if math.isinf(self.object_distance) else f"{self.object_distance:g} mm"
+        unit, obj = field_unit(self.field_kind), object_words(self.object_distance)
         return (
             f"PupilAnalysis({self.name!r}, {self.fields.size} fields "
             f"{self.fields.min():g}..{self.fields.max():g} {unit}, object {obj}, "
             f"{self.wavelength:g} nm, max |CRA| = {self.max_abs_cra_deg:.6g} deg, "
             f"max |viewpoint offset| = {self.max_abs_viewpoint_offset:.6g} mm)"
         )
+
+
+def _max_abs_finite(a: np.ndarray) -> float:
+    """Largest |a| over the finite entries of ``a`` (NaN when there are none)."""
+    v = a[np.isfinite(a)]
+    return float(np.max(np.abs(v))) if v.size else math.nan
 
 
 def pupil_analysis(
@@ -140,13 +145,13 @@ def pupil_analysis(
         orthoscopy_constant_slope,
         resolve_paraxial,
     )
-    from raytrace.trace import STATUS_OK, aim
+    from raytrace.trace import aim
 
     wl = checked_wavelength(wavelength)
     par = resolve_paraxial(lens, object_distance, object_s, object_scale, wl)
     fk, f, kind, x = fields_and_abscissa(lens, par, fields_deg, object_heights_mm)
     cr = aim(lens, f, fk, par.object_distance, wl, clip)
-    ok = cr.status == STATUS_OK
+    ok = cr.ok
 
     def only_ok(a: np.ndarray) -> np.ndarray:
         return np.where(ok, a, np.nan)

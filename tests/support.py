@@ -3,39 +3,82 @@ Import as ``from support import ...`` (pytest puts tests/ on sys.path)."""
 
 from __future__ import annotations
 
-import signal
-from contextlib import contextmanager
+import contextlib
+import importlib
+import io
+import sys
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+from types import ModuleType
 
-from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index
+import pytest
+
+from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index, model_glass
 from raytrace.optimize import DesignSpec, Operand, Variable
+
+ROOT = Path(__file__).resolve().parents[1]  # the repository
+TEST_DATA = ROOT / "tests" / "data"
+CORPUS = TEST_DATA / "corpus"  # published lens files; tests/data/corpus/SOURCES.md names each
+BENCHMARKS = ROOT / "benchmarks"
+
+
+def benchmark_module(name: str, needs: str | None = None) -> ModuleType:
+    """The harness module ``benchmarks/<name>.py`` (``referees``, ``optiland_adapter``, ...);
+    the calling test is skipped when ``needs``, the referee library it drives, is not
+    installed."""
+    if needs is not None:
+        pytest.importorskip(needs)
+    if str(BENCHMARKS) not in sys.path:
+        sys.path.insert(0, str(BENCHMARKS))
+    return importlib.import_module(name)
+
+
+def run_cli(argv: list[str]) -> tuple[int, str, str]:
+    """``orthoscope`` with ``argv``, in process: (exit status, stdout, stderr)."""
+    from orthoscope.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main(argv)
+    return rc, out.getvalue(), err.getvalue()
+
+
+def interrupt_after(calls: int) -> Callable[[int, int], None]:
+    """A ``progress(done, total)`` callback that raises KeyboardInterrupt on its ``calls``-th
+    call: a run interrupted after ``calls`` chunks."""
+    seen: list[int] = []
+
+    def progress(done: int, total: int) -> None:
+        seen.append(done)
+        if len(seen) == calls:
+            raise KeyboardInterrupt
+
+    return progress
+
+
+def with_model_glasses(lens: Lens) -> Lens:
+    """``lens`` with every catalog glass replaced by the nd/vd model glass of its printed nd and
+    vd (how the native lens files give the same glasses)."""
+    return replace(
+        lens,
+        surfaces=tuple(
+            replace(s, material=model_glass(s.material.nd, s.material.vd))
+            if s.material.kind == "catalog"
+            else s
+            for s in lens.surfaces
+        ),
+    )
 
 
 class Hang(BaseException):
     """A call that ran past its :func:`time_limit` (not an Exception: no reader may swallow it)."""
 
 
-@contextmanager
 def time_limit(seconds: float):
     """Raise :class:`Hang` in the block after ``seconds`` (POSIX main thread; no limit
-    otherwise)."""
-    if not hasattr(signal, "setitimer"):
-        yield
-        return
-
-    def handler(signum, frame):
-        raise Hang(f"took more than {seconds} s")
-
-    try:
-        old = signal.signal(signal.SIGALRM, handler)
-    except ValueError:  # not in the main thread
-        yield
-        return
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
+    otherwise): benchmarks/corpus.py's time limit."""
+    return benchmark_module("corpus").time_limit(seconds, Hang(f"took more than {seconds} s"))
 
 
 def singlet(n=1.5, f=100.0, t=0.3, fnum=20.0) -> Lens:
@@ -68,6 +111,46 @@ def singlet_spec(**settings) -> DesignSpec:
 
 #: the sensor of the camera-model tests (px): odd and non-square
 CAMERA_W, CAMERA_H = 3001, 1999
+
+#: the OpenCV distortion terms of the camera-model tests, every one nonzero (a model order's
+#: subset: ``distortion.camera.OPENCV_ORDERS[n]``)
+OPENCV_TERMS = dict(
+    k1=-0.08,
+    k2=0.02,
+    p1=4e-4,
+    p2=-6e-4,
+    k3=-0.003,
+    k4=0.004,
+    k5=-0.002,
+    k6=0.001,
+    s1=3e-4,
+    s2=-2e-4,
+    s3=-4e-4,
+    s4=1e-4,
+    tau_x=0.012,
+    tau_y=-0.008,
+)
+
+
+def fisheye_camera(fx: float, fy: float):
+    """An OpenCV fisheye camera on the CAMERA_W x CAMERA_H sensor: focal lengths ``fx``, ``fy``
+    (px), principal point (1523.4, 987.6) px, alpha 0.002, k1..k4 = 0.03, -0.006, 0.001, -1e-4."""
+    from distortion.camera import CameraModel
+
+    return CameraModel.create(
+        "opencv_fisheye",
+        CAMERA_W,
+        CAMERA_H,
+        fx=fx,
+        fy=fy,
+        cx=1523.4,
+        cy=987.6,
+        alpha=0.002,
+        k1=0.03,
+        k2=-0.006,
+        k3=0.001,
+        k4=-1e-4,
+    )
 
 
 def metashape_camera():

@@ -8,13 +8,11 @@ for the files written; the synthetic calibrations of tests/data/camera (make_mea
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import TEST_DATA, run_cli
 
 import orthoscope as osc
 from distortion.camera import (
@@ -27,20 +25,15 @@ from distortion.camera import (
     read_calibration,
     traced_models_by_distance,
 )
-from orthoscope.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT / "tests" / "data" / "camera"
+DATA = TEST_DATA / "camera"
 BASE = ["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pixels", "1200x800", "--grid", "9x7"]
 
 
 def run(argv, cwd=None, monkeypatch=None):
     if cwd is not None:
         monkeypatch.chdir(cwd)
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(argv)
-    return rc, out.getvalue(), err.getvalue()
+    return run_cli(argv)
 
 
 @pytest.fixture(scope="module")

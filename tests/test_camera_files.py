@@ -12,7 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from support import CAMERA_H, CAMERA_W, australis_camera, metashape_camera
+from support import (
+    CAMERA_H,
+    CAMERA_W,
+    OPENCV_TERMS,
+    australis_camera,
+    fisheye_camera,
+    metashape_camera,
+)
 
 from distortion.camera import (
     OPENCV_ORDERS,
@@ -30,22 +37,6 @@ W, H = CAMERA_W, CAMERA_H
 
 
 def _opencv(n=14):
-    vals = dict(
-        k1=-0.08,
-        k2=0.02,
-        p1=4e-4,
-        p2=-6e-4,
-        k3=-0.003,
-        k4=0.004,
-        k5=-0.002,
-        k6=0.001,
-        s1=3e-4,
-        s2=-2e-4,
-        s3=-4e-4,
-        s4=1e-4,
-        tau_x=0.012,
-        tau_y=-0.008,
-    )
     return CameraModel.create(
         "opencv",
         W,
@@ -54,24 +45,11 @@ def _opencv(n=14):
         fy=3190.5,
         cx=1523.4,
         cy=987.6,
-        **{k: vals[k] for k in OPENCV_ORDERS[n]},
+        **{k: OPENCV_TERMS[k] for k in OPENCV_ORDERS[n]},
     )
 
 
-FISHEYE = CameraModel.create(
-    "opencv_fisheye",
-    W,
-    H,
-    fx=900.0,
-    fy=905.0,
-    cx=1523.4,
-    cy=987.6,
-    alpha=0.002,
-    k1=0.03,
-    k2=-0.006,
-    k3=0.001,
-    k4=-1e-4,
-)
+FISHEYE = fisheye_camera(fx=900.0, fy=905.0)
 
 
 @pytest.mark.parametrize("ext", ["yml", "json"])

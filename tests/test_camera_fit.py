@@ -11,7 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from support import CAMERA_H, CAMERA_W, australis_camera, metashape_camera
+from support import (
+    CAMERA_H,
+    CAMERA_W,
+    OPENCV_TERMS,
+    australis_camera,
+    fisheye_camera,
+    metashape_camera,
+)
 
 from distortion.camera import (
     OPENCV_ORDERS,
@@ -35,6 +42,13 @@ def _cv(**kw):
     return CameraModel.create("opencv", W, H, **base)
 
 
+def _colmap(model, **terms):
+    """A COLMAP camera (COLMAP's pixel-centre convention: principal point 1523.9, 988.1)."""
+    return CameraModel.create(
+        f"colmap:{model}", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, **terms
+    )
+
+
 def _correspondences(cam, grid=(25, 17)):
     uv = sensor_grid(W, H, grid)
     back = unproject(cam, uv, pixels="opencv")
@@ -44,54 +58,12 @@ def _correspondences(cam, grid=(25, 17)):
 
 TRUTHS = [
     _cv(k1=-0.08, k2=0.02, p1=4e-4, p2=-6e-4, k3=-0.003),
-    _cv(
-        k1=-0.08,
-        k2=0.02,
-        p1=4e-4,
-        p2=-6e-4,
-        k3=-0.003,
-        k4=0.004,
-        k5=-0.002,
-        k6=0.001,
-        s1=3e-4,
-        s2=-2e-4,
-        s3=-4e-4,
-        s4=1e-4,
-        tau_x=0.012,
-        tau_y=-0.008,
-    ),
-    CameraModel.create(
-        "opencv_fisheye",
-        W,
-        H,
-        fx=1400.0,
-        fy=1410.0,
-        cx=1523.4,
-        cy=987.6,
-        alpha=0.002,
-        k1=0.03,
-        k2=-0.006,
-        k3=0.001,
-        k4=-1e-4,
-    ),
-    CameraModel.create(
-        "colmap:OPENCV",
-        W,
-        H,
-        fx=3210.0,
-        fy=3190.0,
-        cx=1523.9,
-        cy=988.1,
-        k1=-0.08,
-        k2=0.02,
-        p1=4e-4,
-        p2=-6e-4,
-    ),
-    CameraModel.create("colmap:FOV", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, omega=0.6),
-    CameraModel.create("colmap:DIVISION", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, k=-0.05),
-    CameraModel.create(
-        "colmap:EUCM", W, H, fx=3210.0, fy=3190.0, cx=1523.9, cy=988.1, alpha=0.5, beta=1.1
-    ),
+    _cv(**OPENCV_TERMS),
+    fisheye_camera(fx=1400.0, fy=1410.0),
+    _colmap("OPENCV", k1=-0.08, k2=0.02, p1=4e-4, p2=-6e-4),
+    _colmap("FOV", omega=0.6),
+    _colmap("DIVISION", k=-0.05),
+    _colmap("EUCM", alpha=0.5, beta=1.1),
     metashape_camera(),
     australis_camera(),
 ]

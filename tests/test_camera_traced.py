@@ -36,10 +36,10 @@ import math
 import re
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import ROOT, TEST_DATA, benchmark_module
 
 import orthoscope as osc
 from distortion.camera import (
@@ -66,22 +66,12 @@ from distortion.camera import (
 from distortion.camera.models import OPENCV_ORDERS, project
 from distortion.errors import DataError
 
-ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT / "tests" / "data" / "corpus"
-DATA = ROOT / "tests" / "data" / "camera"
+DATA = TEST_DATA / "camera"
 
 
 @pytest.fixture(scope="module")
 def cooke():
     return osc.load_lens("cooke-triplet-f4")
-
-
-def _optiland():
-    pytest.importorskip("optiland")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import optiland_adapter as ola
-
-    return ola
 
 
 def _load(name: str):
@@ -160,7 +150,7 @@ def test_toml_camera_spec(tmp_path, cooke):
 
 # ------------------------------------------------------------------------------ correspondences
 def test_image_points_equal_optiland_chief_rays(cooke):
-    ola = _optiland()
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     s = Sensor.from_spec(size="28x19", pixels="2800x1900")
     pts = trace_camera_points(cooke, CameraSetup(s, grid=(11, 9)))
     op = ola.build_optic(cooke)
@@ -188,7 +178,7 @@ def test_image_points_equal_optiland_chief_rays(cooke):
 
 
 def test_finite_object_projection_centre_is_the_paraxial_entrance_pupil(cooke):
-    ola = _optiland()
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     s = Sensor.from_spec(size="24x16", pixels="3000x2000")
     pts = trace_camera_points(cooke, CameraSetup(s, object_distance=1500, focus="2m", grid=(9, 7)))
     epl = float(ola.build_optic(cooke).paraxial.EPL())  # optiland: E0 from the first vertex
@@ -462,7 +452,7 @@ def _check_decentering_signs(ideal, image_px, sensor, d, tmp_path):
 def test_decentered_element_signs_in_every_format_with_optiland_rays(cooke, tmp_path):
     """The Cooke triplet with its third element (surfaces 5, 6) decentered by d along +y
     (optiland 0.6.3 places the surfaces with dy), its real chief rays on a small sensor."""
-    ola = _optiland()
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     s = Sensor.from_spec(size="9x9", pixels="3000x3000")
     a = np.degrees(np.arctan(np.linspace(-1.0, 1.0, 11) * math.tan(math.radians(5.0))))
     X, Y = np.meshgrid(a, a)

@@ -9,18 +9,15 @@ angle-field definition, tan(field_x), tan(field_y) — optiland/fields/field_typ
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import benchmark_module
 
 from raytrace.errors import TraceError
 from raytrace.files.library import load_lens
 from raytrace.paraxial import paraxial
 from raytrace.trace import STATUS_AIM_FAILED, STATUS_OK, chief_rays, chief_rays_2d
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def _grid(fmax: float, n: int = 9):
@@ -158,6 +155,17 @@ def test_bad_requests():
         chief_rays_2d(lens)
 
 
+def _optiland_chief_points(op, lens, X, Y):
+    """optiland's chief-ray points (…, 2) on its image surface (mm) for the fields ``X``, ``Y`` in
+    its field units (normalised by its max field), at the lens's wavelength."""
+    fmax = float(op.fields.max_field)
+    rays = op.trace_generic(
+        Hx=(X / fmax).ravel(), Hy=(Y / fmax).ravel(), Px=0.0, Py=0.0,
+        wavelength=lens.wavelength / 1000.0,
+    )  # fmt: skip
+    return np.stack([np.asarray(rays.x), np.asarray(rays.y)], -1).reshape(np.shape(X) + (2,))
+
+
 @pytest.mark.parametrize(
     "name", ["cooke-triplet-f4", "topogon-us2031792-fig1", "topogon-like-pestrecov"]
 )
@@ -165,30 +173,18 @@ def test_2d_chief_ray_image_points_agree_with_optiland(name):
     """optiland 0.6.3: its own chief rays (Px = Py = 0) aimed at the stop centre by its iterative
     aimer (tolerance 1e-13), for normalised fields Hx, Hy × its max field with its angle-field
     convention (direction tangents tan(field_x), tan(field_y)), on its image surface."""
-    pytest.importorskip("optiland")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import optiland_adapter as ola
-
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     lens = load_lens(name)
     op = ola.build_optic(lens)
     op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-13)
-    fmax = float(op.fields.max_field)
     X, Y = _grid(lens.field.value, 9)
     cr = chief_rays_2d(lens, X, Y)
     ours = cr.positions_at(paraxial(lens).z_image_file)
-    rays = op.trace_generic(
-        Hx=(X / fmax).ravel(), Hy=(Y / fmax).ravel(), Px=0.0, Py=0.0,
-        wavelength=lens.wavelength / 1000.0,
-    )  # fmt: skip
-    theirs = np.stack([np.asarray(rays.x), np.asarray(rays.y)], -1).reshape(ours.shape)
-    assert np.max(np.abs(ours - theirs)) <= 1e-9
+    assert np.max(np.abs(ours - _optiland_chief_points(op, lens, X, Y))) <= 1e-9
 
 
 def test_finite_object_heights_agree_with_optiland():
-    pytest.importorskip("optiland")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import optiland_adapter as ola
-
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     lens = load_lens("cooke-triplet-f4").with_object_distance(500.0)
     op = ola.build_optic(lens)
     op.fields.fields.clear()  # the adapter's angle fields → object heights (mm)
@@ -200,10 +196,4 @@ def test_finite_object_heights_agree_with_optiland():
     X, Y = np.meshgrid(a, a)
     cr = chief_rays_2d(lens, object_x_mm=X, object_y_mm=Y)
     ours = cr.positions_at(paraxial(lens).z_image_file)
-    fmax = float(op.fields.max_field)
-    rays = op.trace_generic(
-        Hx=(X / fmax).ravel(), Hy=(Y / fmax).ravel(), Px=0.0, Py=0.0,
-        wavelength=lens.wavelength / 1000.0,
-    )  # fmt: skip
-    theirs = np.stack([np.asarray(rays.x), np.asarray(rays.y)], -1).reshape(ours.shape)
-    assert np.max(np.abs(ours - theirs)) <= 1e-9
+    assert np.max(np.abs(ours - _optiland_chief_points(op, lens, X, Y))) <= 1e-9

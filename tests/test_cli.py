@@ -235,7 +235,7 @@ def test_broken_lens_file_via_console_script(tmp_path, name):
     exe = shutil.which("orthoscope")
     f = tmp_path / name
     f.write_text(BROKEN[name])
-    cmd = [exe] if exe else [sys.executable, "-m", "distortion.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "orthoscope"]
     p = subprocess.run([*cmd, "trace", str(f)], capture_output=True, text=True, cwd=tmp_path)
     assert p.returncode == 2
     assert name in p.stderr and "Traceback" not in p.stderr

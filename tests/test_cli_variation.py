@@ -1,4 +1,5 @@
-"""CLI: ``orthoscope variation`` and ``orthoscope coefficients`` (distortion.cli_variation).
+"""CLI: ``orthoscope variation`` and ``orthoscope coefficients`` (:mod:`orthoscope.cli.variation`,
+:mod:`orthoscope.cli.coefficients`).
 
 Sources: Fraser & Shortis (1992) Table 1 (Pentax, lenses/fraser-shortis-1992-table1-pentax.csv)
 and the paper's text (γ = 1.04, 0.98, 0.97 for 12x with 8x, 16x, 20x); synthetic profiles with
@@ -24,6 +25,13 @@ def run(capsys, *argv):
     rc = main([str(a) for a in argv])
     out, err = capsys.readouterr()
     return rc, out, err
+
+
+def run_s65(capsys, objects, *argv):
+    """``variation`` in prescription mode: S65 focused at 12x, the objects ``objects``, fields
+    to 45°."""
+    head = ["variation", *S65, "--focus", "12x", "--objects", objects, "--max-field", "45"]
+    return run(capsys, *head, *argv)
 
 
 def test_help_teaches_units_signs_and_image_scale(capsys):
@@ -60,20 +68,7 @@ def test_pentax_json(capsys):
 
 def test_prescription_mode_csv_and_roundtrip(capsys, tmp_path):
     prof = tmp_path / "s65.csv"
-    rc, out, err = run(
-        capsys,
-        "variation",
-        *S65,
-        "--focus",
-        "12x",
-        "--objects",
-        "8x,16x,20x",
-        "--max-field",
-        "45",
-        "--csv",
-        "--profiles-csv",
-        prof,
-    )
+    rc, out, err = run_s65(capsys, "8x,16x,20x", "--csv", "--profiles-csv", prof)
     assert rc == 0 and not err
     rows = out.strip().splitlines()
     assert rows[0].startswith("focus,object,gamma,g,se")
@@ -90,37 +85,12 @@ def test_prescription_mode_csv_and_roundtrip(capsys, tmp_path):
 
 def test_prescription_mode_text_json_and_plots(capsys, tmp_path):
     p1, p2 = tmp_path / "p.png", tmp_path / "g.png"
-    rc, out, _ = run(
-        capsys,
-        "variation",
-        *S65,
-        "--focus",
-        "12x",
-        "--objects",
-        "8x,20x",
-        "--max-field",
-        "45",
-        "--plot",
-        p1,
-        "--plot-g",
-        p2,
-    )
+    rc, out, _ = run_s65(capsys, "8x,20x", "--plot", p1, "--plot-g", p2)
     assert rc == 0
     assert "Prescription mode" in out and "Brown Eq. (1) prediction" in out
     assert "8×(12×)" in out and "mean g =" in out
     assert p1.stat().st_size > 1000 and p2.stat().st_size > 1000
-    rc, out, _ = run(
-        capsys,
-        "variation",
-        *S65,
-        "--focus",
-        "12x",
-        "--objects",
-        "8x",
-        "--max-field",
-        "45",
-        "--json",
-    )
+    rc, out, _ = run_s65(capsys, "8x", "--json")
     d = json.loads(out)
     assert d["mode"] == "prescription" and d["efl_mm"] == pytest.approx(65.0)
 

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import with_model_glasses
 
 from raytrace.errors import PrescriptionError
 from raytrace.files import convert
@@ -58,15 +59,7 @@ def test_hand_written_seq_equals_native(stem):
     # NSK16_SCHOTT is the Schott catalog glass; the native file has its nd/vd as a model glass
     # (same d-line index to the catalog's printed digits); compare exactly with that model.
     assert any(s.material.kind == "catalog" for s in lens.surfaces) == (stem == "cooke-triplet-f4")
-    lens = replace(
-        lens,
-        surfaces=tuple(
-            replace(s, material=model_glass(s.material.nd, s.material.vd))
-            if s.material.kind == "catalog"
-            else s
-            for s in lens.surfaces
-        ),
-    )
+    lens = with_model_glasses(lens)
     # the file's image solve ran with the catalog glasses: solve it again for the model glasses
     lens = replace(
         lens.with_image_distance(paraxial(lens).gaussian_image_distance), image_solve="gaussian"

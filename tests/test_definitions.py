@@ -15,11 +15,10 @@ difference: e.g. 0.039 % of Dr at 20° for the Cooke triplet, 0.11 % at 45° for
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import CORPUS, benchmark_module
 
 import orthoscope as osc
 from distortion.definitions import (
@@ -32,9 +31,6 @@ from distortion.definitions import (
 )
 from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index
 from raytrace.errors import TraceError
-
-ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT / "tests" / "data" / "corpus"
 
 #: bundled lenses (object at infinity; the Twinplex-like moved to infinity, so that its file's
 #: image plane — the Gaussian plane of its 44.8 mm object — is a strongly defocused plane there)
@@ -66,14 +62,6 @@ def _lens(name: str) -> Lens:
     return lens.with_object_distance(math.inf) if math.isfinite(lens.object_distance) else lens
 
 
-def _optiland():
-    pytest.importorskip("optiland")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import optiland_adapter as ola
-
-    return ola
-
-
 def _optiland_percent(op, kind: str, wavelength_nm: float) -> np.ndarray:
     from optiland.analysis import Distortion
 
@@ -89,7 +77,7 @@ def _fields(op) -> np.ndarray:
 
 @pytest.mark.parametrize("name", BUNDLED + REAL)
 def test_f_tan_and_f_theta_agree_with_optiland(name):
-    ola = _optiland()
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     lens = _lens(name)
     if lens.field.value == 0.0:
         pytest.fail(f"{name}: no field to compare")
@@ -111,7 +99,7 @@ def test_f_tan_and_f_theta_agree_with_optiland(name):
 def test_per_wavelength_agrees_with_optiland(wavelength):
     # optiland built with our indices at that wavelength; ours: one call for both wavelengths,
     # each against its own paraxial f ("own"), in the lens file's plane
-    ola = _optiland()
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     lens = osc.load_lens("cooke-triplet-f4")
     op = ola.build_optic(lens, wavelength_nm=wavelength)
     op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-14)
@@ -139,7 +127,7 @@ def test_optilands_default_paraxial_aim_is_reproduced(name):
     # optiland's default (paraxial) aim: the chief ray leaves at θ toward the centre of the
     # PARAXIAL entrance pupil E0. Traced with our tracer the same way, the two agree; the
     # difference from the real-stop chief ray is the pupil aberration (bounded here by its size)
-    ola = _optiland()
+    ola = benchmark_module("optiland_adapter", needs="optiland")
     lens = osc.load_lens(name)
     op = ola.build_optic(lens)  # default aim
     theta = _fields(op)

@@ -4,16 +4,15 @@ exits with status 0; every Python block of the README runs."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import re
 import shlex
 import shutil
 from pathlib import Path
 
 import pytest
+from support import run_cli
 
-from orthoscope.cli import build_parser, main
+from orthoscope.cli import build_parser
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
@@ -61,10 +60,8 @@ def scratch(tmp_path_factory):
 def _run(cmd: str, cwd: Path, monkeypatch) -> tuple[int, str]:
     argv = shlex.split(cmd)[1:]
     monkeypatch.chdir(cwd)
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(argv)
-    return rc, err.getvalue()
+    rc, _, err = run_cli(argv)
+    return rc, err
 
 
 def test_examples_were_found():

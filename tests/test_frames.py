@@ -11,13 +11,12 @@ files of the corpus, optiland's surface coordinate systems for the Zemax files.
 from __future__ import annotations
 
 import math
-import sys
 import warnings
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import CORPUS, benchmark_module
 
 from raytrace.files import read_lens_file
 from raytrace.files.library import load_lens
@@ -36,8 +35,6 @@ from raytrace.frames import (
 from raytrace.lens import Surface
 from raytrace.packing import pack
 
-ROOT = Path(__file__).resolve().parents[1]
-CORPUS = ROOT / "tests" / "data" / "corpus"
 CODEV_PLACED = [
     "rayoptics/dar_test.seq",
     "rayoptics/dec_rev_tilt_test.seq",
@@ -173,11 +170,16 @@ def test_codev_reader_maps_the_decenter_types():
     assert dar[1].placement == dar[2].placement == Placement((0, 1.0, 0), codev_tilt(45.0, 0, 0))
 
 
+def _assert_same_frame(rotation, origin, our_rotation, our_origin, origin_tol):
+    """A referee's frame (rotation matrix, origin in mm) equals ours: rotation to 1e-12,
+    origin to ``origin_tol`` mm."""
+    assert np.max(np.abs(np.asarray(rotation) - our_rotation)) <= 1e-12
+    assert np.max(np.abs(np.asarray(origin) - our_origin)) <= origin_tol
+
+
 @pytest.mark.parametrize("rel", CODEV_PLACED)
 def test_codev_frames_equal_rayoptics(rel):
-    pytest.importorskip("rayoptics")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import referees
+    referees = benchmark_module("referees", needs="rayoptics")
     from rayoptics.elem.transform import compute_global_coords
 
     lens = _read(rel)
@@ -187,19 +189,16 @@ def test_codev_frames_equal_rayoptics(rel):
     n = lens.n_surfaces
     for j in range(n):
         r, t = tf[j + 1]
-        assert np.max(np.abs(r - fr.rotation[j])) <= 1e-12
-        assert np.max(np.abs(np.asarray(t) * scale - fr.origin[j])) <= 1e-11
+        _assert_same_frame(r, np.asarray(t) * scale, fr.rotation[j], fr.origin[j], 1e-11)
     r, t = tf[n + 1]
-    assert np.max(np.abs(r - fr.image_surface_rotation)) <= 1e-12
-    assert np.max(np.abs(np.asarray(t) * scale - fr.image_surface_origin)) <= 1e-11
+    _assert_same_frame(
+        r, np.asarray(t) * scale, fr.image_surface_rotation, fr.image_surface_origin, 1e-11
+    )
 
 
 @pytest.mark.parametrize("rel", ZEMAX_PLACED)
 def test_zemax_frames_equal_optiland(rel):
-    pytest.importorskip("optiland")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import referees
-
+    referees = benchmark_module("referees", needs="optiland")
     lens = _read(rel)
     fr = surface_frames(lens)
     op = referees.optiland_open(CORPUS / rel)
@@ -208,8 +207,7 @@ def test_zemax_frames_equal_optiland(rel):
     assert len(theirs) == len(ours)
     for srf, j in zip(theirs, ours, strict=True):
         t, R = srf.geometry.cs.get_effective_transform()
-        assert np.max(np.abs(np.asarray(R) - fr.rotation[j])) <= 1e-12
-        assert np.max(np.abs(np.asarray(t) - fr.origin[j])) <= 1e-10
+        _assert_same_frame(R, t, fr.rotation[j], fr.origin[j], 1e-10)
 
 
 def test_centred_lens_has_exact_identity_frames_and_the_coaxial_table():

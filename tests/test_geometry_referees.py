@@ -20,24 +20,19 @@ The comparisons run when the referee imports (ray-optics is not a declared extra
 from __future__ import annotations
 
 import math
-import sys
 import warnings
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import benchmark_module
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
+from raytrace.files import read_lens_file
+from raytrace.files.library import load_lens
+from raytrace.files.zemax import dumps_zmx
+from raytrace.frames import Placement
 
-import referees as R  # noqa: E402
-
-from raytrace.files import read_lens_file  # noqa: E402
-from raytrace.files.library import load_lens  # noqa: E402
-from raytrace.files.zemax import dumps_zmx  # noqa: E402
-from raytrace.frames import Placement  # noqa: E402
-
+R = benchmark_module("referees")
 TOL = 1e-9  # mm, issue 15
 
 
@@ -47,15 +42,19 @@ def _read(rel):
         return read_lens_file(R.CORPUS / rel)
 
 
+def _assert_agree(ours, referee):
+    """``referee`` = (its chief-ray points, its aim residual) agrees with ``ours`` to TOL."""
+    theirs, res = referee
+    assert res <= 1e-11  # the referee's own aim converged
+    assert np.max(np.abs(ours - theirs)) <= TOL
+
+
 @pytest.mark.parametrize("rel", sorted(R.RAYOPTICS_FILES))
 def test_corpus_chief_rays_agree_with_rayoptics(rel):
     pytest.importorskip("rayoptics")
     lens = _read(rel)
     X, Y = R.grid(R.RAYOPTICS_FILES[rel])
-    ours = R.ours_grid(lens, X, Y)
-    theirs, res = R.rayoptics_grid(R.CORPUS / rel, lens, X, Y)
-    assert res <= 1e-11  # the referee's own aim converged
-    assert np.max(np.abs(ours - theirs)) <= TOL
+    _assert_agree(R.ours_grid(lens, X, Y), R.rayoptics_grid(R.CORPUS / rel, lens, X, Y))
 
 
 @pytest.mark.parametrize("rel", sorted(R.OPTILAND_FILES))
@@ -63,10 +62,8 @@ def test_corpus_chief_rays_agree_with_optiland(rel):
     pytest.importorskip("optiland")
     lens = _read(rel)
     X, Y = R.grid(R.OPTILAND_FILES[rel])
-    ours = R.ours_grid(lens, X, Y)
-    theirs, res = R.optiland_grid(R.optiland_open(R.CORPUS / rel), lens, X, Y)
-    assert res <= 1e-11
-    assert np.max(np.abs(ours - theirs)) <= TOL
+    op = R.optiland_open(R.CORPUS / rel)
+    _assert_agree(R.ours_grid(lens, X, Y), R.optiland_grid(op, lens, X, Y))
 
 
 # ---------------------------------------------------------------- published prescriptions
@@ -115,9 +112,7 @@ def test_moved_published_lens_agrees_with_optiland(name, tmp_path):
         cs.rx, cs.ry = math.radians(ax), math.radians(ay)  # right-handed, as ours
     X, Y = _fields(moved)
     ours = R.ours_grid(moved, X, Y)
-    theirs, res = R.optiland_grid(op, moved, X, Y)
-    assert res <= 1e-11
-    assert np.max(np.abs(ours - theirs)) <= TOL
+    _assert_agree(ours, R.optiland_grid(op, moved, X, Y))
     # the moves matter: the moved lens differs from the nominal one by far more than TOL
     assert np.max(np.abs(ours - R.ours_grid(nominal, X, Y))) > 1e-3
 
@@ -146,8 +141,7 @@ def test_moved_published_lens_agrees_with_rayoptics(name, tmp_path):
     orig = R.rayoptics_open
     try:
         R.rayoptics_open = lambda p: (opm, 1.0)
-        theirs, res = R.rayoptics_grid(path, moved, X, Y)
+        referee = R.rayoptics_grid(path, moved, X, Y)
     finally:
         R.rayoptics_open = orig
-    assert res <= 1e-11
-    assert np.max(np.abs(ours - theirs)) <= TOL
+    _assert_agree(ours, referee)

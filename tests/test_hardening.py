@@ -9,10 +9,8 @@ one line, within a second, also inside a long kernel run; two threads trace at o
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import importlib
-import io
 import os
 import shutil
 import signal
@@ -24,8 +22,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import run_cli
 
-from orthoscope.cli import COMMANDS, build_parser, main
+from orthoscope.cli import COMMANDS, build_parser
 
 ROOT = Path(__file__).resolve().parents[1]
 LENS_NAMES = ("cooke-triplet-f4", "topogon-us2031792-fig1", "twinplex-like-55-525")
@@ -75,13 +74,6 @@ def _materialize(argv: list[str], work: Path) -> list[str]:
     return out
 
 
-def _run(argv: list[str]) -> tuple[int, str, str]:
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(argv)
-    return rc, out.getvalue(), err.getvalue()
-
-
 def _with_output(argv: list[str], flag: str, path: Path) -> list[str]:
     argv = list(argv)
     if flag == "OUT":  # a positional output: the last argument of the sample
@@ -112,7 +104,7 @@ def test_every_command_has_samples():
 @pytest.mark.parametrize("mod,argv", _samples())
 def test_sample_runs(mod, argv, work, monkeypatch):
     monkeypatch.chdir(work)
-    rc, _, err = _run(_materialize(argv, work))
+    rc, _, err = run_cli(_materialize(argv, work))
     assert rc == 0, err
 
 
@@ -125,7 +117,7 @@ def test_output_onto_an_input_is_refused_and_the_input_survives(
     target = _first_input(full)
     before = target.read_bytes()
     for force in ([], ["--force"]):
-        rc, _, err = _run(_with_output(full, flag, target) + force)
+        rc, _, err = run_cli(_with_output(full, flag, target) + force)
         assert rc == 2, err
         assert "input file" in err and len(_error_lines(err)) == 1, err
         assert target.read_bytes() == before
@@ -137,10 +129,10 @@ def test_existing_output_needs_force(argv, flag, suffix, work, monkeypatch):
     out = work / f"existing{suffix}"
     out.write_bytes(b"precious")
     full = _with_output(_materialize(argv, work), flag, out)
-    rc, _, err = _run(full)
+    rc, _, err = run_cli(full)
     assert rc == 2 and "--force" in err, err
     assert out.read_bytes() == b"precious"
-    rc, _, err = _run(full + ["--force"])
+    rc, _, err = run_cli(full + ["--force"])
     assert rc == 0, err
     assert out.read_bytes() != b"precious"
 
@@ -156,7 +148,7 @@ def test_failing_disk_leaves_the_old_file_and_no_fragment(argv, flag, suffix, wo
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(os, "fsync", full_disk)
-    rc, _, err = _run(_with_output(_materialize(argv, work), flag, out) + ["--force"])
+    rc, _, err = run_cli(_with_output(_materialize(argv, work), flag, out) + ["--force"])
     assert rc == 2, err
     assert "No space left" in err and len(_error_lines(err)) == 1, err
     assert out.read_bytes() == b"precious"
@@ -176,7 +168,7 @@ def _wavelength_samples():
 @pytest.mark.parametrize("mod,argv", _wavelength_samples())
 def test_wavelength_in_the_wrong_unit_is_one_clear_line(mod, argv, work, monkeypatch):
     monkeypatch.chdir(work)
-    rc, _, err = _run(_materialize(argv, work) + ["--wavelength", "0.5876"])
+    rc, _, err = run_cli(_materialize(argv, work) + ["--wavelength", "0.5876"])
     assert rc == 2
     assert "micrometres" in err and "0.5876um" in err and len(err.strip().splitlines()) == 1
 

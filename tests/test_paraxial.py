@@ -3,6 +3,7 @@
 import math
 
 import pytest
+from support import benchmark_module
 
 from raytrace import AIR, Aperture, Field, Lens, LensError, Surface, fixed_index, model_glass
 from raytrace.paraxial import paraxial
@@ -76,13 +77,19 @@ def test_stop_at_first_surface_pupil_is_stop():
     assert p.stop_radius == pytest.approx(5.0, rel=1e-12)
 
 
-def test_pestrecov_constants_gaussian_plane_equal_m0_and_f():
-    # Pestrecov Eqs. (7)-(8): in the Gaussian plane M0 = m0 and F0 = f.
+def _two_menisci(r3: float) -> Lens:
+    """Two meniscus elements (glass 1.62/60, radii 25 / 60 and ``r3`` / -25 mm, 4 mm thick) 3 mm
+    either side of a central stop, 40 mm to the image: ``r3`` = -60 makes it symmetric."""
     g = model_glass(1.62, 60.0)
-    lens = make(
-        [(25.0, 4.0, g), (60.0, 3.0, None), (0, 3.0, None), (-60.0, 4.0, g), (-25.0, 40.0, None)],
+    return make(
+        [(25.0, 4.0, g), (60.0, 3.0, None), (0, 3.0, None), (r3, 4.0, g), (-25.0, 40.0, None)],
         stop=2,
     )
+
+
+def test_pestrecov_constants_gaussian_plane_equal_m0_and_f():
+    # Pestrecov Eqs. (7)-(8): in the Gaussian plane M0 = m0 and F0 = f.
+    lens = _two_menisci(-60.0)  # symmetric about its stop
     pi = paraxial(lens)
     c = pestrecov_constants(pi, pi.s_prime_gauss)
     assert c.infinite and c.scale == pytest.approx(pi.efl, rel=1e-12)
@@ -98,12 +105,7 @@ def test_pestrecov_constants_gaussian_plane_equal_m0_and_f():
 
 
 def test_paraxial_chief_heights_linear_in_tan():
-    g = model_glass(1.62, 60.0)
-    lens = make(
-        [(25.0, 4.0, g), (60.0, 3.0, None), (0, 3.0, None), (-50.0, 4.0, g), (-25.0, 40.0, None)],
-        stop=2,
-    )
-    p = paraxial(lens)
+    p = paraxial(_two_menisci(-50.0))
     h = paraxial_chief_heights(p, [0.0, 5.0], "angle", p.z_Fp)
     # at the focal plane the paraxial image height is f tan(alpha)
     assert h[1] == pytest.approx(p.efl * math.tan(math.radians(5.0)), rel=1e-12)
@@ -132,13 +134,9 @@ def test_object_space_na_follows_optiland():
     """Object-space NA → entrance-pupil diameter: the project's convention is optiland's
     (ObjectNAAperture.compute_epd, optiland 0.6.3): EPD = 2 |z_E0 − z_obj| tan(asin(NA/n)).
     Checked against optiland's own paraxial EPD for the same lens and object."""
-    pytest.importorskip("optiland")
-    import sys
     from dataclasses import replace
-    from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-    import optiland_adapter as ola
+    ola = benchmark_module("optiland_adapter", needs="optiland")
 
     from raytrace.files.library import load_lens
     from raytrace.lens import Aperture

@@ -235,6 +235,18 @@ def _surface_case(old: str, new: str, surface: int, words: str) -> None:
     assert words in str(err), str(err)
 
 
+def _file_case(old: str, new: str, at: str, *words: str) -> PrescriptionError:
+    """The bundled Cooke file with ``old`` replaced by ``new`` fails on the line that contains
+    ``at``, saying each of ``words``."""
+    text = COOKE.replace(old, new)
+    assert text != COOKE
+    err = _fails(text)
+    assert err.line == _line_of(text, at)
+    for w in words:
+        assert w in str(err), str(err)
+    return err
+
+
 def test_unknown_key_typo_suggests() -> None:
     _surface_case(
         "t = 6.0,        ",
@@ -305,17 +317,17 @@ def test_surfaces_crossing_at_semi_diameter() -> None:
 
 
 def test_two_stops() -> None:
-    text = COOKE.replace("{ r = 141.25,  t = 2.0,", "{ r = 141.25,  t = 2.0, stop = true,")
-    err = _fails(text)
-    assert err.surface == 5 and err.line == _line_of(text, "r = 141.25")
-    assert "two or more stops (surfaces 4 and 5)" in str(err)
+    err = _file_case(
+        "{ r = 141.25,  t = 2.0,",
+        "{ r = 141.25,  t = 2.0, stop = true,",
+        "r = 141.25",
+        "two or more stops (surfaces 4 and 5)",
+    )
+    assert err.surface == 5
 
 
 def test_no_stop() -> None:
-    text = COOKE.replace("stop = true", "label = 'S4'")
-    err = _fails(text)
-    assert err.line == _line_of(text, "surfaces = [")
-    assert "no surface is the aperture stop" in str(err)
+    _file_case("stop = true", "label = 'S4'", "surfaces = [", "no surface is the aperture stop")
 
 
 def test_missing_aperture() -> None:
@@ -326,39 +338,42 @@ def test_missing_aperture() -> None:
 
 
 def test_two_aperture_kinds() -> None:
-    text = COOKE.replace("{ fnumber = 4.0 }", "{ fnumber = 4.0, epd = 12.5 }")
-    err = _fails(text)
-    assert err.line == _line_of(text, "aperture =")
-    assert "exactly one of fnumber / epd / na / float / working_fnumber / cone_angle " in str(err)
-    assert "(got: fnumber, epd)" in str(err)
+    _file_case(
+        "{ fnumber = 4.0 }",
+        "{ fnumber = 4.0, epd = 12.5 }",
+        "aperture =",
+        "exactly one of fnumber / epd / na / float / working_fnumber / cone_angle ",
+        "(got: fnumber, epd)",
+    )
 
 
 def test_units_other_than_mm() -> None:
-    text = COOKE.replace('units      = "mm"', 'units      = "in"')
-    err = _fails(text)
-    assert err.line == _line_of(text, "units")
-    assert 'units must be "mm"' in str(err)
+    _file_case('units      = "mm"', 'units      = "in"', "units", 'units must be "mm"')
 
 
 def test_unknown_top_level_key() -> None:
-    text = COOKE.replace("wavelength = ", "wavelenght = ")
-    err = _fails(text)
-    assert err.line == _line_of(text, "wavelenght")
-    assert "unknown key 'wavelenght' in the file (did you mean 'wavelength'?)" in str(err)
+    _file_case(
+        "wavelength = ",
+        "wavelenght = ",
+        "wavelenght",
+        "unknown key 'wavelenght' in the file (did you mean 'wavelength'?)",
+    )
 
 
 def test_surfaces_after_a_table_header() -> None:
-    text = COOKE.replace("field    = { angle = 20.0 }", "[field]\nangle = 20.0")
-    err = _fails(text)
-    assert err.line == _line_of(text, "surfaces = [")
-    assert "must come before the first [table] header" in str(err)
+    _file_case(
+        "field    = { angle = 20.0 }",
+        "[field]\nangle = 20.0",
+        "surfaces = [",
+        "must come before the first [table] header",
+    )
 
 
 def test_lens_error_is_converted_with_line() -> None:
-    text = COOKE.replace("wavelength = 587.5618", "wavelength = 0.5876")
-    err = _fails(text)
-    assert err.line == _line_of(text, "wavelength =")
-    assert "looks like micrometres" in str(err)  # raytrace.units.wavelength_nm
+    # the message is raytrace.units.wavelength_nm's
+    _file_case(
+        "wavelength = 587.5618", "wavelength = 0.5876", "wavelength =", "looks like micrometres"
+    )
 
 
 def test_virtual_gaussian_image() -> None:
@@ -402,11 +417,8 @@ def test_invalid_utf8(tmp_path: Path) -> None:
 
 
 def test_toml_syntax_error_keeps_line() -> None:
-    text = COOKE.replace("{ r = -20.25,", "{ r = -20.25 ")
-    err = _fails(text)
-    line = _line_of(text, "{ r = -20.25 ")
-    assert err.line == line
-    assert "TOML syntax error" in str(err) and f"at line {line}" in str(err)
+    err = _file_case("{ r = -20.25,", "{ r = -20.25 ", "{ r = -20.25 ", "TOML syntax error")
+    assert f"at line {err.line}" in str(err)
 
 
 def test_missing_file(tmp_path: Path) -> None:

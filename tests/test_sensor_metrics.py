@@ -23,20 +23,18 @@ give (W_c/W)/(H_c/H) = (1 + K1 a²)/(1 + K1 b²).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import io
 import json
 import math
 
 import numpy as np
 import pytest
+from support import run_cli
 
 from distortion.characteristic import characteristic_distortion
 from distortion.errors import DataError
 from distortion.grid import distortion_grid
 from distortion.sensor_metrics import sensor_metrics, sensor_metrics_from_points
-from orthoscope.cli import main
 from raytrace.files.library import load_lens
 
 
@@ -173,42 +171,26 @@ def test_errors_name_the_fix(grid36, cooke):
         sensor_metrics(grid36, plane=3)
 
 
-def _run(argv):
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(argv)
-    return rc, out.getvalue(), err.getvalue()
+#: the Cooke triplet's sensor metrics on a 24 x 16 mm sensor, 13 x 9 grid
+METRICS_ARGV = [
+    "distortion",
+    "cooke-triplet-f4",
+    "--sensor",
+    "24x16",
+    "--grid",
+    "13x9",
+    "--sensor-metrics",
+]
 
 
 def test_cli_sensor_metrics_json_equals_the_api(cooke):
-    rc, out, err = _run(
-        [
-            "distortion",
-            "cooke-triplet-f4",
-            "--sensor",
-            "24x16",
-            "--grid",
-            "13x9",
-            "--sensor-metrics",
-            "--json",
-        ]
-    )
+    rc, out, err = run_cli([*METRICS_ARGV, "--json"])
     assert rc == 0, err
     js = json.loads(out)["sensor_metrics"][0]
     m = sensor_metrics(distortion_grid(cooke, sensor="24x16", grid=(13, 9)))
     assert js["tv_distortion_smia"] == m.tv_distortion_smia
     assert js["straightness"]["top"]["sag_mm"] == m.line("top").sag_mm
-    rc, out, err = _run(
-        [
-            "distortion",
-            "cooke-triplet-f4",
-            "--sensor",
-            "24x16",
-            "--grid",
-            "13x9",
-            "--sensor-metrics",
-        ]
-    )
+    rc, out, err = run_cli(METRICS_ARGV)
     assert rc == 0 and "SMIA 1.0" in out and f"{100 * m.tv_distortion_smia:+.4f} %" in out
 
 
@@ -220,6 +202,6 @@ def test_cli_sensor_metrics_json_equals_the_api(cooke):
     ],
 )
 def test_cli_refuses_with_one_line(argv, words):
-    rc, out, err = _run(["distortion", "cooke-triplet-f4", *argv])
+    rc, out, err = run_cli(["distortion", "cooke-triplet-f4", *argv])
     lines = [ln for ln in err.splitlines() if "compiling the ray-tracing kernels" not in ln]
     assert rc == 2 and len(lines) == 1 and words in lines[0] and ": error:" in lines[0], err

@@ -10,28 +10,18 @@ after a resumed interruption").
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 from pathlib import Path
 
 import numpy as np
 import pytest
-
-from orthoscope.cli import main
+from support import run_cli
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "lenses" / "tolerances" / "cooke-triplet-f4.toml"
 LENS = "cooke-triplet-f4"
 FIELDS = "0,10,20"
 BASE = ["tolerance", LENS, str(SPEC), "--fields", FIELDS, "--quiet"]
-
-
-def run(argv):
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(argv)
-    return rc, out.getvalue(), err.getvalue()
 
 
 @pytest.fixture(scope="module")
@@ -48,8 +38,8 @@ def api_run():
 
 
 def test_text_run_reports_envelope_spreads_and_yield(api_run):
-    rc, out, err = run(BASE + ["--samples", "48", "--seed", "3", "--chunk", "16",
-                               "--limit", "20@20"])  # fmt: skip
+    rc, out, err = run_cli(BASE + ["--samples", "48", "--seed", "3", "--chunk", "16",
+                                   "--limit", "20@20"])  # fmt: skip
     assert rc == 0, err
     assert "48 lenses" in out and "seed 3" in out
     assert api_run.generator in out
@@ -64,8 +54,8 @@ def test_text_run_reports_envelope_spreads_and_yield(api_run):
 
 
 def test_json_is_the_api_summary_plus_yield(api_run):
-    rc, out, err = run(BASE + ["--samples", "48", "--seed", "3", "--chunk", "16",
-                               "--limit", "15@10", "--json"])  # fmt: skip
+    rc, out, err = run_cli(BASE + ["--samples", "48", "--seed", "3", "--chunk", "16",
+                                   "--limit", "15@10", "--json"])  # fmt: skip
     assert rc == 0, err
     d = json.loads(out)
     mc = d["monte_carlo"]
@@ -82,12 +72,12 @@ def test_json_is_the_api_summary_plus_yield(api_run):
 def test_sensitivity_table_lists_every_item_and_the_rss():
     from raytrace.tolerance import read_tolerance_spec
 
-    rc, out, err = run(BASE + ["--sensitivity"])
+    rc, out, err = run_cli(BASE + ["--sensitivity"])
     assert rc == 0, err
     assert "Sensitivity of" in out and "RSS" in out
     for name in read_tolerance_spec(SPEC).names():
         assert name in out
-    rc, out, err = run(BASE + ["--sensitivity", "--json"])
+    rc, out, err = run_cli(BASE + ["--sensitivity", "--json"])
     assert rc == 0, err
     s = json.loads(out)["sensitivity"]
     ranked = s["outputs"][s["ranked_by"]]["items"]
@@ -97,11 +87,11 @@ def test_sensitivity_table_lists_every_item_and_the_rss():
 
 def test_plot_is_written_and_never_overwritten_without_force(tmp_path):
     png = tmp_path / "tol.png"
-    rc, out, err = run(BASE + ["--samples", "16", "--plot", str(png)])
+    rc, out, err = run_cli(BASE + ["--samples", "16", "--plot", str(png)])
     assert rc == 0, err
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     before = png.read_bytes()
-    rc, out, err = run(BASE + ["--samples", "16", "--plot", str(png)])
+    rc, out, err = run_cli(BASE + ["--samples", "16", "--plot", str(png)])
     assert rc == 2 and "--force" in err and len(err.strip().splitlines()) == 1
     assert png.read_bytes() == before
 
@@ -120,16 +110,16 @@ def test_interrupted_run_keeps_chunks_and_resumes_bit_identical(tmp_path, monkey
             raise KeyboardInterrupt
 
     monkeypatch.setattr(cli.Progress, "__call__", interrupt_after_two_chunks)
-    rc, out, err = run(argv)
+    rc, out, err = run_cli(argv)
     assert rc == 130, err
     assert "resume" in err and len(err.strip().splitlines()) == 1
     manifest = json.loads((run_dir / "manifest.json").read_text())
     assert 2 <= len(manifest["done"]) < 4
     monkeypatch.setattr(cli.Progress, "__call__", real_call)
-    rc, out, err = run(argv)
+    rc, out, err = run_cli(argv)
     assert rc == 0, err
     resumed = json.loads(out)["monte_carlo"]
-    rc, out, err = run(BASE + ["--samples", "64", "--seed", "5", "--chunk", "32", "--json"])
+    rc, out, err = run_cli(BASE + ["--samples", "64", "--seed", "5", "--chunk", "32", "--json"])
     assert rc == 0, err
     fresh = json.loads(out)["monte_carlo"]
     assert resumed == fresh  # bit-identical after resumption and with another chunk size
@@ -147,7 +137,7 @@ def test_interrupted_run_keeps_chunks_and_resumes_bit_identical(tmp_path, monkey
 def test_bad_spec_is_one_line_exit_2(tmp_path, text, words):
     bad = tmp_path / "bad.toml"
     bad.write_text(text + "\n")
-    rc, out, err = run(["tolerance", LENS, str(bad), "--sensitivity"])
+    rc, out, err = run_cli(["tolerance", LENS, str(bad), "--sensitivity"])
     assert rc == 2
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert words in err and "bad.toml" in err
@@ -164,7 +154,7 @@ def test_bad_spec_is_one_line_exit_2(tmp_path, text, words):
     ],
 )
 def test_bad_flags_are_one_line_exit_2(extra, words):
-    rc, out, err = run(BASE + extra)
+    rc, out, err = run_cli(BASE + extra)
     assert rc == 2, err
     assert words in err and len(err.strip().splitlines()) == 1
 

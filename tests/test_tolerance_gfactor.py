@@ -6,13 +6,12 @@ sum of squares of its sensitivities; the spec key, the flag and the errors."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
 
 import numpy as np
 import pytest
+from support import run_cli
 
 from distortion.errors import DataError
 from distortion.tolerance import evaluate, monte_carlo, prepare, sensitivity
@@ -158,8 +157,6 @@ def test_g_errors_are_one_clear_line(cooke, kw, err, words):
 
 
 def test_cli_reports_g_spread_histogram_and_json(tmp_path):
-    from orthoscope.cli import main
-
     spec = tmp_path / "spec.toml"
     spec.write_text(
         '[[tolerances]]\ntype = "TRAD"\nsurface = 1\nlimit = 0.05\n'
@@ -167,30 +164,23 @@ def test_cli_reports_g_spread_histogram_and_json(tmp_path):
     )
     base = ["tolerance", "cooke-triplet-f4", str(spec), "--fields", "0,5,10,15,20", "--quiet",
             "--samples", "24", "--seed", "2"]  # fmt: skip
-
-    def run(argv):
-        out, err = io.StringIO(), io.StringIO()
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            rc = main(argv)
-        return rc, out.getvalue(), err.getvalue()
-
-    rc, out, err = run(base)
+    rc, out, err = run_cli(base)
     assert rc == 0, err
     assert "g: not computed" in out
-    rc, out, err = run(base + ["--g-object-distance", "10x"])
+    rc, out, err = run_cli(base + ["--g-object-distance", "10x"])
     assert rc == 0, err
     assert "variation factor g_ss'" in out and "determined for 24 of 24 lenses" in out
     assert "histogram" in out and "p50" in out
-    rc, out, err = run(base + ["--g-object-distance", "10x", "--json"])
+    rc, out, err = run_cli(base + ["--g-object-distance", "10x", "--json"])
     assert rc == 0, err
     mc = json.loads(out)["monte_carlo"]
     assert mc["stats"]["g"]["n"] == 24 and 0.1 < mc["stats"]["g"]["mean"] < 2.0
     assert mc["units"]["g"] == "1"
-    rc, out, err = run(base[:-4] + ["--sensitivity", "--g-object-distance", "10x", "--json"])
+    rc, out, err = run_cli(base[:-4] + ["--sensitivity", "--g-object-distance", "10x", "--json"])
     assert rc == 0, err
     s = json.loads(out)["sensitivity"]
     assert "g" in s["outputs"] and len(s["outputs"]["g"]["items"]) == 2
-    rc, out, err = run(base + ["--g-object-distance", "inf"])
+    rc, out, err = run_cli(base + ["--g-object-distance", "inf"])
     assert rc == 2 and len(err.strip().splitlines()) == 1 and "focus" in err
 
 

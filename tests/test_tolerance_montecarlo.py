@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pytest
+from support import interrupt_after
 
 from distortion.tolerance import monte_carlo, prepare, sensitivity
 from raytrace.errors import OutputError
@@ -81,16 +82,9 @@ def test_chunk_size_does_not_change_any_instance(cooke, setup, mc64):
 
 
 def test_resume_after_an_interruption_gives_the_same_summary(cooke, setup, mc64, tmp_path):
-    seen = []
-
-    def stop_after_two(done, total):
-        seen.append(done)
-        if len(seen) == 2:
-            raise KeyboardInterrupt
-
     with pytest.raises(KeyboardInterrupt):
         monte_carlo(cooke, _spec(), 150, seed=11, chunk_size=64, setup=setup, out_dir=tmp_path,
-                    progress=stop_after_two)  # fmt: skip
+                    progress=interrupt_after(2))  # fmt: skip
     m = json.loads((tmp_path / "manifest.json").read_text())
     assert m["done"] == [0, 1] and m["n"] == 150 and m["seed"] == 11
     assert not (tmp_path / "summary.json").exists()

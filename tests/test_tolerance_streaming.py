@@ -10,6 +10,7 @@ import json
 
 import numpy as np
 import pytest
+from support import interrupt_after, run_cli
 
 from distortion.tolerance import monte_carlo, prepare
 from distortion.tolerance.summary import StreamingSummary
@@ -73,15 +74,8 @@ def test_streamed_summary_is_bit_identical_across_chunk_sizes(cooke, setup, stre
 
 
 def test_streamed_summary_after_resume_is_bit_identical(cooke, setup, streamed, tmp_path):
-    seen = []
-
-    def stop(done, total):
-        seen.append(done)
-        if len(seen) == 3:
-            raise KeyboardInterrupt
-
     with pytest.raises(KeyboardInterrupt):
-        _run(cooke, setup, "streaming", 40, out_dir=tmp_path, progress=stop)
+        _run(cooke, setup, "streaming", 40, out_dir=tmp_path, progress=interrupt_after(3))
     r = _run(cooke, setup, "streaming", 40, out_dir=tmp_path)
     assert r.resumed_chunks == 3
     assert json.dumps(r.summary()) == json.dumps(streamed.summary())
@@ -190,11 +184,6 @@ def test_values_outside_the_first_block_range_are_counted_not_guessed():
 
 
 def test_cli_streaming_run_reports_and_plots(tmp_path):
-    import contextlib
-    import io
-
-    from orthoscope.cli import main
-
     spec = tmp_path / "spec.toml"
     spec.write_text(
         '[[tolerances]]\ntype = "TRAD"\nsurface = 1\nlimit = 0.05\n'
@@ -204,11 +193,8 @@ def test_cli_streaming_run_reports_and_plots(tmp_path):
     argv = ["tolerance", "cooke-triplet-f4", str(spec), "--fields", "0,5,10,15,20", "--quiet",
             "--samples", "40", "--seed", "2", "--summary", "streaming", "--limit", "30@20",
             "--g-object-distance", "10x", "--plot", str(png)]  # fmt: skip
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        rc = main(argv)
-    assert rc == 0, err.getvalue()
-    text = out.getvalue()
+    rc, text, err = run_cli(argv)
+    assert rc == 0, err
     assert "streamed chunk by chunk" in text and "% of lenses have |D| < 30 µm at 20°" in text
     assert "variation factor g_ss'" in text and "histogram" in text
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

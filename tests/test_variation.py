@@ -349,11 +349,16 @@ def test_plots_written(tmp_path):
 # --------------------------------------------------------------------------------------------
 
 
-def test_csv_missing_focus_object_columns(tmp_path):
-    path = _write_csv(tmp_path / "a.csv", [(1, 2.0), (2, 3.0)], header="r_mm,dr_um")
+def _read_fails(path: Path) -> str:
+    """The message of the DataError that reading the profiles CSV ``path`` raises."""
     with pytest.raises(DataError) as ei:
         read_profiles_csv(path)
-    msg = str(ei.value)
+    return str(ei.value)
+
+
+def test_csv_missing_focus_object_columns(tmp_path):
+    path = _write_csv(tmp_path / "a.csv", [(1, 2.0), (2, 3.0)], header="r_mm,dr_um")
+    msg = _read_fails(path)
     assert msg.startswith(f"{path}:1:")
     assert "missing column(s) 'focus', 'object'" in msg
 
@@ -366,18 +371,15 @@ def test_csv_unit_not_stated(tmp_path):
 
 def test_csv_single_profile(tmp_path):
     path = _write_csv(tmp_path / "c.csv", [(10, 2.0, "12x", "8x"), (20, 5.0, "12x", "8x")])
-    with pytest.raises(DataError) as ei:
-        read_profiles_csv(path)
-    assert "1 profile(s) (focus 12x, object 8x)" in str(ei.value)
-    assert "needs at least two profiles" in str(ei.value)
+    msg = _read_fails(path)
+    assert "1 profile(s) (focus 12x, object 8x)" in msg
+    assert "needs at least two profiles" in msg
 
 
 def test_csv_mixed_units_in_a_column(tmp_path):
     rows = [(10, 2.0, "12x", "8x"), (20, 5.0, "12x", "8x"), (10, 2.0, "12x", 1.5)]
     path = _write_csv(tmp_path / "d.csv", rows)
-    with pytest.raises(DataError) as ei:
-        read_profiles_csv(path)
-    msg = str(ei.value)
+    msg = _read_fails(path)
     assert msg.startswith(f"{path}:4:")
     assert "column 'object' mixes units: metres ('1.5') here, image scales ('8x') on line 2" in msg
 

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import with_model_glasses
 
 from raytrace.errors import PrescriptionError
 from raytrace.files import convert
@@ -115,15 +116,7 @@ def test_hand_written_fixture_matches_native(stem):
     for s in imported.surfaces:
         if s.material.kind == "catalog":
             assert s.material.index(587.5618) == pytest.approx(s.material.nd, abs=5e-6)
-    imported = replace(
-        imported,
-        surfaces=tuple(
-            replace(s, material=model_glass(s.material.nd, s.material.vd))
-            if s.material.kind == "catalog"
-            else s
-            for s in imported.surfaces
-        ),
-    )
+    imported = with_model_glasses(imported)
     assert imported.name == native.name
     assert imported.aperture == native.aperture
     # the file lists its field points (Field.points); the native file gives the maximum only

@@ -50,6 +50,7 @@ import re
 import sys
 import warnings
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -169,6 +170,14 @@ class Sheet:
             if isinstance(v, str) and rx.fullmatch(_clean(v)):
                 return c
         raise SystemExit(f"{self.path.name}: no header {pattern!r} in row {row + 1}")
+
+    def find_run(self, row: int, patterns: tuple[str, ...], start: int = 0) -> int:
+        """Column of the first of the consecutive header cells in ``row`` that match
+        ``patterns`` in turn (found from column ``start``)."""
+        c = self.find(row, patterns[0], start)
+        for k, pattern in enumerate(patterns[1:], start=1):
+            self.expect(row, c + k, pattern)
+        return c
 
     def expect(self, row: int, col: int, pattern: str) -> None:
         v = _clean(self.df.iat[row, col])
@@ -310,101 +319,145 @@ def _transmission(sh: Sheet, r: int, cols: list[tuple[int, float]]) -> list[tupl
     return sorted(pts)
 
 
+def _header_run(sh: Sheet, row: int, start: int, value) -> list[tuple[int, float]]:
+    """[(col, value(header))] over the consecutive header cells of ``row`` from column ``start``
+    that ``value`` reads (a cell it gives None for ends the run): a transmission block and its
+    wavelengths (nm)."""
+    out = []
+    for c in range(start, sh.df.shape[1]):
+        v = value(sh.cell(row, c))
+        if v is None:
+            break
+        out.append((c, v))
+    return out
+
+
+def _labelled(pattern: str):
+    """A header reader for :func:`_header_run`: the number in group 1 of ``pattern`` (e.g.
+    ``TAUI10/(.+)``, ``(\\d+)nm``), None for a header that does not match."""
+
+    def value(head) -> float | None:
+        m = re.fullmatch(pattern, _clean(head))
+        return float(m.group(1)) if m else None
+
+    return value
+
+
+def _all_numbers(sh: Sheet, r: int, cols) -> list[float] | None:
+    """The numbers of row ``r`` in ``cols``, or None when any of them is blank."""
+    vals = [_num(sh.cell(r, c)) for c in cols]
+    return None if any(v is None for v in vals) else vals
+
+
+@dataclass(frozen=True, eq=False)
+class Columns:
+    """Where a vendor sheet keeps the fields of a glass row (0-based columns)."""
+
+    name: int
+    vd: int
+    ve: int
+    index: list[tuple[int, str, float]]  # (col, label, λ nm) of the refractive-index block
+    decimals: dict[int, int]  # printed decimals per index column
+    transmission: list[tuple[int, float]]  # (col, λ nm) of the internal transmittance
+    dndt: list[int] | None = None  # D0 D1 D2 E0 E1 λTK; None: the sheet gives none
+    nd: int | None = None  # None: nd and ne are read among the index columns
+    ne: int | None = None
+
+
+def _row_record(
+    sh: Sheet,
+    r: int,
+    at: Columns,
+    formula: int,
+    coefs: list[float],
+    *,
+    source: str,
+    thickness: float = 10.0,
+    status: str = "",
+) -> dict:
+    """The record of the glass in row ``r`` of ``sh``: name, indices, Abbe numbers, dn/dT and
+    transmission (``thickness`` mm) from the columns ``at``; the dispersion formula from the
+    caller."""
+    ind = _indices(sh, r, at.index, at.decimals)
+    if at.nd is None:
+        nd = next(v for lab, _, v, _ in ind if lab == "nd")
+        ne = next((v for lab, _, v, _ in ind if lab == "ne"), None)
+    else:
+        nd, ne = _num(sh.cell(r, at.nd)), _num(sh.cell(r, at.ne))
+    return _record(
+        _clean(sh.cell(r, at.name)),
+        formula,
+        coefs,
+        ind,
+        nd=nd,
+        vd=_num(sh.cell(r, at.vd)),
+        ne=ne,
+        ve=_num(sh.cell(r, at.ve)),
+        dndt=None if at.dndt is None else _all_numbers(sh, r, at.dndt),
+        transmission=(thickness, _transmission(sh, r, at.transmission)),
+        status=status,
+        source=source,
+    )
+
+
+def _sellmeier_records(sh: Sheet, rows: list[int], at: Columns, c0: int, source: str) -> list[dict]:
+    """The records of a Sellmeier sheet: the rows whose constants B1 B2 B3 C1 C2 C3 (columns
+    ``c0`` on) are all given, as AGF formula 2 (Sellmeier 1: K1 L1 K2 L2 K3 L3)."""
+    out = []
+    for r in rows:
+        b = _all_numbers(sh, r, range(c0, c0 + 6))
+        if b is not None:
+            coefs = [b[0], b[3], b[1], b[4], b[2], b[5]]
+            out.append(_row_record(sh, r, at, 2, coefs, source=source))
+    return out
+
+
 def read_schott(path: Path, source: str) -> list[dict]:
     sh = Sheet(path, "Datatable")
     H = 3
     sh.expect(H, 0, "Glass")
     nd_c, ne_c, vd_c, ve_c = (sh.find(H, x) for x in ("nd", "ne", "vd", "ve"))
-    b1 = sh.find(H, "B1")
-    for k, lab in enumerate(("B1", "B2", "B3", "C1", "C2", "C3")):
-        sh.expect(H, b1 + k, lab)
-    d0 = sh.find(H, "D0")
-    for k, lab in enumerate(("D0", "D1", "D2", "E0", "E1", "lambda")):
-        sh.expect(H, d0 + k, lab)
-    i0, i1 = sh.find(H, r"n2325\.4"), sh.find(H, r"n248\.3")
-    cols = _index_columns(sh, H, i0, i1)
-    t0 = sh.find(H, r"TAUI10/2500")
-    tcols = []
-    c = t0
-    while c < sh.df.shape[1] and str(sh.cell(H, c)).startswith("TAUI10/"):
-        tcols.append((c, float(str(sh.cell(H, c)).split("/")[1])))
-        c += 1
+    b1 = sh.find_run(H, ("B1", "B2", "B3", "C1", "C2", "C3"))
+    d0 = sh.find_run(H, ("D0", "D1", "D2", "E0", "E1", "lambda"))
+    cols = _index_columns(sh, H, sh.find(H, r"n2325\.4"), sh.find(H, r"n248\.3"))
+    tcols = _header_run(sh, H, sh.find(H, r"TAUI10/2500"), _labelled(r"TAUI10/(.+)"))
     rows = _rows(sh, H + 1, 0)
-    dec = _printed(sh, rows, cols)
-    out = []
-    for r in rows:
-        b = [_num(sh.cell(r, b1 + k)) for k in range(6)]
-        if any(v is None for v in b):
-            continue
-        # AGF Sellmeier 1 order: K1 L1 K2 L2 K3 L3
-        coefs = [b[0], b[3], b[1], b[4], b[2], b[5]]
-        dndt = [_num(sh.cell(r, d0 + k)) for k in range(6)]
-        out.append(
-            _record(
-                _clean(sh.cell(r, 0)),
-                2,
-                coefs,
-                _indices(sh, r, cols, dec),
-                nd=_num(sh.cell(r, nd_c)),
-                vd=_num(sh.cell(r, vd_c)),
-                ne=_num(sh.cell(r, ne_c)),
-                ve=_num(sh.cell(r, ve_c)),
-                dndt=None if any(v is None for v in dndt) else dndt,
-                transmission=(10.0, _transmission(sh, r, tcols)),
-                source=source,
-            )
-        )
-    return out
+    at = Columns(
+        name=0,
+        nd=nd_c,
+        ne=ne_c,
+        vd=vd_c,
+        ve=ve_c,
+        index=cols,
+        decimals=_printed(sh, rows, cols),
+        transmission=tcols,
+        dndt=list(range(d0, d0 + 6)),
+    )
+    return _sellmeier_records(sh, rows, at, b1, source)
 
 
 def _ohara_sheet(sh: Sheet, source: str) -> list[dict]:
     H = 1
     sh.expect(H, 1, "Glass")
-    i0, i1 = sh.find(H, "n2325"), sh.find(H, "ni")
-    cols = _index_columns(sh, H, i0, i1)
+    cols = _index_columns(sh, H, sh.find(H, "n2325"), sh.find(H, "ni"))
     # two Abbe columns each: the first rounded to 0.1, the second to 0.01 (use the latter)
     vds = [c for c in range(sh.df.shape[1]) if _clean(sh.cell(H, c)) == "νd"]
     ves = [c for c in range(sh.df.shape[1]) if _clean(sh.cell(H, c)) == "νe"]
-    a1 = sh.find(H, "A1", start=sh.find(0, r"CONSTANTS OF DISPERSION FORMULA \(Sellmeier\)"))
-    for k, lab in enumerate(("A1", "A2", "A3", "B1", "B2", "B3")):
-        sh.expect(H, a1 + k, lab)
-    d0 = sh.find(H, "D0")
-    for k, lab in enumerate(("D0", "D1", "D2", "E0", "E1", "λTK")):
-        sh.expect(H, d0 + k, lab)
+    sellmeier = sh.find(0, r"CONSTANTS OF DISPERSION FORMULA \(Sellmeier\)")
+    a1 = sh.find_run(H, ("A1", "A2", "A3", "B1", "B2", "B3"), start=sellmeier)
+    d0 = sh.find_run(H, ("D0", "D1", "D2", "E0", "E1", "λTK"))
     t0 = sh.find(0, r"INTERNAL TRANSMISSION \(τ／10mm Thick\)")
-    tcols = []
-    c = t0
-    while c < sh.df.shape[1] and _num(sh.cell(H, c)) is not None:
-        tcols.append((c, _num(sh.cell(H, c))))
-        c += 1
     rows = _rows(sh, H + 1, 1)
-    dec = _printed(sh, rows, cols)
-    out = []
-    for r in rows:
-        a = [_num(sh.cell(r, a1 + k)) for k in range(6)]
-        if any(v is None for v in a):
-            continue
-        coefs = [a[0], a[3], a[1], a[4], a[2], a[5]]
-        dndt = [_num(sh.cell(r, d0 + k)) for k in range(6)]
-        ind = _indices(sh, r, cols, dec)
-        nd = next(v for lab, _, v, _ in ind if lab == "nd")
-        ne = next((v for lab, _, v, _ in ind if lab == "ne"), None)
-        out.append(
-            _record(
-                _clean(sh.cell(r, 1)),
-                2,
-                coefs,
-                ind,
-                nd=nd,
-                vd=_num(sh.cell(r, vds[-1])),
-                ne=ne,
-                ve=_num(sh.cell(r, ves[-1])),
-                dndt=None if any(v is None for v in dndt) else dndt,
-                transmission=(10.0, _transmission(sh, r, tcols)),
-                source=source,
-            )
-        )
-    return out
+    at = Columns(
+        name=1,
+        vd=vds[-1],
+        ve=ves[-1],
+        index=cols,
+        decimals=_printed(sh, rows, cols),
+        transmission=_header_run(sh, H, t0, _num),
+        dndt=list(range(d0, d0 + 6)),
+    )
+    return _sellmeier_records(sh, rows, at, a1, source)
 
 
 def read_ohara(path: Path, source: str) -> list[dict]:
@@ -421,24 +474,23 @@ def read_hoya(path: Path, source: str) -> list[dict]:
     nd_c, vd_c = _col("E"), _col("F")
     sh.expect(1, nd_c, "nd")
     sh.expect(1, vd_c, "νd")
-    ne_c, ve_c = sh.find(1, "ne"), sh.find(1, "νe")
     i0 = sh.find(1, r"n1529\.6")
-    i1 = sh.find(1, "ni", start=i0)
-    cols = _index_columns(sh, 1, i0, i1, lam_row=3)
-    a0 = sh.find(1, "A0")
-    for k, lab in enumerate(("A0", "A0pow", "A1", "A1pow", "A2", "A2pow", "A3", "A3pow")):
-        sh.expect(1, a0 + k, lab)
-    d0 = sh.find(2, "D0")
-    for k, lab in enumerate(("D0", "D1", "D2", "E0", "E１", "λTk")):
-        sh.expect(2, d0 + k, lab)
+    cols = _index_columns(sh, 1, i0, sh.find(1, "ni", start=i0), lam_row=3)
+    a0 = sh.find_run(1, ("A0", "A0pow", "A1", "A1pow", "A2", "A2pow", "A3", "A3pow"))
+    d0 = sh.find_run(2, ("D0", "D1", "D2", "E0", "E１", "λTk"))
     t0 = sh.find(1, r"Internal Transmittance \(10mmt\)")
-    tcols = []
-    c = t0
-    while c < sh.df.shape[1] and _num(sh.cell(3, c)) is not None:
-        tcols.append((c, _num(sh.cell(3, c))))
-        c += 1
     rows = [r for r in _rows(sh, 4, 2) if _num(sh.cell(r, nd_c)) is not None]
-    dec = _printed(sh, rows, cols)
+    at = Columns(
+        name=2,
+        nd=nd_c,
+        ne=sh.find(1, "ne"),
+        vd=vd_c,
+        ve=sh.find(1, "νe"),
+        index=cols,
+        decimals=_printed(sh, rows, cols),
+        transmission=_header_run(sh, 3, t0, _num),
+        dndt=list(range(d0, d0 + 6)),
+    )
     out = []
     for r in rows:
         pairs = [(_num(sh.cell(r, a0 + 2 * k)), _num(sh.cell(r, a0 + 2 * k + 1))) for k in range(6)]
@@ -446,68 +498,32 @@ def read_hoya(path: Path, source: str) -> list[dict]:
             continue
         # mantissa × 10**pow, printed so; float(f"{m}e{p}") keeps the decimal value exact
         coefs = [float(f"{m!r}e{int(p)}") for m, p in pairs]
-        dndt = [_num(sh.cell(r, d0 + k)) for k in range(6)]
         cls = sh.cell(r, 0)
-        out.append(
-            _record(
-                _clean(sh.cell(r, 2)),
-                1,
-                coefs,
-                _indices(sh, r, cols, dec),
-                nd=_num(sh.cell(r, nd_c)),
-                vd=_num(sh.cell(r, vd_c)),
-                ne=_num(sh.cell(r, ne_c)),
-                ve=_num(sh.cell(r, ve_c)),
-                dndt=None if any(v is None for v in dndt) else dndt,
-                transmission=(10.0, _transmission(sh, r, tcols)),
-                status=f"HOYA classification {_clean(cls)}" if isinstance(cls, str) else "",
-                source=source,
-            )
-        )
+        status = f"HOYA classification {_clean(cls)}" if isinstance(cls, str) else ""
+        out.append(_row_record(sh, r, at, 1, coefs, status=status, source=source))
     return out
 
 
 def read_cdgm(path: Path, source: str) -> list[dict]:
     sh = Sheet(path, 0)
     sh.expect(0, 0, "Glass")
-    i0, i1 = sh.find(0, "nt"), sh.find(0, "ni")
-    cols = _index_columns(sh, 0, i0, i1)
-    vd_c, ve_c = sh.find(0, "υd"), sh.find(0, "υe")
-    a0 = sh.find(0, "A0")
-    for k in range(6):
-        sh.expect(0, a0 + k, f"A{k}")
-    d0 = sh.find(0, "D0")
-    for k, lab in enumerate(("D0", "D1", "D2", "E0", "E1", "λTK")):
-        sh.expect(0, d0 + k, lab)
-    t0 = sh.find(0, "τ10mm")
-    tcols = []
-    c = t0
-    while c < sh.df.shape[1] and _num(sh.cell(1, c)) is not None:
-        tcols.append((c, _num(sh.cell(1, c))))
-        c += 1
+    cols = _index_columns(sh, 0, sh.find(0, "nt"), sh.find(0, "ni"))
+    a0 = sh.find_run(0, tuple(f"A{k}" for k in range(6)))
+    d0 = sh.find_run(0, ("D0", "D1", "D2", "E0", "E1", "λTK"))
     rows = [r for r in _rows(sh, 2, 0) if _num(sh.cell(r, a0)) is not None]
-    dec = _printed(sh, rows, cols)
-    out = []
-    for r in rows:
-        coefs = [_num(sh.cell(r, a0 + k)) for k in range(6)]
-        dndt = [_num(sh.cell(r, d0 + k)) for k in range(6)]
-        ind = _indices(sh, r, cols, dec)
-        out.append(
-            _record(
-                _clean(sh.cell(r, 0)),
-                1,
-                coefs,
-                ind,
-                nd=next(v for lab, _, v, _ in ind if lab == "nd"),
-                vd=_num(sh.cell(r, vd_c)),
-                ne=next((v for lab, _, v, _ in ind if lab == "ne"), None),
-                ve=_num(sh.cell(r, ve_c)),
-                dndt=None if any(v is None for v in dndt) else dndt,
-                transmission=(10.0, _transmission(sh, r, tcols)),
-                source=source,
-            )
-        )
-    return out
+    at = Columns(
+        name=0,
+        vd=sh.find(0, "υd"),
+        ve=sh.find(0, "υe"),
+        index=cols,
+        decimals=_printed(sh, rows, cols),
+        transmission=_header_run(sh, 1, sh.find(0, "τ10mm"), _num),
+        dndt=list(range(d0, d0 + 6)),
+    )
+    return [
+        _row_record(sh, r, at, 1, [_num(sh.cell(r, a0 + k)) for k in range(6)], source=source)
+        for r in rows
+    ]
 
 
 def read_hikari(path: Path, source: str) -> list[dict]:
@@ -527,17 +543,17 @@ def read_hikari(path: Path, source: str) -> list[dict]:
             lam = float(head) * 1000.0
             lab = (f"n{lam:g}", lam)
         cols.append((c, *lab))
-    vd_c, ve_c = sh.find(2, "νd"), sh.find(2, "νe")
     a0 = sh.find(2, "A0")
     sh.expect(2, a0 + 8, r"A8/λ\^12")
-    t0 = sh.find(2, "280nm")
-    tcols = []
-    c = t0
-    while c < sh.df.shape[1] and re.fullmatch(r"\d+nm", _clean(sh.cell(2, c))):
-        tcols.append((c, float(_clean(sh.cell(2, c))[:-2])))
-        c += 1
     rows = [r for r in _rows(sh, 3, 0) if _num(sh.cell(r, a0)) is not None]
-    dec = _printed(sh, rows, cols)
+    at = Columns(
+        name=0,
+        vd=sh.find(2, "νd"),
+        ve=sh.find(2, "νe"),
+        index=cols,
+        decimals=_printed(sh, rows, cols),
+        transmission=_header_run(sh, 2, sh.find(2, "280nm"), _labelled(r"(\d+)nm")),
+    )
     out = []
     for r in rows:
         # '-' marks a term the fit does not use (J-PSKH8 A2, J-KZFH9 A8): zero
@@ -547,21 +563,7 @@ def read_hikari(path: Path, source: str) -> list[dict]:
         ]
         if any(v is None for v in coefs):
             continue
-        ind = _indices(sh, r, cols, dec)
-        out.append(
-            _record(
-                _clean(sh.cell(r, 0)),
-                13,
-                coefs,
-                ind,
-                nd=next(v for lab, _, v, _ in ind if lab == "nd"),
-                vd=_num(sh.cell(r, vd_c)),
-                ne=next((v for lab, _, v, _ in ind if lab == "ne"), None),
-                ve=_num(sh.cell(r, ve_c)),
-                transmission=(10.0, _transmission(sh, r, tcols)),
-                source=source,
-            )
-        )
+        out.append(_row_record(sh, r, at, 13, coefs, source=source))
     return out
 
 
@@ -569,51 +571,26 @@ def read_sumita(path: Path, source: str) -> list[dict]:
     sh = Sheet(path, 0)
     H = 1
     sh.expect(H, 2, "GNAME")
-    vd_c, ve_c = sh.find(H, "vd"), sh.find(H, "ve")
-    i0, i1 = sh.find(H, "n1548"), sh.find(H, "ni")
-    cols = _index_columns(sh, H, i0, i1)
-    a0 = sh.find(H, "A0")
-    for k in range(6):
-        sh.expect(H, a0 + k, f"A{k}")
-    d0 = sh.find(H, "D0")
-    dcols = [
-        d0,
-        d0 + 1,
-        sh.find(H, "D2"),
-        sh.find(H, "E0"),
-        sh.find(H, "E1"),
-        sh.find(H, "lambdaTK"),
-    ]
-    sh.expect(H, d0 + 1, "D1")
+    cols = _index_columns(sh, H, sh.find(H, "n1548"), sh.find(H, "ni"))
+    a0 = sh.find_run(H, tuple(f"A{k}" for k in range(6)))
+    d0 = sh.find_run(H, ("D0", "D1"))
+    dcols = [d0, d0 + 1] + [sh.find(H, x) for x in ("D2", "E0", "E1", "lambdaTK")]
     thick_c = sh.find(H, "T2_thick")
-    tcols = []
-    c = thick_c + 1
-    while c < sh.df.shape[1] and re.fullmatch(r"T2_\d+", _clean(sh.cell(H, c))):
-        tcols.append((c, float(_clean(sh.cell(H, c))[3:])))
-        c += 1
     rows = [r for r in _rows(sh, H + 1, 2) if _num(sh.cell(r, a0)) is not None]
-    dec = _printed(sh, rows, cols)
+    at = Columns(
+        name=2,
+        vd=sh.find(H, "vd"),
+        ve=sh.find(H, "ve"),
+        index=cols,
+        decimals=_printed(sh, rows, cols),
+        transmission=_header_run(sh, H, thick_c + 1, _labelled(r"T2_(\d+)")),
+        dndt=dcols,
+    )
     out = []
     for r in rows:
         coefs = [_num(sh.cell(r, a0 + k)) for k in range(6)]
-        dndt = [_num(sh.cell(r, k)) for k in dcols]
-        ind = _indices(sh, r, cols, dec)
         thick = _num(sh.cell(r, thick_c)) or 10.0
-        out.append(
-            _record(
-                _clean(sh.cell(r, 2)),
-                1,
-                coefs,
-                ind,
-                nd=next(v for lab, _, v, _ in ind if lab == "nd"),
-                vd=_num(sh.cell(r, vd_c)),
-                ne=next((v for lab, _, v, _ in ind if lab == "ne"), None),
-                ve=_num(sh.cell(r, ve_c)),
-                dndt=None if any(v is None for v in dndt) else dndt,
-                transmission=(thick, _transmission(sh, r, tcols)),
-                source=source,
-            )
-        )
+        out.append(_row_record(sh, r, at, 1, coefs, thickness=thick, source=source))
     return out
 
 
@@ -1005,6 +982,19 @@ def build(date: str) -> dict[str, bytes]:
         }
         return key
 
+    def add_rii_source(rel: str, path: Path, role: str) -> str:
+        """Register the refractiveindex.info page ``rel`` (the file ``path``) as a source."""
+        key = f"refractiveindex.info:{rel}"
+        sources[key] = {
+            "file": f"optiland/database/data-nk/{rel}",
+            "package": "optiland",
+            "version": ol_v,
+            "sha256": _sha256(path),
+            "catalog_date": "",
+            "role": role,
+        }
+        return key
+
     for cat, reader, cur, prev in VENDORS:
         src = add_source(cur, og / cur, "opticalglass", og_v, f"{cat} catalog, current edition")
         recs, seen = [], {}
@@ -1048,15 +1038,9 @@ def build(date: str) -> dict[str, bytes]:
                 rec["note"] = "; ".join(
                     x for x in (rec["note"], "nd and vd computed from the formula") if x
                 )
-            rsrc = f"refractiveindex.info:{rec['path']}"
-            sources[rsrc] = {
-                "file": f"optiland/database/data-nk/{rec['path']}",
-                "package": "optiland",
-                "version": ol_v,
-                "sha256": _sha256(p),
-                "catalog_date": "",
-                "role": f"{cat} legacy glass (refractiveindex.info, from the vendor AGF)",
-            }
+            rsrc = add_rii_source(
+                rec["path"], p, f"{cat} legacy glass (refractiveindex.info, from the vendor AGF)"
+            )
             recs.append(
                 _record(
                     name,
@@ -1098,15 +1082,7 @@ def build(date: str) -> dict[str, bytes]:
                 rec["note"] = "; ".join(
                     x for x in (rec["note"], "nd and vd computed from the data") if x
                 )
-        rsrc = f"refractiveindex.info:{rel}"
-        sources[rsrc] = {
-            "file": f"optiland/database/data-nk/{rel}",
-            "package": "optiland",
-            "version": ol_v,
-            "sha256": _sha256(p),
-            "catalog_date": "",
-            "role": f"Misc: {what}",
-        }
+        rsrc = add_rii_source(rel, p, f"Misc: {what}")
         misc.append(
             _record(
                 name,

@@ -219,7 +219,8 @@ def _opencv_from_nodes(nodes: dict, path: Path) -> CameraModel:
         w, h = int(nodes["image_width"]), int(nodes["image_height"])
     except (KeyError, TypeError, ValueError):
         raise DataError(f"{path}: give image_width and image_height (pixels)") from None
-    fx, fy, cx, cy, skew = k[0, 0], k[1, 1], k[0, 2], k[1, 2], k[0, 1]
+    fx, skew = k[0, 0], k[0, 1]
+    pinhole = {"fx": fx, "fy": k[1, 1], "cx": k[0, 2], "cy": k[1, 2]}
     kind = str(nodes.get("distortion_model", "")).lower()
     if kind in ("fisheye", "equidistant", "kannala_brandt", "opencv_fisheye"):
         if d.size != 4:
@@ -228,15 +229,9 @@ def _opencv_from_nodes(nodes: dict, path: Path) -> CameraModel:
             "opencv_fisheye",
             w,
             h,
-            fx=fx,
-            fy=fy,
-            cx=cx,
-            cy=cy,
+            **pinhole,
             alpha=skew / fx,
-            k1=d[0],
-            k2=d[1],
-            k3=d[2],
-            k4=d[3],
+            **dict(zip(("k1", "k2", "k3", "k4"), d, strict=True)),
         )
     if kind not in ("", "opencv", "plumb_bob", "rational_polynomial", "standard"):
         raise DataError(f"{path}: unknown distortion_model {kind!r} (opencv or fisheye)")
@@ -248,14 +243,7 @@ def _opencv_from_nodes(nodes: dict, path: Path) -> CameraModel:
     if d.size not in OPENCV_ORDERS:
         raise DataError(f"{path}: {d.size} distortion coefficients; OpenCV takes 4, 5, 8, 12 or 14")
     return CameraModel.create(
-        "opencv",
-        w,
-        h,
-        fx=fx,
-        fy=fy,
-        cx=cx,
-        cy=cy,
-        **dict(zip(OPENCV_ORDERS[d.size], d, strict=True)),
+        "opencv", w, h, **pinhole, **dict(zip(OPENCV_ORDERS[d.size], d, strict=True))
     )
 
 

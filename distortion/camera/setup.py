@@ -230,12 +230,16 @@ class CameraGeometry:
                if self.infinite else "")
         )  # fmt: skip
 
+    @property
+    def object_label(self) -> str:
+        """The object plane in a repr: ``inf``, or its distance from the first vertex (mm)."""
+        return "inf" if self.infinite else f"{self.object_distance:g} mm"
+
     def __repr__(self) -> str:
-        obj = "inf" if self.infinite else f"{self.object_distance:g} mm"
         return (
-            f"CameraGeometry({self.lens_name!r}, object {obj}, {self.focus}, sensor plane "
-            f"{self.from_last_vertex:.6g} mm from the last vertex (defocus {self.defocus:+.4g} mm)"
-            f", c = {self.camera_constant:.6g} mm, {self.wavelength:g} nm)"
+            f"CameraGeometry({self.lens_name!r}, object {self.object_label}, {self.focus}, "
+            f"sensor plane {self.from_last_vertex:.6g} mm from the last vertex (defocus "
+            f"{self.defocus:+.4g} mm), c = {self.camera_constant:.6g} mm, {self.wavelength:g} nm)"
         )
 
 

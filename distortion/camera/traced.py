@@ -175,10 +175,9 @@ class CameraPoints:
 
     def __repr__(self) -> str:
         g = self.geometry
-        obj = "inf" if g.infinite else f"{g.object_distance:g} mm"
         return (
             f"CameraPoints({g.lens_name!r}, {self.shape[1]}x{self.shape[0]} chief rays on "
-            f"{self.sensor!r}, object {obj}, {g.focus}, {self.n_failed} failed)"
+            f"{self.sensor!r}, object {g.object_label}, {g.focus}, {self.n_failed} failed)"
         )
 
 
@@ -505,11 +504,10 @@ class TracedCamera:
 
     def __repr__(self) -> str:
         g = self.geometry
-        obj = "inf" if g.infinite else f"{g.object_distance:g} mm"
         return (
-            f"TracedCamera({g.lens_name!r}, {self.camera.model}, object {obj}, {g.focus}: "
-            f"RMS {self.rms_px:.3g} px, max {self.max_px:.3g} px over {self.fit.n_points} chief "
-            "rays)"
+            f"TracedCamera({g.lens_name!r}, {self.camera.model}, object {g.object_label}, "
+            f"{g.focus}: RMS {self.rms_px:.3g} px, max {self.max_px:.3g} px over "
+            f"{self.fit.n_points} chief rays)"
         )
 
 

@@ -4,8 +4,16 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_output_args
-from .distortion import add_calibration_args, add_force_arg, add_table_layout_arg
+from .common import (
+    add_force_arg,
+    add_output_args,
+    add_table_layout_arg,
+    at_fields,
+    check_plot_path,
+    print_result,
+    save_plot,
+)
+from .distortion import add_calibration_args
 
 TABLE_HELP = (
     "Distortion table CSV: a header with the field column (alpha_deg or y_mm), y0p_mm, D0_mm and "
@@ -25,8 +33,6 @@ def cmd_calibrate(args) -> int:
     from distortion.tablefile import read_distortion_table
 
     from ..report.distortion import calibration_csv, calibration_to_dict, format_calibration
-    from .common import print_json
-    from .distortion import at_fields, check_plot_path
 
     args._inputs = [args.table]
     for flag in ("plot", "plot_rotation"):
@@ -35,22 +41,18 @@ def cmd_calibrate(args) -> int:
     res = calibrate(
         curve, args.method, at=at_fields(args.at), value=args.value, k=args.exaggeration
     )
-    if args.json:
-        print_json(calibration_to_dict(res))
-    elif args.csv:
-        print(calibration_csv(res))
-    else:
-        print(format_calibration(res, layout=args.table_layout))
+    print_result(
+        args,
+        json=lambda: calibration_to_dict(res),
+        csv=lambda: calibration_csv(res),
+        text=lambda: format_calibration(res, layout=args.table_layout),
+    )
     if args.plot or args.plot_rotation:
-        from ..plots.common import offscreen_figures
         from ..plots.distortion import plot_calibrated, plot_rotation
-        from ..plots.save import save_figure
 
-        for path, fn in ((args.plot, plot_calibrated), (args.plot_rotation, plot_rotation)):
+        for path, plot in ((args.plot, plot_calibrated), (args.plot_rotation, plot_rotation)):
             if path:
-                with offscreen_figures():
-                    fig = fn(res)
-                save_figure(fig, path, overwrite=args.force, inputs=[args.table])
+                save_plot(lambda plot=plot: plot(res), path, args)
     return 0
 
 
@@ -66,7 +68,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
         epilog="Example: orthoscope calibrate tests/data/pestrecov_table1.csv --method two-point "
         "--at 37.5,45",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     q.add_argument("table", metavar="TABLE.csv", help=TABLE_HELP)
     add_calibration_args(q, required=True)

@@ -19,6 +19,21 @@ from __future__ import annotations
 
 import argparse
 
+from .common import (
+    OBJECT_HELP,
+    CliError,
+    add_force_arg,
+    add_object_args,
+    add_output_args,
+    add_strict_arg,
+    add_wavelength_arg,
+    check_plot_path,
+    length,
+    load,
+    print_json,
+    save_plot,
+)
+
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
 SAMPLES = [
@@ -67,8 +82,6 @@ def _grid(text: str | None):
         return None
     from distortion.camera.sensor import parse_pixels
 
-    from .common import CliError
-
     try:
         return parse_pixels(text)
     except Exception as e:  # noqa: BLE001 - DataError with its own words
@@ -78,8 +91,6 @@ def _grid(text: str | None):
 def _setup_keywords(args) -> dict:
     """The object / focus / trace keywords of CameraSetup from the flags (strings are parsed by
     CameraSetup, one path for the API and the command line)."""
-    from .common import CliError
-
     plane = {
         k: getattr(args, k)
         for k in ("s_prime", "from_last_vertex", "defocus")
@@ -114,8 +125,6 @@ def _sensor(args, calibration=None):
     calibration's pixel count when one is given)."""
     from distortion.camera import Sensor, read_camera_setup
     from distortion.camera.traced import sensor_for_calibration
-
-    from .common import CliError
 
     base = read_camera_setup(args.camera).sensor if args.camera else None
     off = args.principal_point
@@ -171,8 +180,6 @@ def _setup(args, sensor):
 def _calibration_format(path: str, fmt: str | None) -> str:
     from distortion.camera.files import FORMATS, detect_format
 
-    from .common import CliError
-
     if fmt is not None:
         if fmt not in FORMATS:
             raise CliError(f"--format {fmt}: use one of {', '.join(FORMATS)}")
@@ -184,8 +191,6 @@ def _emit(args, text: str, data: dict, csv: str | None = None, note: str | None 
     """Text, JSON or CSV on stdout; with CSV (which has no room for it) ``note`` — the
     projection centre — goes to stderr, so that every output states it."""
     import sys
-
-    from .common import print_json
 
     if args.json:
         print_json(data)
@@ -201,7 +206,6 @@ def _model_table_out(args, table, note: str | None = None) -> None:
     """A table of camera models per object distance: written to ``-o`` (.csv or .json) when
     given, and shown as text, JSON or CSV (:func:`_emit`, ``note`` as there)."""
     from ..report.camera import format_model_table, model_table_csv, model_table_to_dict
-    from .common import CliError
 
     data = {"models_by_distance": model_table_to_dict(table)}
     if args.output:
@@ -229,8 +233,6 @@ def _cmd_lens(args, lens_name: str) -> int:
         points_csv,
         traced_camera_to_dict,
     )
-    from .common import CliError, load
-    from .distortion import check_plot_path
 
     lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, args.camera) if p]
@@ -261,7 +263,6 @@ def _cmd_lens(args, lens_name: str) -> int:
           tc.geometry.projection_centre)  # fmt: skip
     if args.plot:
         from ..plots.camera import plot_camera_residuals
-        from .common import save_plot
 
         save_plot(lambda: plot_camera_residuals(tc), args.plot, args)
     if args.picture:
@@ -280,8 +281,6 @@ def _png(image) -> bytes:
 
     ok, buf = cv2.imencode(".png", image)
     if not ok:  # pragma: no cover - OpenCV always encodes a uint8 image
-        from .common import CliError
-
         raise CliError("OpenCV could not encode the picture as PNG")
     return buf.tobytes()
 
@@ -307,8 +306,6 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
     from distortion.camera import compare_calibration, read_calibration
 
     from ..report.camera import comparison_csv, comparison_to_dict, format_comparison
-    from .common import load
-    from .distortion import check_plot_path
 
     lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
@@ -332,7 +329,6 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
           comparison_csv(cmp), cmp.prediction.geometry.projection_centre)  # fmt: skip
     if args.plot:
         from ..plots.camera import plot_calibration_comparison
-        from .common import save_plot
 
         save_plot(lambda: plot_calibration_comparison(cmp), args.plot, args)
     return 0
@@ -344,7 +340,6 @@ def _cmd_convert(args, cal_path: str) -> int:
     from distortion.errors import DataError
 
     from ..report.camera import conversion_to_dict, format_conversion
-    from .common import CliError
 
     args._inputs = [p for p in (cal_path, args.camera) if p]
     _check_out(args.output, args, "-o")
@@ -375,8 +370,6 @@ def _cmd_convert(args, cal_path: str) -> int:
 
 def _cmd_variation(args, cal1: str, cal2: str) -> int:
     from distortion.camera import calibrated_models_by_distance, read_calibration
-
-    from .common import CliError, length
 
     args._inputs = [cal1, cal2]
     _check_out(args.output, args, "-o")
@@ -412,8 +405,6 @@ def _cmd_variation(args, cal1: str, cal2: str) -> int:
 
 
 def cmd_camera(args) -> int:
-    from .common import CliError
-
     words = list(args.words)
     head = words[0]
     if head == "compare":
@@ -440,9 +431,6 @@ def cmd_camera(args) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from .common import OBJECT_HELP, add_object_args, add_wavelength_arg
-    from .distortion import add_force_arg
-
     q = sub.add_parser(
         "camera",
         help="Camera models (OpenCV, fisheye, COLMAP, Metashape, Australis) from a lens; "
@@ -482,7 +470,6 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope camera convert tests/data/camera/cooke-measured-2m.yml --model "
             "metashape -o cooke.xml"
         ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     q.add_argument(
         "words",
@@ -606,18 +593,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="undistort: the ideal image from the camera's; distort: the camera's from an "
         "ideal one.",
     )
-    o.add_argument(
-        "--strict",
-        action="store_true",
+    add_strict_arg(
+        o,
         help="Exit with status 2 when a chief ray fails, or when the lens file names a glass that "
         "can only be read as a substitute (an N- successor, a parent glass, a model of nd/vd).",
     )
     add_force_arg(q)
-    og = q.add_mutually_exclusive_group()
-    og.add_argument("--json", action="store_true", help="Print JSON (keys carry units; README).")
-    og.add_argument(
-        "--csv",
-        action="store_true",
-        help="Print CSV: the traced points with the residual, the table, or the radial profiles.",
+    add_output_args(
+        q,
+        csv_help="Print CSV: the traced points with the residual, the table, or the radial "
+        "profiles.",
     )
     q.set_defaults(func=cmd_camera)

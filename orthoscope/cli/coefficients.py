@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from .common import CliError, load_scaled, print_json
+from .common import CliError, add_output_args, load_scaled, print_json, refuse_flags
 from .variation import CONJ_HELP, UNITS_EPILOG
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -97,9 +97,15 @@ def _csv_profile(args):
     from distortion.variation.profiles import read_profiles_csv
     from distortion.variation.traced import parse_conjugate
 
-    extra = _lens_only(args)
-    if extra:
-        raise CliError(f"{', '.join(extra)} only apply with --lens")
+    refuse_flags(
+        "{} only apply with --lens",
+        (
+            ("--focus", args.focus),
+            ("--object", args.object),
+            ("--scale-to-efl", args.scale_to_efl),
+            ("--max-field", args.max_field),
+        ),
+    )
     ps = read_profiles_csv(args.profiles, min_profiles=1)
     profs = list(ps.profiles)
     if args.profile:
@@ -229,22 +235,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="Derive the OpenCV coefficients from the balanced fit (c_g = c (1 + K0)).",
     )
-    c.add_argument(
-        "--json",
-        action="store_true",
-        help="Print JSON: fits and an 'opencv' block with dist_coeffs [k1,k2,p1,p2,k3].",
+    add_output_args(
+        c,
+        csv=False,
+        json_help="Print JSON: fits and an 'opencv' block with dist_coeffs [k1,k2,p1,p2,k3].",
     )
     c.set_defaults(func=cmd_coefficients)
-
-
-def _lens_only(args) -> list[str]:
-    return [
-        f
-        for f, v in (
-            ("--focus", args.focus),
-            ("--object", args.object),
-            ("--scale-to-efl", args.scale_to_efl),
-            ("--max-field", args.max_field),
-        )
-        if v
-    ]

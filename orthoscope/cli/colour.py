@@ -5,7 +5,24 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_field_args, add_lens_arg, add_object_args, add_output_args, add_plane_args
+from .common import (
+    CliError,
+    add_field_args,
+    add_force_arg,
+    add_lens_arg,
+    add_object_args,
+    add_output_args,
+    add_plane_args,
+    check_finite_object,
+    check_plot_path,
+    field_keyword,
+    load_input,
+    print_result,
+    resolve_fields,
+    resolve_object,
+    resolve_planes,
+    save_plot,
+)
 
 #: Quick runs of this command for the per-command tests: argv lists with {data} = tests/data,
 #: {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -65,29 +82,13 @@ def cmd_colour(args) -> int:
         format_lateral_colour,
         lateral_colour_to_dict,
     )
-    from .common import (
-        CliError,
-        field_keyword,
-        load_input,
-        print_json,
-        resolve_fields,
-        resolve_object,
-        resolve_planes,
-    )
 
     lens = load_input(args)
     if args.plot:
-        from pathlib import Path
-
-        from raytrace.files.output import check_output
-
-        check_output(args.plot, inputs=args._inputs, overwrite=args.force, flag="--force")
-        if Path(args.plot).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise CliError(f"--plot {args.plot}: the file must end in .png, .svg or .pdf")
+        check_plot_path(args.plot, "--plot", args)
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
-    if kind == "height" and od == float("inf"):
-        raise CliError("object-height fields need a finite object (--object-distance)")
+    check_finite_object(kind, od)
     planes = resolve_planes(lens, args)
     wls = args.wavelengths
     if wls is None:
@@ -102,23 +103,19 @@ def cmd_colour(args) -> int:
     cd = characteristic_distortion(
         lens, **fkw, object_distance=od, plane=planes, wavelengths=wl_list, scale=args.scale
     )
-    if args.json:
-        print_json(
-            {
-                "focal_shift": focal_shift_to_dict(fs),
-                "lateral_colour": lateral_colour_to_dict(lc),
-                "distortion": chromatic_distortion_to_dict(cd),
-            }
-        )
-    else:
-        print(format_focal_shift(fs))
-        print()
-        print(format_lateral_colour(lc))
-        print()
-        print(format_chromatic_distortion(cd))
+    print_result(
+        args,
+        json=lambda: {
+            "focal_shift": focal_shift_to_dict(fs),
+            "lateral_colour": lateral_colour_to_dict(lc),
+            "distortion": chromatic_distortion_to_dict(cd),
+        },
+        text=lambda: "\n\n".join(
+            (format_focal_shift(fs), format_lateral_colour(lc), format_chromatic_distortion(cd))
+        ),
+    )
     if args.plot:
         from ..plots.colour import plot_colour_summary
-        from .common import save_plot
 
         curve = focal_shift(lens, kind=args.focus, object_distance=od)
         save_plot(lambda: plot_colour_summary(curve, lc, cd), args.plot, args)
@@ -142,7 +139,6 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope colour cooke-triplet-f4 --wavelengths F,d,C --fields 0,5,10,15,20\n"
             "  orthoscope colour tessar-fr1066698 --focus best-focus --scale own --plot colour.png"
         ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_lens_arg(q)
     add_object_args(q)
@@ -170,8 +166,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Save a chart (.png/.svg/.pdf): focal-shift curve, lateral colour, distortion per "
         "wavelength.",
     )
-    q.add_argument(
-        "--force", action="store_true", help="Replace an existing plot file (never an input)."
-    )
+    add_force_arg(q, help="Replace an existing plot file (never an input).")
     add_output_args(q, csv=False)
     q.set_defaults(func=cmd_colour)

@@ -66,6 +66,11 @@ class DeprecatedAlias(argparse.Action):
             setattr(namespace, self.dest, values)
 
 
+def add_alias(p, old: str, new: str, dest: str, **kw) -> None:
+    """The hidden flag ``old``: a :class:`DeprecatedAlias` of ``new`` (storing to ``dest``)."""
+    p.add_argument(old, dest=dest, action=DeprecatedAlias, new=new, help=argparse.SUPPRESS, **kw)
+
+
 def warn(message: str) -> None:
     """One warning line on stderr."""
     print(f"orthoscope: warning: {message}", file=sys.stderr)
@@ -112,6 +117,11 @@ def parse_list(text: str, what: str, *, lengths: bool = False) -> np.ndarray:
         raise CliError(f"{what}: empty list")
     conv = (lambda p: length(p, what)) if lengths else (lambda p: number(p, what))
     return np.array([conv(p) for p in parts])
+
+
+def at_fields(text: str | None) -> tuple[float, ...] | None:
+    """The fields of ``--at`` (``A`` or ``A,B``), None without it."""
+    return None if text is None else tuple(parse_list(text, "--at"))
 
 
 def signed_list(text: str) -> str:
@@ -162,10 +172,9 @@ def strict_check(args, status, what: str = "field(s)", see: str = " (see the tab
 
 def load_scaled(args):
     """The lens of ``--lens``, scaled to ``--scale-to-efl`` mm when given."""
-    from raytrace.files.library import load_lens
     from raytrace.paraxial import paraxial
 
-    lens = load_lens(args.lens, strict=getattr(args, "strict", False))
+    lens = load(args.lens, strict=getattr(args, "strict", False))
     if args.scale_to_efl is not None:
         if not (args.scale_to_efl > 0 and math.isfinite(args.scale_to_efl)):
             raise CliError(
@@ -191,14 +200,7 @@ def add_object_args(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--object-s", metavar="S", help="Pestrecov's s: mm from H, negative.")
     g.add_argument("--object-scale", metavar="N", help="image scale N (Nx): magnification -1/N.")
-    g.add_argument(
-        "--s",
-        dest="object_s",
-        metavar="S",
-        action=DeprecatedAlias,
-        new="--object-s",
-        help=argparse.SUPPRESS,
-    )
+    add_alias(g, "--s", "--object-s", "object_s", metavar="S")
 
 
 def resolve_object(lens, args) -> float:
@@ -242,15 +244,7 @@ def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> N
         ("--image-distance", "--s-prime", "s_prime"),
         ("--image-from-vertex", "--from-last-vertex", "from_last_vertex"),
     ):
-        g.add_argument(
-            old,
-            dest=dest,
-            metavar="X",
-            action=DeprecatedAlias,
-            new=new,
-            default=[] if repeatable else None,
-            help=argparse.SUPPRESS,
-        )
+        add_alias(g, old, new, dest, metavar="X", default=[] if repeatable else None)
 
 
 def resolve_planes(lens, args) -> list:
@@ -366,12 +360,93 @@ def field_keyword(fields: np.ndarray, kind: str) -> dict[str, Any]:
     return {"fields_deg": fields} if kind == "angle" else {"object_heights_mm": fields}
 
 
+def check_finite_object(kind: str, object_distance: float) -> None:
+    """Refuse object-height fields (``kind == "height"``) with the object at infinity."""
+    if kind == "height" and object_distance == float("inf"):
+        raise CliError("object-height fields need a finite object (--object-distance)")
+
+
+def refuse_flags(message: str, flags) -> None:
+    """CliError ``message`` (``{}`` = the flag names) when a flag of the ``(flag, value)`` pairs
+    ``flags`` is given (its value true): flags that do not apply to this run."""
+    given = [flag for flag, value in flags if value]
+    if given:
+        raise CliError(message.format(", ".join(given)))
+
+
 # ----------------------------------------------------------------------------- output
-def add_output_args(p: argparse.ArgumentParser, *, csv: bool = True) -> None:
+JSON_HELP = "Print JSON (keys carry units; README)."
+FORCE_HELP = "Replace existing output files (never an input)."
+STRICT_HELP = (
+    "Exit with status 2 when a field cannot be traced, or when the lens file names a glass read "
+    "only as a substitute (an N- successor, a parent glass, a model of nd/vd)."
+)
+TABLE_LAYOUT_HELP = (
+    "Table orientation: 'rows' (one row per field; default) or 'paper' (fields across, as "
+    "Pestrecov's Tables I, II and V)."
+)
+
+
+def add_output_args(
+    p: argparse.ArgumentParser,
+    *,
+    csv: bool = True,
+    json_help: str = JSON_HELP,
+    csv_help: str = "Print CSV.",
+) -> None:
+    """``--json`` and (with ``csv``) ``--csv``, one or the other: what :func:`print_result`
+    prints."""
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--json", action="store_true", help="Print JSON (keys carry units; README).")
+    g.add_argument("--json", action="store_true", help=json_help)
     if csv:
-        g.add_argument("--csv", action="store_true", help="Print CSV.")
+        g.add_argument("--csv", action="store_true", help=csv_help)
+
+
+def add_force_arg(p, *, help: str = FORCE_HELP) -> None:
+    """``--force``: output files may replace existing files (never an input)."""
+    p.add_argument("--force", action="store_true", help=help)
+
+
+def add_strict_arg(p, *, help: str = STRICT_HELP) -> None:
+    """``--strict``: what is only a warning or a table entry by default fails the run."""
+    p.add_argument("--strict", action="store_true", help=help)
+
+
+def add_table_layout_arg(p) -> None:
+    """``--table-layout rows|paper`` of the distortion tables."""
+    p.add_argument(
+        "--table-layout", choices=["rows", "paper"], default="rows", help=TABLE_LAYOUT_HELP
+    )
+
+
+def check_plot_path(path: str | None, flag: str, args) -> None:
+    """Refuse a plot file name before any work: suffix, folder, no overwrite without --force."""
+    if path is None:
+        return
+    from raytrace.files.output import check_output
+
+    check_output(path, inputs=getattr(args, "_inputs", ()), overwrite=args.force, flag="--force")
+    check_plot_suffix(path, flag)
+
+
+def check_plot_suffix(path: str, flag: str) -> None:
+    """Refuse a plot file name (of ``flag``) that is not .png, .svg or .pdf."""
+    from pathlib import Path
+
+    if Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise CliError(f"{flag} {path}: the file must end in .png, .svg or .pdf")
+
+
+def print_result(args, *, json, text, csv=None) -> None:
+    """A command's result on stdout in the form its output flags ask for: ``json()`` as JSON
+    with ``--json``, ``csv()`` with ``--csv`` (where the command has it), ``text()``
+    otherwise. Only the chosen one is called."""
+    if args.json:
+        print_json(json())
+    elif csv is not None and args.csv:
+        print(csv())
+    else:
+        print(text())
 
 
 def add_wavelength_arg(p: argparse.ArgumentParser) -> None:

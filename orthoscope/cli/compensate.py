@@ -5,6 +5,17 @@ from __future__ import annotations
 import argparse
 import math
 
+from .common import (
+    METHODS,
+    CliError,
+    add_alias,
+    add_output_args,
+    at_fields,
+    load,
+    parse_list,
+    print_result,
+)
+
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
 SAMPLES = [
@@ -22,8 +33,6 @@ def _curve_from(arg: str, role: str, args, camera_curve=None):
 
     from distortion.characteristic import characteristic_distortion
     from distortion.tablefile import read_distortion_table
-
-    from .common import CliError, load, parse_list
 
     if Path(arg).suffix.lower() == ".csv":
         return read_distortion_table(arg)
@@ -49,24 +58,19 @@ def cmd_compensate(args) -> int:
     from distortion.compensation import compensate
 
     from ..report.distortion import compensation_to_dict, format_compensation
-    from .common import print_json
-    from .distortion import at_fields
 
     cam = _curve_from(args.camera, "camera", args)
     prn = _curve_from(args.printer, "printer", args, camera_curve=cam)
     res = compensate(
         cam, prn, method=args.method, magnification=args.magnification, at=at_fields(args.at)
     )
-    if args.json:
-        print_json(compensation_to_dict(res))
-    else:
-        print(format_compensation(res))
+    print_result(
+        args, json=lambda: compensation_to_dict(res), text=lambda: format_compensation(res)
+    )
     return 0
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from .common import METHODS, DeprecatedAlias
-
     q = sub.add_parser(
         "compensate",
         help="Residual distortion of a print: camera distortion compensated by a printer.",
@@ -89,28 +93,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="How M is chosen: 'given' (--magnification, default M2: Pestrecov's condition for "
         "characteristic curves) or a calibration method over the camera fields.",
     )
-    q.add_argument(
-        "--criterion",
-        dest="method",
-        choices=METHODS,
-        action=DeprecatedAlias,
-        new="--method",
-        help=argparse.SUPPRESS,
-    )
+    add_alias(q, "--criterion", "--method", "method", choices=METHODS)
     q.add_argument(
         "--magnification", type=float, metavar="M", help="Print magnification factor M for 'given'."
     )
-    q.add_argument(
-        "--M",
-        dest="magnification",
-        type=float,
-        action=DeprecatedAlias,
-        new="--magnification",
-        help=argparse.SUPPRESS,
-    )
+    add_alias(q, "--M", "--magnification", "magnification", type=float)
     q.add_argument("--at", metavar="A[,B]", help="Field(s) for two-point or zero-at (degrees).")
     q.add_argument(
         "--fields", metavar="F1,F2,...", help="Camera field angles (deg) when CAMERA is a lens."
     )
-    q.add_argument("--json", action="store_true", help="Print JSON.")
+    add_output_args(q, csv=False, json_help="Print JSON.")
     q.set_defaults(func=cmd_compensate)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from .common import add_force_arg
+
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
 SAMPLES = [["convert", "cooke-triplet-f4", "{tmp}/cooke.zmx"]]
@@ -48,7 +50,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Lens to read: a .toml, .zmx or .seq file, or a bundled lens name.",
     )
     q.add_argument("output", metavar="OUT", help="Lens file to write (.toml or .zmx).")
-    q.add_argument(
-        "--force", action="store_true", help="Replace an existing OUT (never the input)."
-    )
+    add_force_arg(q, help="Replace an existing OUT (never the input).")
     q.set_defaults(func=cmd_convert)

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 
+from .common import CliError, print_result, refuse_flags, strict_check
+
 DEFINITION_HELP = (
     "Measure the distortion against a named definition instead of Pestrecov's (object at "
     "infinity; theta = field angle): 'f-tan-theta' (y_ref = f tan theta) and 'f-theta' "
@@ -35,15 +37,13 @@ def add_definition_args(q: argparse.ArgumentParser) -> None:
 
 def run_definition(lens, fields, kind, od, planes, args) -> int:
     """The distortion command with ``--definition``: text (default), ``--json`` or ``--csv``."""
-
     from distortion.definitions import projection_distortion
 
     from ..report.definitions import format_projection, projection_csv, projection_to_dict
-    from .common import CliError, print_json, strict_check
 
-    bad = [
-        flag
-        for flag, on in (
+    refuse_flags(
+        "--definition does not combine with {}",
+        (
             ("--reference", args.reference != "characteristic"),
             ("--calibrate", args.calibrate is not None),
             ("--at", args.at is not None),
@@ -51,11 +51,8 @@ def run_definition(lens, fields, kind, od, planes, args) -> int:
             ("--plot", args.plot is not None),
             ("--plot-rotation", args.plot_rotation is not None),
             ("--layout", args.layout is not None),
-        )
-        if on
-    ]
-    if bad:
-        raise CliError(f"--definition does not combine with {', '.join(bad)}")
+        ),
+    )
     if kind == "height":
         raise CliError("--definition takes field angles (object at infinity), not object heights")
     res = projection_distortion(
@@ -69,11 +66,11 @@ def run_definition(lens, fields, kind, od, planes, args) -> int:
         wavelengths=getattr(args, "wavelengths", None),
         scale=getattr(args, "scale", "reference"),
     )
-    if args.json:
-        print_json({"projection_distortion": projection_to_dict(res)})
-    elif args.csv:
-        print(projection_csv(res))
-    else:
-        print(format_projection(res, layout=args.table_layout))
+    print_result(
+        args,
+        json=lambda: {"projection_distortion": projection_to_dict(res)},
+        csv=lambda: projection_csv(res),
+        text=lambda: format_projection(res, layout=args.table_layout),
+    )
     strict_check(args, res.status)
     return 0

@@ -5,12 +5,34 @@ from __future__ import annotations
 import argparse
 
 from .common import (
+    MAX_FIELDS,
+    METHODS,
+    REFERENCES,
+    CliError,
+    add_alias,
     add_field_args,
+    add_force_arg,
     add_lens_arg,
     add_object_args,
     add_output_args,
     add_plane_args,
+    add_strict_arg,
+    add_table_layout_arg,
     add_wavelength_arg,
+    at_fields,
+    check_finite_object,
+    check_plot_path,
+    check_size,
+    field_keyword,
+    load_input,
+    print_json,
+    print_result,
+    refuse_flags,
+    resolve_fields,
+    resolve_object,
+    resolve_planes,
+    save_plot,
+    strict_check,
 )
 
 METHOD_HELP = (
@@ -28,10 +50,6 @@ REFERENCE_HELP = (
     "evaluation plane), 'real-chief-transport' (Gaussian reference point carried along the real "
     "chief ray to the plane)."
 )
-TABLE_LAYOUT_HELP = (
-    "Table orientation: 'rows' (one row per field; default) or 'paper' (fields across, as "
-    "Pestrecov's Tables I, II and V)."
-)
 
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -46,72 +64,22 @@ OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png"), ("--layout", ".png")
 
 
 def add_calibration_args(q: argparse.ArgumentParser, *, required: bool) -> None:
-    from .common import METHODS
-
     g = q.add_argument_group("calibration")
     if required:
         g.add_argument("--method", required=True, choices=METHODS, help=METHOD_HELP)
-        g.add_argument(
-            "--criterion",
-            dest="method",
-            choices=METHODS,
-            action=_alias("--method"),
-            help=argparse.SUPPRESS,
-        )
+        add_alias(g, "--criterion", "--method", "method", choices=METHODS)
     else:
         g.add_argument("--calibrate", metavar="METHOD", choices=METHODS, help=METHOD_HELP)
     g.add_argument("--at", metavar="A[,B]", help=AT_HELP)
     g.add_argument("--value", type=float, metavar="K", help="Fc (mm) or Mc for 'given'.")
     g.add_argument("--exaggeration", type=float, default=200.0, metavar="K", help=EXAGGERATION_HELP)
-    g.add_argument(
-        "--k",
-        dest="exaggeration",
-        type=float,
-        action=_alias("--exaggeration"),
-        help=argparse.SUPPRESS,
-    )
-
-
-def _alias(new: str):
-    from functools import partial
-
-    from .common import DeprecatedAlias
-
-    return partial(DeprecatedAlias, new=new)
-
-
-def add_table_layout_arg(q: argparse.ArgumentParser) -> None:
-    q.add_argument(
-        "--table-layout", choices=["rows", "paper"], default="rows", help=TABLE_LAYOUT_HELP
-    )
-
-
-def at_fields(text: str | None) -> tuple[float, ...] | None:
-    from .common import parse_list
-
-    return None if text is None else tuple(parse_list(text, "--at"))
-
-
-def check_plot_path(path: str | None, flag: str, args) -> None:
-    """Refuse a plot file name before any work: suffix, folder, no overwrite without --force."""
-    if path is None:
-        return
-    from pathlib import Path
-
-    from raytrace.files.output import check_output
-
-    from .common import CliError
-
-    check_output(path, inputs=getattr(args, "_inputs", ()), overwrite=args.force, flag="--force")
-    if Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise CliError(f"{flag} {path}: the file must end in .png, .svg or .pdf")
+    add_alias(g, "--k", "--exaggeration", "exaggeration", type=float)
 
 
 def cmd_distortion(args) -> int:
     import numpy as np
 
     from distortion.calibration import calibrate
-    from distortion.characteristic import characteristic_distortion
 
     from ..report.distortion import (
         calibration_to_dict,
@@ -119,16 +87,6 @@ def cmd_distortion(args) -> int:
         characteristic_to_dict,
         format_calibration,
         format_characteristic,
-    )
-    from .common import (
-        CliError,
-        field_keyword,
-        load_input,
-        print_json,
-        resolve_fields,
-        resolve_object,
-        resolve_planes,
-        strict_check,
     )
 
     lens = load_input(args)
@@ -142,8 +100,7 @@ def cmd_distortion(args) -> int:
     for flag in ("plot", "plot_rotation", "layout"):
         check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
     planes = resolve_planes(lens, args)
-    if kind == "height" and od == float("inf"):
-        raise CliError("object-height fields need a finite object (--object-distance)")
+    check_finite_object(kind, od)
     if args.definition is not None:  # named definitions: orthoscope/cli/definitions.py
         from .definitions import run_definition
 
@@ -152,14 +109,7 @@ def cmd_distortion(args) -> int:
         raise CliError("--focal needs --definition NAME")
     if args.wavelengths is not None:
         return _by_wavelength(lens, fields, kind, od, planes, args)
-    res = characteristic_distortion(
-        lens,
-        **field_keyword(fields, kind),
-        object_distance=od,
-        plane=planes,
-        reference=args.reference,
-        wavelength=args.wavelength,
-    )
+    res = _characteristic(lens, fields, kind, od, planes, args, wavelength=args.wavelength)
     if args.calibrate is None and (args.at is not None or args.value is not None):
         raise CliError("--at and --value need --calibrate METHOD")
     cals = (
@@ -191,43 +141,45 @@ def cmd_distortion(args) -> int:
     return 0
 
 
-def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
-    """--wavelengths: distortion per wavelength (one trace), against --scale."""
-
+def _characteristic(lens, fields, kind, od, planes, args, **kw):
+    """Characteristic distortion at the fields, object and planes of the run, with --reference
+    (``kw``: the wavelength keywords)."""
     from distortion.characteristic import characteristic_distortion
 
-    from ..report.colour import chromatic_distortion_to_dict, format_chromatic_distortion
-    from .common import CliError, field_keyword, print_json, strict_check
-
-    bad = [
-        flag
-        for flag, on in (
-            ("--wavelength", args.wavelength is not None),
-            ("--calibrate", args.calibrate is not None),
-            ("--csv", args.csv),
-            ("--plot-rotation", args.plot_rotation),
-            ("--layout", args.layout),
-        )
-        if on
-    ]
-    if bad:
-        raise CliError(f"--wavelengths does not combine with {', '.join(bad)}")
-    cd = characteristic_distortion(
+    return characteristic_distortion(
         lens,
         **field_keyword(fields, kind),
         object_distance=od,
         plane=planes,
         reference=args.reference,
-        wavelengths=args.wavelengths,
-        scale=args.scale,
+        **kw,
     )
-    if args.json:
-        print_json({"distortion_by_wavelength": chromatic_distortion_to_dict(cd)})
-    else:
-        print(format_chromatic_distortion(cd))
+
+
+def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
+    """--wavelengths: distortion per wavelength (one trace), against --scale."""
+    from ..report.colour import chromatic_distortion_to_dict, format_chromatic_distortion
+
+    refuse_flags(
+        "--wavelengths does not combine with {}",
+        (
+            ("--wavelength", args.wavelength is not None),
+            ("--calibrate", args.calibrate is not None),
+            ("--csv", args.csv),
+            ("--plot-rotation", args.plot_rotation),
+            ("--layout", args.layout),
+        ),
+    )
+    cd = _characteristic(
+        lens, fields, kind, od, planes, args, wavelengths=args.wavelengths, scale=args.scale
+    )
+    print_result(
+        args,
+        json=lambda: {"distortion_by_wavelength": chromatic_distortion_to_dict(cd)},
+        text=lambda: format_chromatic_distortion(cd),
+    )
     if args.plot:
         from ..plots.colour import plot_distortion_by_wavelength
-        from .common import save_plot
 
         save_plot(lambda: plot_distortion_by_wavelength(cd), args.plot, args)
     strict_check(args, cd.status, "ray(s)")
@@ -237,8 +189,6 @@ def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
 def _plots(res, cals, args, lens) -> None:
     import numpy as np
 
-    from .common import CliError
-
     if (args.plot or args.plot_rotation or args.layout) and not np.isfinite(res.yp).any():
         raise CliError("no field could be traced (see the table): there is nothing to plot")
 
@@ -246,46 +196,36 @@ def _plots(res, cals, args, lens) -> None:
         raise CliError("--plot-rotation (Fig. 4) needs --calibrate")
     if not (args.plot or args.plot_rotation or args.layout):
         return
-    from ..plots.common import offscreen_figures
     from ..plots.distortion import plot_calibrated, plot_characteristic, plot_planes, plot_rotation
     from ..plots.layout import plot_layout
-    from ..plots.save import save_figure
 
     if args.plot:
-        with offscreen_figures():
-            if res.n_planes > 1:
-                fig = plot_planes(res)
-            elif cals:
-                fig = plot_calibrated(cals[0])
-            else:
-                fig = plot_characteristic(res)
-        save_figure(fig, args.plot, overwrite=args.force, inputs=args._inputs)
+        if res.n_planes > 1:
+            plot, data = plot_planes, res
+        elif cals:
+            plot, data = plot_calibrated, cals[0]
+        else:
+            plot, data = plot_characteristic, res
+        save_plot(lambda: plot(data), args.plot, args)
     if args.plot_rotation:
-        with offscreen_figures():
-            fig = plot_rotation(cals[0])
-        save_figure(fig, args.plot_rotation, overwrite=args.force)
+        save_plot(lambda: plot_rotation(cals[0]), args.plot_rotation, args)
     if args.layout:
         key = "object_heights_mm" if res.field_kind == "height" else "fields_deg"
-        with offscreen_figures():
-            fig = plot_layout(
+        save_plot(
+            lambda: plot_layout(
                 lens,
                 **{key: res.fields},
                 object_distance=res.object_distance,
                 z_planes=res.z_planes,
                 wavelength=args.wavelength,
-            )
-        save_figure(fig, args.layout, overwrite=args.force)
-
-
-def add_force_arg(q: argparse.ArgumentParser) -> None:
-    q.add_argument(
-        "--force", action="store_true", help="Replace existing output files (never an input)."
-    )
+            ),
+            args.layout,
+            args,
+        )
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     from .colour import add_scale_arg, add_wavelengths_arg
-    from .common import REFERENCES
     from .definitions import add_definition_args
 
     q = sub.add_parser(
@@ -305,7 +245,6 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope distortion twinplex-like-55-525 --object-s -55.0009 "
             "--s-prime 425,525,625"
         ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_lens_arg(q)
     add_object_args(q)
@@ -322,12 +261,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_scale_arg(q)
     add_definition_args(q)
     add_table_layout_arg(q)
-    q.add_argument(
-        "--strict",
-        action="store_true",
-        help="Exit with status 2 when a field cannot be traced, or when the lens file names a "
-        "glass read only as a substitute (an N- successor, a parent glass, a model of nd/vd).",
-    )
+    add_strict_arg(q)
     g = q.add_argument_group("plots")
     g.add_argument(
         "--plot",
@@ -389,8 +323,6 @@ def _grid_mode(args) -> bool:
 
 
 def _grid_size(text: str | None) -> tuple[int, int]:
-    from .common import CliError
-
     if text is None:
         return (21, 21)
     parts = text.lower().replace("×", "x").split("x")
@@ -412,19 +344,10 @@ def _grid(args, lens) -> int:
     from distortion.grid import decompose_distortion, distortion_grid, fit_brown_conrady
 
     from ..report.grid import format_grid, grid_to_dict
-    from .common import (
-        MAX_FIELDS,
-        CliError,
-        check_size,
-        print_json,
-        resolve_object,
-        resolve_planes,
-        strict_check,
-    )
 
-    bad = [
-        flag
-        for flag, on in (
+    refuse_flags(
+        "--grid (2-D distortion) does not combine with {}",
+        (
             ("--fields", args.fields is not None),
             ("--steps", args.steps is not None),
             ("--calibrate", args.calibrate is not None),
@@ -433,11 +356,8 @@ def _grid(args, lens) -> int:
             ("--plot-rotation", args.plot_rotation),
             ("--layout", args.layout),
             ("--wavelengths", getattr(args, "wavelengths", None) is not None),
-        )
-        if on
-    ]
-    if bad:
-        raise CliError(f"--grid (2-D distortion) does not combine with {', '.join(bad)}")
+        ),
+    )
     nx, ny = _grid_size(args.grid)
     check_size(nx * ny, MAX_FIELDS, "--grid (fields)", args, per_item_bytes=400)
     _check_sensor_metrics(args, nx, ny)
@@ -481,15 +401,15 @@ def _grid(args, lens) -> int:
             decs.append(decompose_distortion(g, p))
             fits.append(fit_brown_conrady(g, p))
     metrics = _sensor_metrics(args, g)
-    if args.json:
-        print_json({"distortion_grid": grid_to_dict(g, decs, fits), **metrics[0]})
-    else:
-        print(format_grid(g, decs, fits) + metrics[1])
+    print_result(
+        args,
+        json=lambda: {"distortion_grid": grid_to_dict(g, decs, fits), **metrics[0]},
+        text=lambda: format_grid(g, decs, fits) + metrics[1],
+    )
     if (args.plot_grid or args.plot_vectors) and not np.isfinite(g.actual).any():
         raise CliError("no field could be traced: there is nothing to plot")
     if args.plot_grid or args.plot_vectors:
         from ..plots.grid import plot_distortion_vectors, plot_grid_distortion
-        from .common import save_plot
 
         if args.plot_grid:
             save_plot(lambda: plot_grid_distortion(g), args.plot_grid, args)
@@ -513,8 +433,6 @@ def _add_sensor_metrics_arg(g) -> None:
 
 def _check_sensor_metrics(args, nx: int, ny: int) -> None:
     """Refuse --sensor-metrics without --sensor or with even counts, before any trace."""
-    from .common import CliError
-
     if not getattr(args, "sensor_metrics", False):
         return
     if args.sensor is None:

@@ -4,7 +4,26 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_object_args, add_output_args, add_plane_args, add_wavelength_arg
+from .common import (
+    MAX_SAMPLES,
+    CliError,
+    add_field_args,
+    add_force_arg,
+    add_lens_arg,
+    add_object_args,
+    add_output_args,
+    add_plane_args,
+    add_wavelength_arg,
+    check_plot_path,
+    check_size,
+    load_input,
+    number,
+    print_result,
+    resolve_fields,
+    resolve_object,
+    resolve_planes,
+    save_plot,
+)
 
 #: Quick runs of these commands for the per-command tests (tests/test_hardening.py).
 SAMPLES = [
@@ -16,8 +35,6 @@ OUTPUTS = [("--plot", ".png")]
 
 
 def _common(lens, args):
-    from .common import CliError, resolve_object, resolve_planes
-
     od = resolve_object(lens, args)
     planes = resolve_planes(lens, args)
     if len(planes) != 1:
@@ -29,28 +46,18 @@ def _field_kw(value: float, kind: str) -> dict:
     return {"field_deg": value} if kind == "angle" else {"object_height_mm": value}
 
 
-def _check_plot(args, lens) -> None:
-    from .distortion import check_plot_path
-
-    args._inputs = [lens.path] if lens.path else []
-    check_plot_path(args.plot, "--plot", args)
-
-
 def _output(args, lens, key, items, to_dict, to_csv, to_text, what) -> None:
     """``items`` (ray fans or spot diagrams) as JSON (``{"lens", key: [...]}``), CSV or text on
     stdout, and the plot of ``--plot`` (:func:`orthoscope.plots.rays.plot_ray_fan` for
     ``key="fans"``, :func:`~orthoscope.plots.rays.plot_spot` for ``"spots"``)."""
-    from .common import print_json
-
-    if args.json:
-        print_json({"lens": lens.name, key: [to_dict(i) for i in items]})
-    elif args.csv:
-        print(to_csv(items))
-    else:
-        print(to_text(items))
+    print_result(
+        args,
+        json=lambda: {"lens": lens.name, key: [to_dict(i) for i in items]},
+        csv=lambda: to_csv(items),
+        text=lambda: to_text(items),
+    )
     if args.plot:
         from ..plots.rays import plot_ray_fan, plot_spot
-        from .common import save_plot
 
         plot = plot_ray_fan if key == "fans" else plot_spot
         save_plot(lambda: plot(items, title=f"{lens.name}: {what}"), args.plot, args)
@@ -60,10 +67,9 @@ def cmd_fan(args) -> int:
     from raytrace.trace import ray_fan
 
     from ..report.rays import fan_to_dict, fans_csv, format_fans
-    from .common import MAX_SAMPLES, check_size, load, number
 
-    lens = load(args.lens)
-    _check_plot(args, lens)
+    lens = load_input(args)
+    check_plot_path(args.plot, "--plot", args)
     kind = args.field_kind or lens.field.kind
     field = number(args.field, "--field")
     axes = ["y", "x"] if args.axis == "both" else [args.axis]
@@ -79,10 +85,9 @@ def cmd_spot(args) -> int:
     from raytrace.trace import spot_diagram
 
     from ..report.rays import format_spots, spot_to_dict, spots_csv
-    from .common import check_size, load, resolve_fields
 
-    lens = load(args.lens)
-    _check_plot(args, lens)
+    lens = load_input(args)
+    check_plot_path(args.plot, "--plot", args)
     fields, kind = resolve_fields(lens, args)
     check_size(args.rings, 1000, "--rings", args, per_item_bytes=6 * 200 * args.rings)
     spots = [
@@ -96,10 +101,18 @@ def cmd_spot(args) -> int:
     return 0
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    from .common import add_field_args, add_lens_arg
-    from .distortion import add_force_arg
+def _add_image_args(q: argparse.ArgumentParser, plot_help: str) -> None:
+    """What fan and spot share after their own flags: object, image plane, wavelength, --plot
+    (``plot_help``), --force, --json / --csv."""
+    add_object_args(q)
+    add_plane_args(q)
+    add_wavelength_arg(q)
+    q.add_argument("--plot", metavar="FILE", help=plot_help)
+    add_force_arg(q)
+    add_output_args(q)
 
+
+def register(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser(
         "fan",
         help="Ray fan: transverse ray aberrations of one field across the pupil.",
@@ -108,19 +121,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "minus the chief ray's, mm) in the image plane: tangential (eps_y against py) and/or "
         "sagittal (eps_x against px).",
         epilog="Example: orthoscope fan cooke-triplet-f4 --field 14 --axis both --plot fan.png",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     add_lens_arg(q)
     q.add_argument("--field", default="0", metavar="F", help="Field: degrees or object mm.")
     q.add_argument("--field-kind", choices=["angle", "height"], help="What --field is.")
     q.add_argument("--axis", choices=["y", "x", "both"], default="y", help="Fan direction.")
     q.add_argument("--n", type=int, default=21, help="Rays across the pupil.")
-    add_object_args(q)
-    add_plane_args(q)
-    add_wavelength_arg(q)
-    q.add_argument("--plot", metavar="FILE", help="Save the ray-fan plot (.png/.svg/.pdf).")
-    add_force_arg(q)
-    add_output_args(q)
+    _add_image_args(q, "Save the ray-fan plot (.png/.svg/.pdf).")
     q.set_defaults(func=cmd_fan)
 
     q = sub.add_parser(
@@ -130,7 +137,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         "and report the spot in the image plane relative to the chief ray: centroid, RMS radius "
         "and geometric radius about the centroid (mm in JSON, µm in the table).",
         epilog="Example: orthoscope spot cooke-triplet-f4 --fields 0,10,20 --plot spots.png",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     add_lens_arg(q)
     add_field_args(q)
@@ -139,10 +145,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Pupil sampling.",
     )  # fmt: skip
     q.add_argument("--rings", type=int, default=8, help="Rings (or points across) of the pattern.")
-    add_object_args(q)
-    add_plane_args(q)
-    add_wavelength_arg(q)
-    q.add_argument("--plot", metavar="FILE", help="Save the spot diagrams (.png/.svg/.pdf).")
-    add_force_arg(q)
-    add_output_args(q)
+    _add_image_args(q, "Save the spot diagrams (.png/.svg/.pdf).")
     q.set_defaults(func=cmd_spot)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 
 from .colour import add_wavelengths_arg
+from .common import CliError, add_output_args, add_strict_arg, print_result
 
 SAMPLES = [
     ["glass", "N-BK7", "--wavelengths", "F,d,C"],
@@ -58,7 +59,6 @@ def cmd_glass(args) -> int:
         glass_to_dict,
         search_to_dict,
     )
-    from .common import CliError, print_json
 
     if (args.name is None) == (args.search is None):
         raise CliError("give a glass NAME or --search nd=...,vd=... (one of them)")
@@ -74,10 +74,11 @@ def cmd_glass(args) -> int:
         matches = search_glass(
             nd, vd, args.count, catalogs=cats, include_retired=args.include_retired
         )
-        if args.json:
-            print_json(search_to_dict(nd, vd, matches))
-        else:
-            print(format_search(nd, vd, matches))
+        print_result(
+            args,
+            json=lambda: search_to_dict(nd, vd, matches),
+            text=lambda: format_search(nd, vd, matches),
+        )
         return 0
     g = lookup_glass(
         args.name, [args.catalog] if args.catalog else None, first_catalog_wins=bool(args.catalog)
@@ -91,10 +92,7 @@ def cmd_glass(args) -> int:
         wls = default_wavelengths(g)
     wl = np.asarray(wls, dtype=float)
     n = np.atleast_1d(g.material.index(wl, strict=args.strict))
-    if args.json:
-        print_json(glass_to_dict(g, wl, n))
-    else:
-        print(format_glass(g, wl, n))
+    print_result(args, json=lambda: glass_to_dict(g, wl, n), text=lambda: format_glass(g, wl, n))
     return 0
 
 
@@ -115,7 +113,6 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope glass S-BSL7 --catalog Ohara --json\n"
             "  orthoscope glass --search nd=1.62,vd=60 --count 5"
         ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     q.add_argument("name", metavar="NAME", nargs="?", help="Glass name (N-BK7, NSK16_SCHOTT).")
     q.add_argument(
@@ -134,10 +131,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Wavelengths for the index listing: nm, a number with a unit (0.5876um) or a line "
         "letter (F, d, C, e, g, ...). Default: the spectral lines inside the data range.",
     )
-    q.add_argument(
-        "--strict",
-        action="store_true",
-        help="Refuse wavelengths outside the glass's data range (default: a warning).",
+    add_strict_arg(
+        q, help="Refuse wavelengths outside the glass's data range (default: a warning)."
     )
     q.add_argument("--count", type=int, default=10, metavar="N", help="--search: how many.")
     q.add_argument(
@@ -145,5 +140,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="--search: also withdrawn / legacy glasses.",
     )
-    q.add_argument("--json", action="store_true", help="Print JSON.")
+    add_output_args(q, csv=False, json_help="Print JSON.")
     q.set_defaults(func=cmd_glass)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from .common import add_output_args, print_result
+
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
 SAMPLES = [["lenses"]]
@@ -15,13 +17,11 @@ def cmd_lenses(args) -> int:
     from raytrace.files.library import list_lenses
 
     from ..report.lenses import format_lens_table, lens_infos_to_dict
-    from .common import print_json
 
     infos = list_lenses()
-    if args.json:
-        print_json(lens_infos_to_dict(infos))
-    else:
-        print(format_lens_table(infos))
+    print_result(
+        args, json=lambda: lens_infos_to_dict(infos), text=lambda: format_lens_table(infos)
+    )
     return 0
 
 
@@ -32,5 +32,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="The bundled lenses with EFL, f-number, field, kind and source.",
         epilog="Example: orthoscope lenses --json",
     )
-    q.add_argument("--json", action="store_true", help="Print JSON.")
+    add_output_args(q, csv=False, json_help="Print JSON.")
     q.set_defaults(func=cmd_lenses)

@@ -11,10 +11,10 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from .common import CliError, print_json
+from . import EXIT_INTERRUPTED
+from .common import CliError, add_force_arg, add_output_args, print_json, refuse_flags
 
 EXIT_NOT_CONVERGED = 1
-EXIT_INTERRUPTED = 130
 
 
 class _Progress:
@@ -185,20 +185,18 @@ def cmd_optimize(args) -> int:
     from raytrace.files.output import check_output
     from raytrace.optimize import read_spec, start_lens
 
-    glob_only = [
-        f
-        for f, v in (
-            ("--time", args.time),
-            ("--seed", args.seed),
-            ("--starts", args.starts),
-            ("--workers", args.workers),
-            ("--hops", args.hops),
-            ("--glass-map", args.glass_map),
+    if not args.global_search:
+        refuse_flags(
+            "{} belong(s) to the global search: add --global",
+            (
+                ("--time", args.time is not None),
+                ("--seed", args.seed is not None),
+                ("--starts", args.starts is not None),
+                ("--workers", args.workers is not None),
+                ("--hops", args.hops is not None),
+                ("--glass-map", args.glass_map is not None),
+            ),
         )
-        if v is not None
-    ]
-    if glob_only and not args.global_search:
-        raise CliError(f"{', '.join(glob_only)} belong(s) to the global search: add --global")
     spec = read_spec(args.spec)
     if args.max_evaluations is not None:
         if args.max_evaluations < 1:
@@ -447,8 +445,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Write the lens even when the run did not converge (marked in its notes).",
     )
     q.add_argument("--quiet", action="store_true", help="No progress display.")
-    q.add_argument(
-        "--force", action="store_true", help="Replace existing output files (never an input)."
-    )
-    q.add_argument("--json", action="store_true", help="Print the result as JSON.")
+    add_force_arg(q)
+    add_output_args(q, csv=False, json_help="Print the result as JSON.")
     q.set_defaults(func=cmd_optimize)

@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_object_args, add_wavelength_arg
+from .common import (
+    add_lens_arg,
+    add_object_args,
+    add_output_args,
+    add_wavelength_arg,
+    load,
+    print_result,
+    resolve_object,
+)
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -17,15 +25,15 @@ def cmd_paraxial(args) -> int:
     from raytrace.paraxial import paraxial
 
     from ..report.paraxial import format_paraxial, paraxial_to_dict
-    from .common import load, print_json, resolve_object
 
     lens = load(args.lens)
     od = resolve_object(lens, args)
     par = paraxial(lens, od, args.wavelength)
-    if args.json:
-        print_json(paraxial_to_dict(lens, par))
-    else:
-        print(format_paraxial(lens, par))
+    print_result(
+        args,
+        json=lambda: paraxial_to_dict(lens, par),
+        text=lambda: format_paraxial(lens, par),
+    )
     return 0
 
 
@@ -38,8 +46,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "first vertex.",
         epilog="Example: orthoscope paraxial twinplex-like-55-525 --object-s -55.0009",
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_object_args(q)
     add_wavelength_arg(q)
-    q.add_argument("--json", action="store_true", help="Print JSON (keys as in the README).")
+    add_output_args(q, csv=False, json_help="Print JSON (keys as in the README).")
     q.set_defaults(func=cmd_paraxial)

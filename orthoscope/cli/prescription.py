@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from .common import add_lens_arg, add_output_args, load, print_result
+
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
 SAMPLES = [["prescription", "cooke-triplet-f4"]]
@@ -15,13 +17,11 @@ def cmd_prescription(args) -> int:
     from raytrace.listing import format_prescription
 
     from ..report.prescription import prescription_to_dict
-    from .common import load, print_json
 
     lens = load(args.lens)
-    if args.json:
-        print_json(prescription_to_dict(lens))
-    else:
-        print(format_prescription(lens))
+    print_result(
+        args, json=lambda: prescription_to_dict(lens), text=lambda: format_prescription(lens)
+    )
     return 0
 
 
@@ -34,6 +34,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         "its first-order summary. The same table is str(lens) in Python.",
         epilog="Example: orthoscope prescription cooke-triplet-f4",
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
-    q.add_argument("--json", action="store_true", help="Print JSON (keys carry units).")
+    add_lens_arg(q)
+    add_output_args(q, csv=False, json_help="Print JSON (keys carry units).")
     q.set_defaults(func=cmd_prescription)

@@ -7,11 +7,24 @@ from __future__ import annotations
 import argparse
 
 from .common import (
+    CliError,
     add_field_args,
+    add_force_arg,
     add_lens_arg,
     add_object_args,
     add_output_args,
+    add_strict_arg,
+    add_table_layout_arg,
     add_wavelength_arg,
+    check_finite_object,
+    check_plot_path,
+    field_keyword,
+    load_input,
+    print_result,
+    resolve_fields,
+    resolve_object,
+    save_plot,
+    strict_check,
 )
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -30,33 +43,21 @@ def cmd_pupils(args) -> int:
     from distortion.telecentricity import pupil_analysis
 
     from ..report.telecentricity import format_pupils, pupils_csv, pupils_to_dict
-    from .common import (
-        CliError,
-        field_keyword,
-        load_input,
-        print_json,
-        resolve_fields,
-        resolve_object,
-        save_plot,
-        strict_check,
-    )
-    from .distortion import check_plot_path
 
     lens = load_input(args)
     check_plot_path(args.plot, "--plot", args)
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
-    if kind == "height" and od == float("inf"):
-        raise CliError("object-height fields need a finite object (--object-distance)")
+    check_finite_object(kind, od)
     pa = pupil_analysis(
         lens, **field_keyword(fields, kind), object_distance=od, wavelength=args.wavelength
     )
-    if args.json:
-        print_json({"pupils": pupils_to_dict(pa)})
-    elif args.csv:
-        print(pupils_csv(pa))
-    else:
-        print(format_pupils(pa, layout=args.table_layout))
+    print_result(
+        args,
+        json=lambda: {"pupils": pupils_to_dict(pa)},
+        csv=lambda: pupils_csv(pa),
+        text=lambda: format_pupils(pa, layout=args.table_layout),
+    )
     if args.plot:
         if not np.isfinite(pa.cra_deg).any():
             raise CliError("no field could be traced (see the table): there is nothing to plot")
@@ -68,8 +69,6 @@ def cmd_pupils(args) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from .distortion import add_force_arg, add_table_layout_arg
-
     q = sub.add_parser(
         "pupils",
         help="Chief-ray angle (telecentricity), real pupils and viewpoint, dD0/ds' per field.",
@@ -87,19 +86,13 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope pupils super-angulon-de975637 --plot pupils.png\n"
             "  orthoscope pupils twinplex-like-55-525 --object-s -55.0009 --json"
         ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_lens_arg(q)
     add_object_args(q)
     add_field_args(q)
     add_wavelength_arg(q)
     add_table_layout_arg(q)
-    q.add_argument(
-        "--strict",
-        action="store_true",
-        help="Exit with status 2 when a field cannot be traced, or when the lens file names a "
-        "glass read only as a substitute (an N- successor, a parent glass, a model of nd/vd).",
-    )
+    add_strict_arg(q)
     q.add_argument(
         "--plot",
         metavar="FILE",

@@ -6,7 +6,21 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_object_args, add_output_args, add_plane_args, add_wavelength_arg
+from .common import (
+    CliError,
+    add_force_arg,
+    add_lens_arg,
+    add_object_args,
+    add_output_args,
+    add_plane_args,
+    add_wavelength_arg,
+    check_plot_path,
+    load_input,
+    print_result,
+    resolve_object,
+    resolve_planes,
+    save_plot,
+)
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -31,8 +45,6 @@ def cmd_report(args) -> int:
     from distortion.certificate import calibration_certificate
 
     from ..report.certificate import certificate_to_dict, format_certificate
-    from .common import CliError, load_input, print_json, resolve_object, resolve_planes
-    from .distortion import check_plot_path
 
     lens = load_input(args)
     check_plot_path(args.output, "-o", args)
@@ -55,13 +67,9 @@ def cmd_report(args) -> int:
         date=args.date,
     )
     d = certificate_to_dict(cert)
-    if args.json:
-        print_json({"certificate": d})
-    else:
-        print(format_certificate(d))
+    print_result(args, json=lambda: {"certificate": d}, text=lambda: format_certificate(d))
     if args.output:
         from ..plots.certificate import plot_certificate
-        from .common import save_plot
 
         save_plot(lambda: plot_certificate(d), args.output, args)
     return 0
@@ -89,9 +97,6 @@ def _step(text: str) -> float:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from .common import add_lens_arg
-    from .distortion import add_force_arg
-
     q = sub.add_parser(
         "report",
         help="Calibration certificate of the design: calibrated focal length, PPA/PPBS, radial "
@@ -111,7 +116,6 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope report topogon-like-pestrecov -o certificate.pdf\n"
             "  orthoscope report cooke-triplet-f4 --sensor 36x24 --object-distance 2m --json"
         ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_lens_arg(q)
     add_object_args(q)

@@ -11,9 +11,16 @@ import sys
 import time
 from pathlib import Path
 
-from .common import CliError, check_size, parse_list, print_json
+from . import EXIT_INTERRUPTED
+from .common import (
+    CliError,
+    add_force_arg,
+    add_output_args,
+    check_size,
+    parse_list,
+    print_json,
+)
 
-EXIT_INTERRUPTED = 130
 #: raytrace.tolerance.COMPENSATORS, spelled here so that building the parser imports no kernels
 #: (tests/test_tolerance_cli.py checks they are equal)
 COMPENSATORS = ("paraxial-refocus", "best-focus", "fixed-sensor")
@@ -384,11 +391,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(chunk by chunk, for very large runs: percentiles from 4096-bin histograms, within one "
         "bin width), or auto (exact up to 100,000 lenses; default).",
     )
-    q.add_argument("--json", action="store_true", help="Print JSON (keys carry units).")
+    add_output_args(q, csv=False, json_help="Print JSON (keys carry units).")
     q.add_argument("--quiet", action="store_true", help="No progress display.")
-    q.add_argument(
-        "--force",
-        action="store_true",
-        help="Replace an existing plot, and a chunk folder that holds a different run.",
+    add_force_arg(
+        q, help="Replace an existing plot, and a chunk folder that holds a different run."
     )
     q.set_defaults(func=cmd_tolerance)

@@ -5,11 +5,20 @@ from __future__ import annotations
 import argparse
 
 from .common import (
+    CliError,
     add_field_args,
+    add_lens_arg,
     add_object_args,
     add_output_args,
     add_plane_args,
     add_wavelength_arg,
+    check_finite_object,
+    load,
+    plane_origin,
+    print_result,
+    resolve_fields,
+    resolve_object,
+    resolve_planes,
 )
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -24,15 +33,6 @@ def cmd_trace(args) -> int:
     from raytrace.trace import aim
 
     from ..report.trace import format_trace, image_plane_dict, trace_csv, trace_to_dict
-    from .common import (
-        CliError,
-        load,
-        plane_origin,
-        print_json,
-        resolve_fields,
-        resolve_object,
-        resolve_planes,
-    )
 
     lens = load(args.lens)
     od = resolve_object(lens, args)
@@ -42,16 +42,15 @@ def cmd_trace(args) -> int:
     if len(planes) != 1:
         raise CliError("trace takes one image plane; 'orthoscope distortion' takes several")
     z_img = float(plane_z(par, planes)[0])
-    if kind == "height" and par.infinite:
-        raise CliError("object-height fields need a finite object (--object-distance)")
+    check_finite_object(kind, od)
     cr = aim(lens, fields, kind, od, args.wavelength)
     plane = image_plane_dict(par, z_img, plane_origin(args))
-    if args.json:
-        print_json(trace_to_dict(lens, par, cr, plane))
-    elif args.csv:
-        print(trace_csv(cr, z_img))
-    else:
-        print(format_trace(lens, par, cr, plane))
+    print_result(
+        args,
+        json=lambda: trace_to_dict(lens, par, cr, plane),
+        csv=lambda: trace_csv(cr, z_img),
+        text=lambda: format_trace(lens, par, cr, plane),
+    )
     return 0
 
 
@@ -64,7 +63,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "entrance-pupil position (z from the first vertex) and the ray status.",
         epilog="Example: orthoscope trace topogon-us2031792-fig1 --max-field 50 --steps 10 --json",
     )
-    q.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+    add_lens_arg(q)
     add_object_args(q)
     add_field_args(q)
     add_plane_args(q)

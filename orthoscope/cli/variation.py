@@ -9,7 +9,16 @@ from __future__ import annotations
 import argparse
 import math
 
-from .common import CliError, load_scaled, print_json
+from .common import (
+    CliError,
+    add_force_arg,
+    add_output_args,
+    check_plot_suffix,
+    load_scaled,
+    print_result,
+    refuse_flags,
+    save_plot,
+)
 
 CONJ_HELP = (
     "Distances are positive magnitudes: 'Nx' (also 'NX') is an image scale, Gaussian "
@@ -75,37 +84,27 @@ def cmd_variation(args) -> int:
         )
     if args.profiles:
         _check_outputs(args)
-        bad = [
-            f
-            for f, v in (
+        refuse_flags(
+            "{} only apply with --lens (prescription mode)",
+            (
                 ("--focus", args.focus),
                 ("--objects", args.objects),
                 ("--scale-to-efl", args.scale_to_efl),
                 ("--max-field", args.max_field),
                 ("--profiles-csv", args.profiles_csv),
-            )
-            if v
-        ]
-        if bad:
-            raise CliError(f"{', '.join(bad)} only apply with --lens (prescription mode)")
+            ),
+        )
         from distortion.variation.profiles import analyze_csv
 
         from ..report.variation import format_variation, variation_to_dict
 
-        a = analyze_csv(
-            args.profiles,
-            focal_length_mm=args.focal_length,
-            r_min=args.r_min,
-            r_max=args.r_max,
-            threshold_um=args.threshold_um,
-            method=args.method,
+        a = analyze_csv(args.profiles, focal_length_mm=args.focal_length, **_analysis_options(args))
+        print_result(
+            args,
+            json=lambda: {"mode": "data", "variation": variation_to_dict(a)},
+            csv=lambda: _g_csv(a),
+            text=lambda: format_variation(a),
         )
-        if args.json:
-            print_json({"mode": "data", "variation": variation_to_dict(a)})
-        elif args.csv:
-            _print_g_csv(a)
-        else:
-            print(format_variation(a))
         _plots(a, args)
         return 0
 
@@ -122,10 +121,9 @@ def cmd_variation(args) -> int:
 
         lens, confs = read_configured(args.lens)
         st = focus_study(lens, confs, focus_index=len(confs) // 2, max_field_deg=args.max_field)
-        if args.json:
-            print_json(focus_study_to_dict(st))
-        else:
-            print(format_focus_study(st))
+        print_result(
+            args, json=lambda: focus_study_to_dict(st), text=lambda: format_focus_study(st)
+        )
         return 0
     if not args.focus:
         raise CliError("prescription mode needs --focus (e.g. --focus 12x)")
@@ -141,31 +139,36 @@ def cmd_variation(args) -> int:
         lens,
         _focus_list(args.focus),
         parse_conjugates(args.objects),
-        r_min=args.r_min,
-        r_max=args.r_max,
         n_r=args.n_r,
         max_field_deg=args.max_field,
-        threshold_um=args.threshold_um,
-        method=args.method,
         reference=args.reference,
+        **_analysis_options(args),
     )
     if args.profiles_csv:
         _write_profiles_csv(tv, args.profiles_csv, force=args.force, inputs=args._inputs)
-    if args.json:
-        print_json(traced_variation_to_dict(tv))
-    elif args.csv:
-        _print_g_csv(tv.analysis)
-    else:
-        print(format_traced_variation(tv))
+    print_result(
+        args,
+        json=lambda: traced_variation_to_dict(tv),
+        csv=lambda: _g_csv(tv.analysis),
+        text=lambda: format_traced_variation(tv),
+    )
     _plots(tv.analysis, args)
     return 0
+
+
+def _analysis_options(args) -> dict:
+    """The options of the analysis that both modes share: radius range, threshold, g method."""
+    return {
+        "r_min": args.r_min,
+        "r_max": args.r_max,
+        "threshold_um": args.threshold_um,
+        "method": args.method,
+    }
 
 
 def _check_outputs(args) -> None:
     """Refuse bad output files before any work (same file as an input, existing without
     --force, unknown plot suffix)."""
-    from pathlib import Path
-
     from raytrace.files.output import check_output
 
     if not hasattr(args, "_inputs"):
@@ -174,35 +177,32 @@ def _check_outputs(args) -> None:
         if path:
             check_output(path, inputs=args._inputs, overwrite=args.force, flag="--force")
     for flag, path in (("--plot", args.plot), ("--plot-g", args.plot_g)):
-        if path and Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise CliError(f"{flag} {path}: the file must end in .png, .svg or .pdf")
+        if path:
+            check_plot_suffix(path, flag)
 
 
 def _plots(a, args) -> None:
     if not (args.plot or args.plot_g):
         return
-    from ..plots.common import offscreen_figures
-    from ..plots.save import save_figure
     from ..plots.variation import plot_g, plot_profiles
 
-    for path, fn in ((args.plot, plot_profiles), (args.plot_g, plot_g)):
+    for path, plot in ((args.plot, plot_profiles), (args.plot_g, plot_g)):
         if path:
-            with offscreen_figures():
-                fig = fn(a)
-            save_figure(fig, path, overwrite=args.force, inputs=args._inputs)
+            save_plot(lambda plot=plot: plot(a), path, args)
 
 
-def _print_g_csv(a) -> None:
+def _g_csv(a) -> str:
+    """--csv: one row per object plane (gamma, g, its standard error, RMS errors)."""
+
+    def v(x):
+        return "" if x is None or not math.isfinite(x) else repr(float(x))
+
     gam = {(g.focus.label, g.obj.label): g.gamma for g in a.gammas}
-    print("focus,object,gamma,g,se,n_used,n_excluded,rms_fit_um,rms_mean_g_um,status")
+    rows = ["focus,object,gamma,g,se,n_used,n_excluded,rms_fit_um,rms_mean_g_um,status"]
     for fs in a.focus_summaries:
         for p in fs.planes:
             e = p.estimate
-
-            def v(x):
-                return "" if x is None or not math.isfinite(x) else repr(float(x))
-
-            print(
+            rows.append(
                 ",".join(
                     [
                         p.focus.label,
@@ -218,6 +218,7 @@ def _print_g_csv(a) -> None:
                     ]
                 )
             )
+    return "\n".join(rows)
 
 
 def _write_profiles_csv(tv, path: str, *, force: bool, inputs) -> None:
@@ -333,12 +334,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="g per plane by least squares through the origin (lsq) or as the mean "
         "of the pointwise ratios (mean, the paper's Tables 2-3).",
     )
-    g = q.add_mutually_exclusive_group()
-    g.add_argument("--json", action="store_true", help="Print JSON (all tables and profiles).")
-    g.add_argument(
-        "--csv",
-        action="store_true",
-        help="Print CSV: one row per object plane (gamma, g, se, RMS errors).",
+    add_output_args(
+        q,
+        json_help="Print JSON (all tables and profiles).",
+        csv_help="Print CSV: one row per object plane (gamma, g, se, RMS errors).",
     )
     q.add_argument(
         "--profiles-csv",
@@ -352,7 +351,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="FILE.png",
         help="Plot g_ss' against radial distance (paper's Figs. 5-7).",
     )
-    q.add_argument(
-        "--force", action="store_true", help="Replace existing output files (never an input)."
-    )
+    add_force_arg(q)
     q.set_defaults(func=cmd_variation)

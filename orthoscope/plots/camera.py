@@ -17,7 +17,7 @@ import numpy as np
 from distortion.camera import CameraComparison, CameraModel, DistortionPicture, TracedCamera
 from distortion.errors import DataError
 
-from .common import GRID, ZERO, figure_and_axes, fmt, legend, set_title
+from .common import GRID, ZERO, figure_and_axes, fmt, legend, panel_figure, set_title
 
 ARROWS = "tab:red"
 MEASURED = "tab:blue"
@@ -172,9 +172,7 @@ def plot_difference_map(c: CameraComparison, *, ax=None, title: str | None = Non
 def plot_calibration_comparison(c: CameraComparison):
     """Two panels side by side: the radial curves (:func:`plot_radial_comparison`) and the map
     of the difference (:func:`plot_difference_map`)."""
-    fig, ax0 = figure_and_axes(None, figsize=(14.0, 5.0))
-    ax0.remove()
-    axs = fig.subplots(1, 2)
+    fig, axs = panel_figure(1, 2, figsize=(14.0, 5.0))
     plot_radial_comparison(c, ax=axs[0])
     plot_difference_map(c, ax=axs[1])
     return fig

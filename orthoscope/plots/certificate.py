@@ -15,7 +15,7 @@ import textwrap
 
 import numpy as np
 
-from .common import GRID, ZERO, figure_and_axes
+from .common import GRID, ZERO, blank_figure, figure_and_axes
 
 #: how the page spells the plain-text labels of the report cells
 PRETTY = (
@@ -300,8 +300,7 @@ def plot_certificate(cert):
     left, +x−y bottom right), the decentering profile and the four curves together — and the
     definitions at the foot."""
     d = _as_dict(cert)
-    fig, ax = figure_and_axes(None, figsize=PAGE)
-    ax.remove()
+    fig = blank_figure(PAGE)
     fig.set_layout_engine("none")
     fig.orthoscope_page = True  # save_figure keeps the whole A4 page (no tight bounding box)
     pg = _Page(fig)

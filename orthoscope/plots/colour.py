@@ -15,7 +15,7 @@ from distortion.characteristic import ChromaticDistortion
 from distortion.colour import FocalShift, LateralColour
 from distortion.errors import DataError
 
-from .common import GRID, ZERO, figure_and_axes, set_title
+from .common import GRID, ZERO, figure_and_axes, panel_figure, set_title
 
 
 def wavelength_colour(nm: float) -> tuple[float, float, float]:
@@ -117,9 +117,7 @@ def plot_distortion_by_wavelength(
 def plot_colour_summary(fs: FocalShift, lc: LateralColour, cd: ChromaticDistortion):
     """One figure of three panels: the focal-shift curve, lateral colour and distortion per
     wavelength (first image plane)."""
-    fig, ax0 = figure_and_axes(None, figsize=(15.0, 4.6))
-    ax0.remove()
-    axs = fig.subplots(1, 3)
+    fig, axs = panel_figure(1, 3, figsize=(15.0, 4.6))
     plot_focal_shift(fs, ax=axs[0])
     plot_lateral_colour(lc, ax=axs[1])
     plot_distortion_by_wavelength(cd, ax=axs[2])

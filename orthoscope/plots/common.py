@@ -83,6 +83,21 @@ def figure_and_axes(ax=None, *, figsize: tuple[float, float] = FIGSIZE):
     return fig, ax
 
 
+def blank_figure(figsize: tuple[float, float]):
+    """A new figure of ``figsize`` inches with no Axes (made as :func:`figure_and_axes` makes
+    one: pyplot's, or a plain ``Figure`` inside :func:`offscreen_figures`)."""
+    fig, ax = figure_and_axes(None, figsize=figsize)
+    ax.remove()
+    return fig
+
+
+def panel_figure(rows: int, cols: int, *, figsize: tuple[float, float]):
+    """``(figure, axes)``: a new :func:`blank_figure` with a ``rows`` x ``cols`` grid of Axes
+    (``axes`` as :meth:`matplotlib.figure.Figure.subplots` returns them)."""
+    fig = blank_figure(figsize)
+    return fig, fig.subplots(rows, cols)
+
+
 # ------------------------------------------------------------------ titles and numbers
 
 

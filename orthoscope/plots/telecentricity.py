@@ -10,7 +10,7 @@ from distortion.curve import HEIGHT
 from distortion.errors import DataError
 from distortion.telecentricity import PupilAnalysis
 
-from .common import GRID, ZERO, figure_and_axes, fmt, set_title
+from .common import GRID, ZERO, figure_and_axes, fmt, panel_figure, set_title
 
 
 def _check(pa) -> None:
@@ -100,9 +100,7 @@ def plot_entrance_pupil(pa: PupilAnalysis, *, ax=None, title: str | None = None)
 def plot_pupils(pa: PupilAnalysis):
     """One figure of three panels: chief-ray angle, ∂D0/∂s' and the entrance-pupil shift."""
     _check(pa)
-    fig, ax0 = figure_and_axes(None, figsize=(15.0, 4.6))
-    ax0.remove()
-    axs = fig.subplots(1, 3)
+    fig, axs = panel_figure(1, 3, figsize=(15.0, 4.6))
     plot_chief_ray_angle(pa, ax=axs[0])
     plot_distortion_slope(pa, ax=axs[1])
     plot_entrance_pupil(pa, ax=axs[2])

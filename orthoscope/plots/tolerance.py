@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import GRID, ZERO, figure_and_axes, set_title
+from .common import GRID, ZERO, figure_and_axes, panel_figure, set_title
 
 #: the envelope bands drawn (outer, inner percentile pairs), when the run computed them
 BANDS = ((2.5, 97.5), (16.0, 84.0))
@@ -137,9 +137,8 @@ def plot_tolerance(mc=None, sens=None, *, limits=()):
         panels.append("sens")
     cols = 3 if len(panels) > 2 else max(1, len(panels))
     rows = -(-len(panels) // cols)
-    fig, ax0 = figure_and_axes(None, figsize=(5.2 * cols, 3.9 * rows))
-    ax0.remove()
-    axs = np.atleast_1d(fig.subplots(rows, cols)).ravel()
+    fig, axs = panel_figure(rows, cols, figsize=(5.2 * cols, 3.9 * rows))
+    axs = np.atleast_1d(axs).ravel()
     for ax, p in zip(axs, panels, strict=False):
         if p == "env":
             plot_envelope(mc, limits=limits, ax=ax)

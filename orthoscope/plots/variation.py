@@ -45,6 +45,17 @@ def _source(a: VariationAnalysis) -> str:
     return (Path(s).name if s.lower().endswith(".csv") else s) or "profiles"
 
 
+def _finish(ax, ylabel: str, title: str, handles: list, labels: list[str], key: str) -> None:
+    """Axis labels (radial distance r across), the wrapped title, the grid and — when there are
+    curves — the legend titled ``key``."""
+    ax.set_xlabel("radial distance r (mm)")
+    ax.set_ylabel(ylabel)
+    set_title(ax, title)
+    ax.grid(True, **GRID)
+    if handles:
+        legend(ax, handles, labels, title=key, fontsize=8, title_fontsize=8)
+
+
 def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
     """Radial distortion profiles i×(j×) of an analysis (Fraser & Shortis Figs. 1–4 style):
     δr (µm) against the radial distance r (mm); Gaussian profiles (object plane = plane of
@@ -83,19 +94,14 @@ def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
         handles.append(h)
         labels.append(p.label)
     ax.axhline(0.0, **ZERO)
-    ax.set_xlabel("radial distance r (mm)")
-    ax.set_ylabel(r"radial distortion $\delta r$ (µm)")
-    set_title(ax, title or f"Radial distortion profiles — {_source(a)}")
-    ax.grid(True, **GRID)
-    if handles:
-        legend(
-            ax,
-            handles,
-            labels,
-            title="object plane (plane of focus)",
-            fontsize=8,
-            title_fontsize=8,
-        )
+    _finish(
+        ax,
+        r"radial distortion $\delta r$ (µm)",
+        title or f"Radial distortion profiles — {_source(a)}",
+        handles,
+        labels,
+        "object plane (plane of focus)",
+    )
     return fig
 
 
@@ -152,22 +158,15 @@ def plot_g(a: VariationAnalysis, *, ax=None, title: str | None = None):
         lo, hi = np.percentile(finite, [2, 98])
         pad = max(0.1, 0.25 * (hi - lo))
         ax.set_ylim(lo - pad, hi + pad)
-    ax.set_xlabel("radial distance r (mm)")
-    ax.set_ylabel("distortion factor $g_{ss'}$ (dimensionless)")
-    set_title(ax, title or f"Distortion factor $g_{{ss'}}$ (Eq. 6) — {_source(a)}")
-    ax.grid(True, **GRID)
-    if handles:
-        legend(
-            ax,
-            handles,
-            labels,
-            fontsize=8,
-            title=(
-                rf"dashed, open: $|\delta r_{{s'}} - \delta r_s|$ < {a.threshold_um:g} µm (weak)"
-            ),
-            title_fontsize=8,
-        )
-    else:
+    _finish(
+        ax,
+        "distortion factor $g_{ss'}$ (dimensionless)",
+        title or f"Distortion factor $g_{{ss'}}$ (Eq. 6) — {_source(a)}",
+        handles,
+        labels,
+        rf"dashed, open: $|\delta r_{{s'}} - \delta r_s|$ < {a.threshold_um:g} µm (weak)",
+    )
+    if not handles:
         ax.text(
             0.5,
             0.5,

@@ -24,19 +24,8 @@ from distortion.errors import DataError
 from raytrace.kernels.codes import STATUS_NAMES
 
 from .text import csv_text
+from .units import PARAMETER_UNITS
 
-_AUSTRALIS_UNITS = {
-    "c": "mm",
-    "xp": "mm",
-    "yp": "mm",
-    "K1": "mm^-2",
-    "K2": "mm^-4",
-    "K3": "mm^-6",
-    "P1": "mm^-1",
-    "P2": "mm^-1",
-    "b1": "",
-    "b2": "",
-}
 _PIXEL_PARAMS = ("f", "fx", "fy", "cx", "cy")
 #: a fit whose (column-scaled) Jacobian is worse conditioned than this gets a note
 CONDITION_NOTE = 1e5
@@ -50,7 +39,7 @@ def parameter_units(camera: CameraModel) -> dict[str, str]:
     out = {}
     for n in camera.spec.params:
         if camera.model == "australis":
-            out[n] = _AUSTRALIS_UNITS.get(n, "")
+            out[n] = PARAMETER_UNITS.get(n, "")
         elif n in _PIXEL_PARAMS:
             out[n] = "px"
         elif n in _RADIAN_PARAMS:

@@ -4,11 +4,10 @@ the focal length it uses."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from distortion.definitions import ProjectionDistortion
 from raytrace.kernels.codes import STATUS_NAMES
 
+from .jsonout import float_list
 from .text import csv_text, format_columns
 
 
@@ -69,10 +68,6 @@ def format_projection(res: ProjectionDistortion, *, decimals: int = 4, layout: s
 
 def projection_to_dict(res: ProjectionDistortion) -> dict:
     """JSON-ready dict (keys carry units; relative values as fractions and in per cent)."""
-
-    def lst(a):
-        return np.asarray(a, dtype=float).ravel().tolist()
-
     return {
         "lens": res.name,
         "definition": res.definition,
@@ -82,7 +77,7 @@ def projection_to_dict(res: ProjectionDistortion) -> dict:
         "focal_basis": res.focal_basis,
         "focal_description": res.focal_description,
         "object_distance_mm": float("inf"),
-        "angle_deg": lst(res.fields),
+        "angle_deg": float_list(res.fields),
         "scale": res.scale or None,
         "reference_wavelength_nm": res.reference_wavelength,
         "wavelengths": [
@@ -101,11 +96,11 @@ def projection_to_dict(res: ProjectionDistortion) -> dict:
                         "least_squares_focal_length_mm": float(
                             res.least_squares_focal_length[k, i]
                         ),
-                        "y_ref_mm": lst(res.y_ref[k, i]),
-                        "yp_mm": lst(res.yp[k, i]),
-                        "D_mm": lst(res.D[k, i]),
-                        "Dr": lst(res.Dr[k, i]),
-                        "Dr_pct": lst(100.0 * res.Dr[k, i]),
+                        "y_ref_mm": float_list(res.y_ref[k, i]),
+                        "yp_mm": float_list(res.yp[k, i]),
+                        "D_mm": float_list(res.D[k, i]),
+                        "Dr": float_list(res.Dr[k, i]),
+                        "Dr_pct": float_list(100.0 * res.Dr[k, i]),
                     }
                     for i in range(res.n_planes)
                 ],

@@ -3,14 +3,13 @@ V), calibrations (Table II) and compensation residuals (Section VI)."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from distortion.calibration import CalibrationResult
 from distortion.characteristic import CharacteristicDistortion
 from distortion.compensation import CompensationResult
 from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 from raytrace.kernels.codes import STATUS_NAMES
 
+from .jsonout import float_list
 from .text import csv_text, format_columns
 
 
@@ -94,18 +93,14 @@ def format_characteristic(
 
 def characteristic_to_dict(res: CharacteristicDistortion) -> dict:
     """JSON-ready dict of a traced distortion result (keys carry units; see jsonout)."""
-
-    def lst(a):
-        return np.asarray(a, dtype=float).ravel().tolist()
-
     return {
         "lens": res.name,
         "reference": res.reference,
         "field_kind": res.field_kind,
         "object_distance_mm": res.object_distance,
-        "fields": lst(res.fields),
-        "x": lst(res.x),
-        "y_mm": lst(res.y),
+        "fields": float_list(res.fields),
+        "x": float_list(res.x),
+        "y_mm": float_list(res.y),
         "status": [STATUS_NAMES.get(int(c), str(int(c))) for c in res.status],
         "gaussian_constant": res.gaussian_constant,
         "planes": [
@@ -116,11 +111,11 @@ def characteristic_to_dict(res: CharacteristicDistortion) -> dict:
                 "defocus_mm": float(res.defocus[i]),
                 "F0_mm" if res.symbol == "F" else "M0": float(res.constant[i]),
                 "scale": float(res.scale[i]),
-                "y0p_mm": lst(res.y0p[i]),
-                "yp_mm": lst(res.yp[i]),
-                "D0_mm": lst(res.D0[i]),
-                "Dr": lst(res.Dr[i]),
-                "Dr_pct": lst(100.0 * res.Dr[i]),
+                "y0p_mm": float_list(res.y0p[i]),
+                "yp_mm": float_list(res.yp[i]),
+                "D0_mm": float_list(res.D0[i]),
+                "Dr": float_list(res.Dr[i]),
+                "Dr_pct": float_list(100.0 * res.Dr[i]),
             }
             for i in range(res.n_planes)
         ],

@@ -12,22 +12,7 @@ import numpy as np
 from distortion.grid import BrownConradyFit, DistortionGrid, GridDecomposition
 from raytrace.kernels.codes import STATUS_NAMES
 
-_UNITS = {
-    "c": "mm",
-    "x0": "mm",
-    "y0": "mm",
-    "xp": "mm",
-    "yp": "mm",
-    "K1": "mm^-2",
-    "K2": "mm^-4",
-    "K3": "mm^-6",
-    "P1": "mm^-1",
-    "P2": "mm^-1",
-    "S1": "mm^-1",
-    "S2": "mm^-1",
-    "b1": "",
-    "b2": "",
-}
+from .units import PARAMETER_UNITS
 
 
 def _g(v: float, digits: int = 6) -> str:
@@ -44,7 +29,9 @@ def _param_lines(values: dict, std: dict, order: Sequence[str]) -> list[str]:
             continue
         se = std.get(k, math.nan)
         held = "" if k in std else "  (held)"
-        out.append(f"    {k:<10}{_g(values[k], 9):>16}{_g(se, 3):>14}  {_UNITS.get(k, '')}{held}")
+        out.append(
+            f"    {k:<10}{_g(values[k], 9):>16}{_g(se, 3):>14}  {PARAMETER_UNITS.get(k, '')}{held}"
+        )
     return out
 
 

@@ -36,6 +36,12 @@ def jsonable(obj: Any) -> Any:
     return obj
 
 
+def float_list(a: Any) -> list[float]:
+    """``a`` (a number or an array of any shape) flattened to a list of Python floats; NaN and
+    infinities stay as they are (:func:`jsonable` converts them)."""
+    return np.asarray(a, dtype=float).ravel().tolist()
+
+
 def dumps(obj: Any) -> str:
     """Strict JSON text of ``obj`` (indented, UTF-8 characters kept)."""
     return json.dumps(jsonable(obj), indent=2, ensure_ascii=False, allow_nan=False)

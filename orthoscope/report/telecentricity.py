@@ -11,6 +11,7 @@ from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE
 from distortion.telecentricity import PupilAnalysis
 from raytrace.kernels.codes import STATUS_NAMES
 
+from .jsonout import float_list
 from .text import csv_text, format_columns
 
 _FIELD_LABEL = {ANGLE: "alpha (deg)", HEIGHT: "y (mm)", NOMINAL_ANGLE: "nominal alpha (deg)"}
@@ -83,15 +84,11 @@ def format_pupils(pa: PupilAnalysis, *, decimals: int = 4, layout: str = "rows")
 
 def pupils_to_dict(pa: PupilAnalysis) -> dict:
     """JSON-ready dict (keys carry units; infinite pupil positions as "inf"/"-inf")."""
-
-    def lst(a):
-        return np.asarray(a, dtype=float).ravel().tolist()
-
     par = pa.paraxial
     return {
         "lens": pa.name,
         "field_kind": pa.field_kind,
-        "fields": lst(pa.fields),
+        "fields": float_list(pa.fields),
         "object_distance_mm": pa.object_distance,
         "wavelength_nm": pa.wavelength,
         "paraxial": {
@@ -102,17 +99,17 @@ def pupils_to_dict(pa: PupilAnalysis) -> dict:
             "constant_slope_unit": "1/mm" if pa.finite else "1",
         },
         "max_abs_cra_deg": pa.max_abs_cra_deg,
-        "x": lst(pa.x),
-        "cra_deg": lst(pa.cra_deg),
-        "cra_paraxial_deg": lst(pa.cra_paraxial_deg),
-        "exit_pupil_z_mm": lst(pa.exit_pupil_z),
-        "exit_pupil_shift_mm": lst(pa.exit_pupil_shift),
-        "distortion_slope": lst(pa.slope),
-        "theta_object_deg": lst(pa.theta_object_deg),
-        "entrance_pupil_z_mm": lst(pa.entrance_pupil_z),
-        "entrance_pupil_shift_mm": lst(pa.entrance_pupil_shift),
-        "height_at_E0_mm": lst(pa.height_at_E0),
-        "viewpoint_offset_mm": lst(pa.viewpoint_offset),
+        "x": float_list(pa.x),
+        "cra_deg": float_list(pa.cra_deg),
+        "cra_paraxial_deg": float_list(pa.cra_paraxial_deg),
+        "exit_pupil_z_mm": float_list(pa.exit_pupil_z),
+        "exit_pupil_shift_mm": float_list(pa.exit_pupil_shift),
+        "distortion_slope": float_list(pa.slope),
+        "theta_object_deg": float_list(pa.theta_object_deg),
+        "entrance_pupil_z_mm": float_list(pa.entrance_pupil_z),
+        "entrance_pupil_shift_mm": float_list(pa.entrance_pupil_shift),
+        "height_at_E0_mm": float_list(pa.height_at_E0),
+        "viewpoint_offset_mm": float_list(pa.viewpoint_offset),
         "status": [STATUS_NAMES.get(int(c), str(int(c))) for c in pa.status],
     }
 

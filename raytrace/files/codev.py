@@ -65,14 +65,13 @@ from pathlib import Path
 from ..errors import LensError, PrescriptionError
 from ..frames import Placement, codev_tilt
 from ..glass import normalize_name, parse_glass_code, private_material, resolve_glass
-from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
+from ..lens import Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material
 from .text import (
     ImportResult,
     LineParser,
     emit_warnings,
     guarded_parse,
-    lens_error,
     number,
     read_bytes,
     solve_paraxial_image,
@@ -90,7 +89,16 @@ _IGNORED = set(
 _DECENTER = {"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE"}
 _DECENTER_TYPES = {"DEC": "basic", "DAR": "dar", "BEN": "bend", "REV": "rev"}
 _APERTURES = {"CIR", "REX", "REY", "ELX", "ELY", "ADX", "ADY"}
-_SPECIAL = {"DIF", "HOE", "HCO", "HWL", "HOR", "GRT", "SPS", "UDS", "GRIN", "GRD", "ZRN"}
+#: commands refused (at their line, naming the surface before them), and why
+_REFUSED = dict.fromkeys(
+    ("RET", "GLB", "TILT"),
+    "coordinates relative to another surface are not supported; in CODE V convert the decenters "
+    "to DEC/DAR/BEN/REV form (local to each surface) and save the .seq again",
+) | dict.fromkeys(
+    ("DIF", "HOE", "HCO", "HWL", "HOR", "GRT", "SPS", "UDS", "GRIN", "GRD", "ZRN"),
+    "diffractive, gradient-index and special surfaces are not supported; orthoscope reads "
+    "spheres, conics and even aspheres (ASP with K, A, B, C, D ...)",
+)
 
 
 @dataclass
@@ -351,22 +359,8 @@ class _SeqParser(LineParser):
                     if cur.kind == "SI" and cmd != "DEC":
                         raise self.err(f"{cmd} on the image surface (SI) has no meaning", line)
                     cur.dtype = _DECENTER_TYPES[cmd]
-            elif cmd in ("RET", "GLB", "TILT"):
-                raise self.err(
-                    f"{cmd}: coordinates relative to another surface are not supported; in "
-                    "CODE V convert the decenters to DEC/DAR/BEN/REV form (local to each "
-                    "surface) and save the .seq again",
-                    line,
-                    max(len(surfs) - 1, 0) or None,
-                )
-            elif cmd in _SPECIAL:
-                raise self.err(
-                    f"{cmd}: diffractive, gradient-index and special surfaces are not "
-                    "supported; orthoscope reads spheres, conics and even aspheres (ASP with "
-                    "K, A, B, C, D ...)",
-                    line,
-                    max(len(surfs) - 1, 0) or None,
-                )
+            elif cmd in _REFUSED:
+                raise self.err(f"{cmd}: {_REFUSED[cmd]}", line, max(len(surfs) - 1, 0) or None)
             elif cmd in ("REFL", "REFLECT"):
                 if cur is None or cur.kind != "S":
                     raise self.err("REFL must follow a lens surface line (S r t)", line)
@@ -758,9 +752,7 @@ class _SeqParser(LineParser):
             if math.isinf(od):
                 raise self.err("YOB: object heights need a finite object distance (SO)", fline)
             fld = Field("height", fmax * scale, tuple((a * scale, b * scale) for a, b in pts))
-        if self.unknown:
-            listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
-            self.warn(f"unknown commands skipped: {listing}")
+        self.warn_unknown()
         name = h.get("TITLE") or (Path(self.path).stem if self.path else "CODE V lens")
         kw = dict(
             name=name,
@@ -780,11 +772,7 @@ class _SeqParser(LineParser):
             path=self.path,
         )
         lines = [s.line for s in body]
-        try:
-            lens = Lens(**kw)
-            check_file_lens(lens)
-        except (LensError, ValueError) as e:
-            raise lens_error(self.err, e, lines, obj.line) from None
+        lens = self.file_lens(lines, obj.line, **kw)
         if pims:
             if lens.is_centred:
                 lens = self.solve_image(lens, pims[-1].pim, lines)

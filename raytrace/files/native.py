@@ -76,7 +76,7 @@ from ..lens import APERTURE_KINDS, IMAGE_FIELDS, Aperture, ClearAperture, Field,
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from ..qtype import FORMS, QType
 from .output import write_atomic
-from .text import decode_text, read_bytes
+from .text import decode_text, read_bytes, solve_paraxial_image
 
 WHAT = "a TOML lens prescription"
 
@@ -1046,32 +1046,27 @@ def _make_lens(src: _Source, **kw: Any) -> Lens:
 
 
 def _solve_gaussian(src: _Source, lens: Lens) -> Lens:
-    """Put the image plane at the paraxial image of the lens's own object."""
-    from ..paraxial import paraxial
-
+    """Put the image plane at the paraxial image of the lens's own object (``t = "gaussian"``)."""
     n = lens.n_surfaces
     line = src.surface_line(n - 1)
-    provisional = lens.with_image_distance(0.0)
-    try:
-        d = float(paraxial(provisional).gaussian_image_distance)
-    except LensError as e:
-        raise _lens_error(src, lens.name, e, line) from None
+    return solve_paraxial_image(
+        lens,
+        lambda message, at: src.error(message, at, n),
+        src.surface_lines,
+        line,
+        _gaussian_refusal,
+        trace_error=lambda e: _lens_error(src, lens.name, e, line),
+    )
+
+
+def _gaussian_refusal(d: float) -> str:
+    """Why ``t = "gaussian"`` has no image ``d`` mm from the last vertex (infinite or virtual)."""
     if not math.isfinite(d):
-        raise src.error(
-            't = "gaussian": the paraxial image is at infinity; give the image distance',
-            line,
-            n,
-        )
-    if d * lens.image_direction < 0.0:
-        raise src.error(
-            f't = "gaussian": the paraxial image is virtual ({abs(d):.6g} mm before the last '
-            "vertex); give the image distance",
-            line,
-            n,
-        )
-    s = list(lens.surfaces)
-    s[-1] = replace(s[-1], thickness=float(d))
-    return replace(lens, surfaces=tuple(s), image_solve="gaussian")
+        return 't = "gaussian": the paraxial image is at infinity; give the image distance'
+    return (
+        f't = "gaussian": the paraxial image is virtual ({abs(d):.6g} mm before the last '
+        "vertex); give the image distance"
+    )
 
 
 def _scale_to_efl(src: _Source, lens: Lens, target: float) -> Lens:

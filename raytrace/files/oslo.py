@@ -36,16 +36,15 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import LensError, PrescriptionError
+from ..errors import PrescriptionError
 from ..glass import private_material, resolve_glass
-from ..lens import Aperture, Field, Lens, Surface, check_file_lens
+from ..lens import Aperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material
 from .text import (
     ImportResult,
     LineParser,
     emit_warnings,
     guarded_parse,
-    lens_error,
     number,
     read_bytes,
     solve_paraxial_image,
@@ -368,29 +367,25 @@ class _LenParser(LineParser):
         else:
             fld = Field("angle", 0.0)
             self.warn("no field (ANG/OBH): the field is 0")
-        if self.unknown:
-            listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
-            self.warn(f"unknown commands skipped: {listing}")
+        self.warn_unknown()
         name = h.get("NAME") or (Path(self.path).stem if self.path else "OSLO lens")
         lines = [s.line for s in body]
-        try:
-            lens = Lens(
-                name=name,
-                surfaces=tuple(out),
-                aperture=aperture,
-                field=fld,
-                object_distance=od,
-                wavelength=wls[0],
-                wavelengths=tuple(wls),
-                weights=tuple(wts),
-                source=f"imported from the OSLO file {Path(self.path).name}" if self.path else "",
-                units="mm",
-                object_material=object_material,
-                path=self.path,
-            )
-            check_file_lens(lens)
-        except (LensError, ValueError) as e:
-            raise lens_error(self.err, e, lines, obj.line) from None
+        lens = self.file_lens(
+            lines,
+            obj.line,
+            name=name,
+            surfaces=tuple(out),
+            aperture=aperture,
+            field=fld,
+            object_distance=od,
+            wavelength=wls[0],
+            wavelengths=tuple(wls),
+            weights=tuple(wts),
+            source=f"imported from the OSLO file {Path(self.path).name}" if self.path else "",
+            units="mm",
+            object_material=object_material,
+            path=self.path,
+        )
         if pys:
             lens = self.solve_image(lens, pys[-1].py, lines)
         return ImportResult(lens, tuple(self.warnings))

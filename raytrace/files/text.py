@@ -14,7 +14,7 @@ from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
-from ..lens import Lens
+from ..lens import Lens, check_file_lens
 
 
 class InteropWarning(UserWarning):
@@ -183,16 +183,21 @@ def solve_paraxial_image(
     surface_lines: list[int],
     line: int,
     refusal: Callable[[float], str],
+    *,
+    trace_error: Callable[[Exception], Exception] | None = None,
 ) -> Lens:
     """The lens with its image plane at the paraxial image of its own object: a file's paraxial
-    image solve (CODE V ``PIM``, OSLO ``PY 0``). A paraxial trace that fails raises through
-    :func:`lens_error`; an image at infinity or virtual (before the last vertex) raises
-    ``err(refusal(d), line)``, ``d`` the distance from the last vertex (mm)."""
+    image solve (CODE V ``PIM``, OSLO ``PY 0``, the native ``t = "gaussian"``). A paraxial trace
+    that fails raises ``trace_error(e)`` (default: :func:`lens_error` with ``surface_lines``); an
+    image at infinity or virtual (before the last vertex) raises ``err(refusal(d), line)``, ``d``
+    the distance from the last vertex (mm)."""
     from ..paraxial import paraxial
 
     try:
         d = float(paraxial(lens.with_image_distance(0.0)).gaussian_image_distance)
     except (LensError, ValueError, ArithmeticError) as e:
+        if trace_error is not None:
+            raise trace_error(e) from None
         raise lens_error(err, e, surface_lines, line) from None
     if not (math.isfinite(d) and d * lens.image_direction >= 0.0):
         raise err(refusal(d), line)
@@ -232,6 +237,23 @@ class LineParser:
     def warn(self, message: str) -> None:
         if len(self.warnings) < MAX_WARNINGS:
             self.warnings.append(message)
+
+    def warn_unknown(self) -> None:
+        """One warning naming the unknown commands skipped (the first 30, with their lines)."""
+        if self.unknown:
+            listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
+            self.warn(f"unknown commands skipped: {listing}")
+
+    def file_lens(self, surface_lines: list[int], line: int, **kw) -> Lens:
+        """``Lens(**kw)`` checked as a lens read from a file (:func:`check_file_lens`); what the
+        constructor or the check refuses raises through :func:`lens_error` (``surface_lines``: the
+        line of each surface; ``line`` where the message names no surface)."""
+        try:
+            lens = Lens(**kw)
+            check_file_lens(lens)
+        except (LensError, ValueError) as e:
+            raise lens_error(self.err, e, surface_lines, line) from None
+        return lens
 
     def num(self, args: list[str], i: int, cmd: str, line: int, *, allow_inf=False) -> float:
         """Number ``i`` of a command's arguments (finite; ``inf`` when ``allow_inf``)."""

@@ -78,7 +78,7 @@ from pathlib import Path
 from ..errors import LensError, PrescriptionError
 from ..frames import ORDERS, Placement
 from ..glass import lookup_glass, parse_glass_code, printed_nd_vd, resolve_glass
-from ..lens import Aperture, ClearAperture, Field, Lens, Surface, check_file_lens
+from ..lens import Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from ..qtype import QType
 from .output import write_atomic
@@ -87,7 +87,6 @@ from .text import (
     LineParser,
     emit_warnings,
     guarded_parse,
-    lens_error,
     micron_to_nm,
     nm_to_micron_text,
     number,
@@ -929,32 +928,28 @@ class _ZmxParser(LineParser):
         solve = solve if solve == "gaussian" else None
         if meta.get("field_points") == [] and image_field is None:
             fld = replace(fld, points=())
-        if self.unknown:
-            listing = ", ".join(f"{c} (line {ln})" for c, ln in list(self.unknown.items())[:30])
-            self.warn(f"unknown commands skipped: {listing}")
-        try:
-            lens = Lens(
-                name=name,
-                surfaces=tuple(out),
-                aperture=aperture,
-                field=fld,
-                object_distance=od,
-                wavelength=primary,
-                wavelengths=wls,
-                weights=wts,
-                temperature_c=temperature,
-                pressure_atm=pressure,
-                source=source,
-                notes=notes,
-                units="mm",
-                object_material=object_material,
-                image_solve=solve,
-                path=self.path,
-                image_placement=image_placement,
-            )
-            check_file_lens(lens)
-        except (LensError, ValueError) as e:
-            raise lens_error(self.err, e, [z.line for z in body], surfaces[0].line) from None
+        self.warn_unknown()
+        lens = self.file_lens(
+            [z.line for z in body],
+            surfaces[0].line,
+            name=name,
+            surfaces=tuple(out),
+            aperture=aperture,
+            field=fld,
+            object_distance=od,
+            wavelength=primary,
+            wavelengths=wls,
+            weights=wts,
+            temperature_c=temperature,
+            pressure_atm=pressure,
+            source=source,
+            notes=notes,
+            units="mm",
+            object_material=object_material,
+            image_solve=solve,
+            path=self.path,
+            image_placement=image_placement,
+        )
         if image_field is not None:
             from ..errors import TraceError
             from ..trace.image_field import field_for_image_height

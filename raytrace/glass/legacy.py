@@ -312,14 +312,10 @@ def _substitute(r: GlassResolution, strict: bool) -> GlassResolution:
 
 
 def _historical(
-    name: str,
-    g: CatalogGlass,
-    head: str,
-    printed: tuple[float, float] | None,
-    strict: bool,
+    name: str, g: CatalogGlass, head: str, printed: tuple[float, float] | None
 ) -> GlassResolution:
     """A Schott 1980 glass (:data:`HISTORICAL_SOURCE`): its fit, or the file's nd/vd model
-    glass where the file prints numbers beyond the tolerances."""
+    glass (``glass`` None) where the file prints numbers beyond the tolerances."""
     m = re.search(r"max error ([0-9.eE+-]+) at ([0-9.]+) µm", g.note)
     err = f"largest error {m.group(1)} at {m.group(2)} µm, " if m else ""
     lo, hi = g.wavelength_range_nm
@@ -333,21 +329,17 @@ def _historical(
         nd, vd = printed
         dnd, dvd = nd - g.nd, vd - g.vd
         if abs(dnd) > ND_TOLERANCE or abs(dvd) > VD_TOLERANCE:
-            return _substitute(
-                GlassResolution(
-                    name,
-                    model_glass(nd, vd),
-                    None,
-                    f"{text}; the file prints nd {nd:.10g}, vd {vd:.10g} for it (Δnd {dnd:+.2e}, "
-                    f"Δvd {dvd:+.3f} from the 1980 data, more than {ND_TOLERANCE:g} / "
-                    f"{VD_TOLERANCE:g}): a model glass with the file's nd and vd is used "
-                    f"instead — {_model_dispersion_note(nd, vd)}",
-                ),
-                strict,
+            return GlassResolution(
+                name,
+                model_glass(nd, vd),
+                None,
+                f"{text}; the file prints nd {nd:.10g}, vd {vd:.10g} for it (Δnd {dnd:+.2e}, "
+                f"Δvd {dvd:+.3f} from the 1980 data, more than {ND_TOLERANCE:g} / "
+                f"{VD_TOLERANCE:g}): a model glass with the file's nd and vd is used "
+                f"instead — {_model_dispersion_note(nd, vd)}",
             )
         text += f"; the file's nd {nd:.10g}, vd {vd:.10g} agree (Δnd {dnd:+.2e}, Δvd {dvd:+.3f})"
-    r = GlassResolution(name, g.material, g, text)
-    return _substitute(r, strict) if head else r
+    return GlassResolution(name, g.material, g, text)
 
 
 def _found(
@@ -358,11 +350,13 @@ def _found(
     strict: bool,
 ) -> GlassResolution:
     """The resolution of a catalog glass found by its name; ``head``: the warning when it is
-    not in the catalogs the file names (a substitute), else empty."""
+    not in the catalogs the file names (a substitute), else empty. A substitute (that, or a
+    model glass in place of a 1980 glass) goes through :func:`_substitute`."""
     if g.source == HISTORICAL_SOURCE:
-        return _historical(name, g, head, printed, strict)
-    r = GlassResolution(name, g.material, g, head)
-    return _substitute(r, strict) if head else r
+        r = _historical(name, g, head, printed)
+    else:
+        r = GlassResolution(name, g.material, g, head)
+    return _substitute(r, strict) if head or r.glass is None else r
 
 
 def _unshipped_note(unshipped: list[str]) -> str:

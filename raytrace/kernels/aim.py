@@ -53,6 +53,14 @@ def _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, 
     return st, y
 
 
+@kernel(error_model="numpy", inline="always")
+def _bracket(ua, ra, ub, rb):
+    """The bracket (lo, hi, r(lo)) of two points ua, ub whose residuals ra, rb differ in sign."""
+    if ua < ub:
+        return ua, ub, ra
+    return ub, ua, rb
+
+
 @kernel(error_model="numpy")
 def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0, tol, hscale):
     """Safeguarded secant solve of y_stop(u) = 0 from the guess u0.
@@ -89,10 +97,7 @@ def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f,
     rlo = 0.0
     if r0 * r1 < 0.0:
         have_br = True
-        if u0 < u1:
-            lo, hi, rlo = u0, u1, r0
-        else:
-            lo, hi, rlo = u1, u0, r1
+        lo, hi, rlo = _bracket(u0, r0, u1, r1)
     for _ in range(AIM_MAXIT):
         if g != 0.0 and math.isfinite(g):
             un = ub - rb / g
@@ -125,10 +130,7 @@ def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f,
                 hi = un
         elif rn * rb < 0.0:
             have_br = True
-            if un < ub:
-                lo, hi, rlo = un, ub, rn
-            else:
-                lo, hi, rlo = ub, un, rb
+            lo, hi, rlo = _bracket(un, rn, ub, rb)
         if abs(rn) < abs(rb) or have_br:
             ub, rb = un, rn
         if have_br and hi - lo <= 4e-16 * max(abs(lo), abs(hi)):

@@ -15,12 +15,13 @@ The residual is the point ``(x, y)`` where the ray meets the stop surface (trace
 :func:`raytrace.kernels.surface.trace_span`, the shared 3-D surface step); the chief ray has
 ``(x, y) = (0, 0)`` there to an absolute tolerance ``tol`` (mm).
 
-Solver (per field, :func:`_newton2`): Newton's method on the 2 × 2 system with a forward-
-difference Jacobian (steps ``1e-7 × max(|u_i|, hscale)``; a backward step where the forward one
-cannot be traced), safeguarded by a backtracking line search on |r|² (step halved up to
-``LINE_HALVINGS`` times until the trial ray is traceable and |r| decreases). After the tolerance is
-met, one more Newton step with the last Jacobian is taken when it lowers |r| (a polish to
-round-off, so that independently aimed rays agree far below the tolerance).
+Solver (per field, :func:`newton_2d`, shared with :mod:`.instances`): Newton's method on the
+2 × 2 system with a forward-difference Jacobian (steps ``1e-7 × max(|u_i|, hscale)``; a
+backward step where the forward one cannot be traced), safeguarded by a backtracking line
+search on |r|² (step halved up to ``LINE_HALVINGS`` times until the trial ray is traceable and
+|r| decreases). After the tolerance is met, one more Newton step with the last Jacobian is
+taken when it lowers |r| (a polish to round-off, so that independently aimed rays agree far
+below the tolerance).
 
 Continuation over the grid (:func:`_aim_fields_2d`): fields are solved in order of their distance
 from the origin (|f|). Each starts from its nearest already-solved field j (found in a uniform
@@ -56,7 +57,7 @@ FD_STEP = 1e-7
 
 
 @kernel(error_model="numpy", inline="always")
-def _start_ray_2d(finite, z_obj, f1, f2, u1, u2):
+def start_ray_2d(finite, z_obj, f1, f2, u1, u2):
     """Object-space ray (x, y, z, L, M, N) of field (f1, f2) and unknowns (u1, u2) (module
     docstring)."""
     if finite == 0:
@@ -66,58 +67,81 @@ def _start_ray_2d(finite, z_obj, f1, f2, u1, u2):
     return f1, f2, z_obj, u1 * nrm, u2 * nrm, nrm
 
 
-@kernel(error_model="numpy")
-def _stop_residual_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1, u2):
-    """(ok, x, y): where the ray (f, u) meets the stop surface, traced unclipped."""
-    x0, y0, z0, L0, M0, N0 = _start_ray_2d(finite, z_obj, f1, f2, u1, u2)
-    st, sf, x, y, z, L, M, N = trace_span(
-        kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, False, x0, y0, z0, L0, M0, N0
-    )
-    ok = st == STATUS_OK and math.isfinite(x) and math.isfinite(y)
-    return ok, x, y
+@kernel(error_model="numpy", inline="always")
+def _trace_lens(lens, j0, j1, clip, x, y, z, L, M, N):
+    """:func:`trace_span` of the packed lens ``lens`` = (kind, c, k, asph, geo, n_in, n_out, sd)
+    at one wavelength."""
+    kind, c, k, asph, geo, n_in, n_out, sd = lens
+    return trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L, M, N)
 
 
-@kernel(error_model="numpy")
-def _newton2(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1, u2, tol,
-             hscale):  # fmt: skip
-    """Safeguarded Newton solve of r(u) = (x_stop, y_stop) = 0 from the guess (u1, u2).
+@kernel(error_model="numpy", inline="always")
+def stop_point(span, lens, stop, finite, z_obj, f1, f2, u1, u2):
+    """(ok, x, y): where the ray (f, u) meets the stop surface, traced unclipped by ``span(lens,
+    j0, j1, clip, x, y, z, L, M, N)`` (:func:`_trace_lens`, or the instance kernels' trace of
+    one instance) with the results of :func:`raytrace.kernels.surface.trace_span`."""
+    x0, y0, z0, L0, M0, N0 = start_ray_2d(finite, z_obj, f1, f2, u1, u2)
+    st, sf, x, y, z, L, M, N = span(lens, 0, stop + 1, False, x0, y0, z0, L0, M0, N0)
+    return st == STATUS_OK and math.isfinite(x) and math.isfinite(y), x, y
+
+
+@kernel(error_model="numpy", inline="always")
+def trace_via_stop(span, lens, stop, ns, clip, x, y, z, L, M, N):
+    """The ray traced through all ns surfaces with ``span`` (:func:`stop_point`), in two spans
+    so that the point on the stop is kept: (status, surface_1based, x_stop, y_stop, x, y, z, L,
+    M, N), the last six the final segment."""
+    st, sf, x, y, z, L, M, N = span(lens, 0, stop + 1, clip, x, y, z, L, M, N)
+    xs = x
+    ys = y
+    if st == STATUS_OK:
+        st, sf, x, y, z, L, M, N = span(lens, stop + 1, ns, clip, x, y, z, L, M, N)
+    return st, sf, xs, ys, x, y, z, L, M, N
+
+
+@kernel(error_model="numpy", inline="always")
+def put_segment(out, i, ok, x, y, z, L, M, N):
+    """Column i of ``out`` (rows x, y, z, L, M, N) set to the segment, or to NaN where not ok."""
+    out[0, i] = x if ok else np.nan
+    out[1, i] = y if ok else np.nan
+    out[2, i] = z if ok else np.nan
+    out[3, i] = L if ok else np.nan
+    out[4, i] = M if ok else np.nan
+    out[5, i] = N if ok else np.nan
+
+
+@kernel(error_model="numpy", inline="always")
+def newton_2d(residual, lens, stop, finite, z_obj, f1, f2, u1, u2, tol, hscale, backstep):
+    """Safeguarded Newton solve of r(u) = ``residual(lens, stop, finite, z_obj, f1, f2, u1,
+    u2)`` = 0 (a stop point (ok, x, y): :func:`stop_point`) from the guess (u1, u2) (module
+    docstring). ``backstep``: where the forward-difference ray cannot be traced, try the
+    backward step (True) or stop there (False).
 
     Returns (converged, u1, u2, r1, r2, evaluations); on failure the best point found."""
     nev = 1
-    ok, r1, r2 = _stop_residual_2d(
-        kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1, u2
-    )
+    ok, r1, r2 = residual(lens, stop, finite, z_obj, f1, f2, u1, u2)
     if not ok:
         return False, u1, u2, np.nan, np.nan, nev
     for _ in range(AIM2_MAXIT):
         done = max(abs(r1), abs(r2)) <= tol
         # forward-difference Jacobian (backward where the forward ray cannot be traced)
         h1 = FD_STEP * max(abs(u1), hscale)
-        ok, a1, a2 = _stop_residual_2d(
-            kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1 + h1, u2
-        )
+        ok, a1, a2 = residual(lens, stop, finite, z_obj, f1, f2, u1 + h1, u2)
         nev += 1
-        if not ok:
+        if not ok and backstep:
             h1 = -h1
-            ok, a1, a2 = _stop_residual_2d(
-                kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1 + h1, u2
-            )
+            ok, a1, a2 = residual(lens, stop, finite, z_obj, f1, f2, u1 + h1, u2)
             nev += 1
-            if not ok:
-                return done, u1, u2, r1, r2, nev
-        h2 = FD_STEP * max(abs(u2), hscale)
-        ok, b1, b2 = _stop_residual_2d(
-            kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1, u2 + h2
-        )
-        nev += 1
         if not ok:
+            return done, u1, u2, r1, r2, nev
+        h2 = FD_STEP * max(abs(u2), hscale)
+        ok, b1, b2 = residual(lens, stop, finite, z_obj, f1, f2, u1, u2 + h2)
+        nev += 1
+        if not ok and backstep:
             h2 = -h2
-            ok, b1, b2 = _stop_residual_2d(
-                kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, u1, u2 + h2
-            )
+            ok, b1, b2 = residual(lens, stop, finite, z_obj, f1, f2, u1, u2 + h2)
             nev += 1
-            if not ok:
-                return done, u1, u2, r1, r2, nev
+        if not ok:
+            return done, u1, u2, r1, r2, nev
         j11 = (a1 - r1) / h1
         j21 = (a2 - r2) / h1
         j12 = (b1 - r1) / h2
@@ -133,9 +157,7 @@ def _newton2(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2,
         for _h in range(LINE_HALVINGS if not done else 1):
             t1 = u1 + lam * d1
             t2 = u2 + lam * d2
-            ok, s1, s2 = _stop_residual_2d(
-                kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, t1, t2
-            )
+            ok, s1, s2 = residual(lens, stop, finite, z_obj, f1, f2, t1, t2)
             nev += 1
             if ok and s1 * s1 + s2 * s2 < rr:
                 u1, u2, r1, r2 = t1, t2, s1, s2
@@ -150,17 +172,27 @@ def _newton2(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2,
 
 
 @kernel(error_model="numpy")
-def _solve_from(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, g1, g2,
-                ub1, ub2, slope0, tol, hscale):  # fmt: skip
+def _stop_residual_2d(lens, stop, finite, z_obj, f1, f2, u1, u2):
+    """:func:`stop_point` of the packed lens ``lens`` (:func:`_trace_lens`)."""
+    return stop_point(_trace_lens, lens, stop, finite, z_obj, f1, f2, u1, u2)
+
+
+@kernel(error_model="numpy")
+def _newton2(lens, stop, finite, z_obj, f1, f2, u1, u2, tol, hscale):
+    """:func:`newton_2d` on the packed lens ``lens`` (with backward finite-difference steps)."""
+    return newton_2d(_stop_residual_2d, lens, stop, finite, z_obj, f1, f2, u1, u2, tol, hscale,
+                     True)  # fmt: skip
+
+
+@kernel(error_model="numpy")
+def _solve_from(lens, stop, finite, z_obj, f1, f2, g1, g2, ub1, ub2, slope0, tol, hscale):
     """Solve field (f1, f2) starting from the solved field (g1, g2) with solution (ub1, ub2):
     Newton from the paraxial prediction, then continuation along the path from g to f.
 
     Returns (converged, u1, u2, r1, r2, evaluations)."""
     p1 = ub1 + slope0 * (f1 - g1)
     p2 = ub2 + slope0 * (f2 - g2)
-    ok, u1, u2, r1, r2, nev = _newton2(
-        kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, p1, p2, tol, hscale
-    )
+    ok, u1, u2, r1, r2, nev = _newton2(lens, stop, finite, z_obj, f1, f2, p1, p2, tol, hscale)
     if ok:
         return True, u1, u2, r1, r2, nev
     # continuation along s in [0, 1]: field g + s (f − g); solution derivative du/ds
@@ -180,10 +212,7 @@ def _solve_from(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, 
             q2 = f2
         gu1 = c1 + v1 * (stry - scur)
         gu2 = c2 + v2 * (stry - scur)
-        ok, u1, u2, r1, r2, ne = _newton2(
-            kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, q1, q2, gu1, gu2, tol,
-            hscale,
-        )  # fmt: skip
+        ok, u1, u2, r1, r2, ne = _newton2(lens, stop, finite, z_obj, q1, q2, gu1, gu2, tol, hscale)
         nev += ne
         if ok:
             v1 = (u1 - c1) / (stry - scur)
@@ -222,18 +251,19 @@ def aim_chief_2d(lens, stop, finite, z_obj, f1, f2, slope0, tol, hscale, clip, s
     """
     kind, c, k, asph, zv, n_in_w, n_out_w, sd = lens
     for iw in range(n_in_w.shape[0]):
-        _aim_fields_2d(kind, c, k, asph, zv, n_in_w[iw], n_out_w[iw], sd, stop, finite, z_obj,
+        _aim_fields_2d((kind, c, k, asph, zv, n_in_w[iw], n_out_w[iw], sd), stop, finite, z_obj,
                        f1, f2, slope0[iw], tol[iw], hscale[iw], clip, start[iw], last[iw],
                        status[iw], surface[iw], evals[iw], residual[iw])  # fmt: skip
 
 
 @kernel(error_model="numpy")
-def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1, f2, slope0,
-                   tol, hscale, clip, start, last, status, surface, evals, residual):  # fmt: skip
-    """:func:`aim_chief_2d` at one wavelength (indices ``n_in``, ``n_out``); outputs (6, n),
-    (6, n), (n,), (n,), (n,), (2, n)."""
+def _aim_fields_2d(lens, stop, finite, z_obj, f1, f2, slope0, tol, hscale, clip, start, last,
+                   status, surface, evals, residual):  # fmt: skip
+    """:func:`aim_chief_2d` at one wavelength: ``lens`` the packed arrays with the indices
+    ``n_in``, ``n_out`` of that wavelength (the argument tuple of :func:`trace_span`); outputs
+    (6, n), (6, n), (n,), (n,), (n,), (2, n)."""
     n = f1.shape[0]
-    ns = c.shape[0]
+    ns = lens[1].shape[0]
     order = np.argsort(f1 * f1 + f2 * f2)
     U1 = np.zeros(n)
     U2 = np.zeros(n)
@@ -248,10 +278,8 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
     head = np.full(nb * nb, -1, dtype=np.int64)
     nxt = np.full(n, -1, dtype=np.int64)
     # the origin field (0, 0) anchors the continuation
-    ok0, o1, o2, _r1, _r2, _ne = _newton2(
-        kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, 0.0, 0.0, 0.0, 0.0, tol,
-        hscale,
-    )  # fmt: skip
+    ok0, o1, o2, _r1, _r2, _ne = _newton2(lens, stop, finite, z_obj, 0.0, 0.0, 0.0, 0.0, tol,
+                                          hscale)  # fmt: skip
     for ii in range(n):
         i = order[ii]
         # nearest solved field (the origin when none is nearer or none is solved)
@@ -285,11 +313,10 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
         else:  # no anchor: the paraxial guess only
             g1, g2, b1, b2 = 0.0, 0.0, 0.0, 0.0
         conv, u1, u2, r1, r2, nev = _solve_from(
-            kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f1[i], f2[i], g1, g2,
-            b1, b2, slope0, tol, hscale,
-        )  # fmt: skip
+            lens, stop, finite, z_obj, f1[i], f2[i], g1, g2, b1, b2, slope0, tol, hscale
+        )
         evals[i] = nev
-        x0, y0, z0, L0, M0, N0 = _start_ray_2d(finite, z_obj, f1[i], f2[i], u1, u2)
+        x0, y0, z0, L0, M0, N0 = start_ray_2d(finite, z_obj, f1[i], f2[i], u1, u2)
         if not conv:
             start[0, i] = np.nan if finite == 0 else x0
             start[1, i] = np.nan if finite == 0 else y0
@@ -297,8 +324,7 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
             start[3, i] = np.nan if finite == 1 else L0
             start[4, i] = np.nan if finite == 1 else M0
             start[5, i] = np.nan if finite == 1 else N0
-            for r in range(6):
-                last[r, i] = np.nan
+            put_segment(last, i, False, x0, y0, z0, L0, M0, N0)
             status[i] = STATUS_AIM_FAILED
             surface[i] = 0
             residual[0, i] = np.nan
@@ -309,34 +335,13 @@ def _aim_fields_2d(kind, c, k, asph, zv, n_in, n_out, sd, stop, finite, z_obj, f
         cell = c1 * nb + c2
         nxt[i] = head[cell]
         head[cell] = i
-        start[0, i] = x0
-        start[1, i] = y0
-        start[2, i] = z0
-        start[3, i] = L0
-        start[4, i] = M0
-        start[5, i] = N0
-        st, sf, x, y, z, L, M, N = trace_span(
-            kind, c, k, asph, zv, n_in, n_out, sd, 0, stop + 1, clip, x0, y0, z0, L0, M0, N0
+        put_segment(start, i, True, x0, y0, z0, L0, M0, N0)
+        st, sf, xs, ys, x, y, z, L, M, N = trace_via_stop(
+            _trace_lens, lens, stop, ns, clip, x0, y0, z0, L0, M0, N0
         )
-        xs = x
-        ys = y
-        if st == STATUS_OK:
-            st, sf, x, y, z, L, M, N = trace_span(
-                kind, c, k, asph, zv, n_in, n_out, sd, stop + 1, ns, clip, x, y, z, L, M, N
-            )
+        ok = st == STATUS_OK
         status[i] = st
         surface[i] = sf
-        if st == STATUS_OK:
-            last[0, i] = x
-            last[1, i] = y
-            last[2, i] = z
-            last[3, i] = L
-            last[4, i] = M
-            last[5, i] = N
-            residual[0, i] = xs
-            residual[1, i] = ys
-        else:
-            for r in range(6):
-                last[r, i] = np.nan
-            residual[0, i] = r1
-            residual[1, i] = r2
+        put_segment(last, i, ok, x, y, z, L, M, N)
+        residual[0, i] = xs if ok else r1
+        residual[1, i] = ys if ok else r2

@@ -40,10 +40,10 @@ from .surface import (
     acts,
     backward_limit,
     path_length,
-    quadric_root,
     reframe,
     snell,
     surface_step,
+    vertex_plane_root,
 )
 
 BLOCK = 256
@@ -78,6 +78,51 @@ NROWS = 16
 
 
 @kernel(error_model="numpy", inline="always")
+def _ray(buf, i):
+    """Ray i of the scratch buffer: (x, y, z, L, M, N)."""
+    return buf[_RX + i], buf[_RY + i], buf[_RZ + i], buf[_RL + i], buf[_RM + i], buf[_RN + i]
+
+
+@kernel(error_model="numpy", inline="always")
+def _set_ray(buf, i, x, y, z, L, M, N):
+    """Ray i of the scratch buffer set to (x, y, z, L, M, N)."""
+    buf[_RX + i] = x
+    buf[_RY + i] = y
+    buf[_RZ + i] = z
+    buf[_RL + i] = L
+    buf[_RM + i] = M
+    buf[_RN + i] = N
+
+
+@kernel(error_model="numpy", inline="always")
+def _path_limit(zvj, mu, check):
+    """The backward-travel limit of a surface at vertex z zvj with index ratio mu (:mod:`.surface`,
+    "Travelling backwards"), or −inf where the test does not apply (``check`` False, or a
+    surface that does not refract): one compare per ray in the loops below."""
+    return backward_limit(zvj) if (check and mu != 1.0) else -np.inf
+
+
+@kernel(error_model="numpy", inline="always")
+def _failure(tir, clipped, back, missed):
+    """The status code of a ray at one surface, the first that applies of MISSED, BACKWARD,
+    CLIPPED, TIR; 0.0 when it passes. Selects only (branch-free, so the loops vectorise)."""
+    code = float(STATUS_TIR) if tir else 0.0
+    code = float(STATUS_CLIPPED) if clipped else code
+    code = float(STATUS_BACKWARD) if back else code
+    return float(STATUS_MISSED) if missed else code
+
+
+@kernel(error_model="numpy", inline="always")
+def _record(buf, i, code, jp1):
+    """Ray i of the scratch buffer gets the status ``code`` at surface jp1 (1-based) unless it
+    failed before: the first failure is kept (code 0.0 changes nothing). Selects only."""
+    old = buf[_RS + i]
+    fresh = old == 0.0 and code != 0.0
+    buf[_RS + i] = code if old == 0.0 else old
+    buf[_RF + i] = jp1 if fresh else buf[_RF + i]
+
+
+@kernel(error_model="numpy", inline="always")
 def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere, check, carry):
     """One plane / quadric surface for the nb rays of the scratch buffer, branch-free (selects
     only) so that it vectorises. Failed rays keep computing on meaningless values; their status
@@ -91,19 +136,10 @@ def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere, check, carry):
     ck = cj * (1.0 + kj)
     mu2 = mu * mu
     carried = 1.0 if carry else 0.0
-    # the test applies (check, a refracting surface) or lim = −inf: one compare in the loop
-    lim = backward_limit(zvj) if (check and mu != 1.0) else -np.inf
+    lim = _path_limit(zvj, mu, check)
     for i in range(nb):
-        LL = buf[_RL + i]
-        MM = buf[_RM + i]
-        NN = buf[_RN + i]
-        x0 = buf[_RX + i]
-        y0 = buf[_RY + i]
-        z0 = buf[_RZ + i]
-        t0 = (zvj - z0) / NN
-        xx = x0 + t0 * LL
-        yy = y0 + t0 * MM
-        s, hit = quadric_root(cj, kj, xx, yy, LL, MM, NN)
+        x0, y0, z0, LL, MM, NN = _ray(buf, i)
+        t0, xx, yy, s, hit = vertex_plane_root(cj, kj, zvj, x0, y0, z0, LL, MM, NN)
         xx += s * LL
         yy += s * MM
         zl = s * NN
@@ -125,21 +161,9 @@ def _quadric_rows(buf, nb, cj, kj, zvj, sd2, mu, jp1, sphere, check, carry):
         clipped = xx * xx + yy * yy > sd2
         tt = t0 + s + buf[_RT + i] * carried  # the path: p = p0 + (t0 + s) d
         buf[_RT + i] = tt
-        back = tt < lim
-        code = float(STATUS_TIR) if sin2t > 1.0 else 0.0
-        code = float(STATUS_CLIPPED) if clipped else code
-        code = float(STATUS_BACKWARD) if back else code
-        code = float(STATUS_MISSED) if missed else code
-        buf[_RX + i] = xx
-        buf[_RY + i] = yy
-        buf[_RZ + i] = zvj + zl
-        buf[_RL + i] = L2
-        buf[_RM + i] = M2
-        buf[_RN + i] = N2
-        old = buf[_RS + i]
-        fresh = old == 0.0 and code != 0.0
-        buf[_RS + i] = code if old == 0.0 else old
-        buf[_RF + i] = jp1 if fresh else buf[_RF + i]
+        code = _failure(sin2t > 1.0, clipped, tt < lim, missed)
+        _set_ray(buf, i, xx, yy, zvj + zl, L2, M2, N2)
+        _record(buf, i, code, jp1)
 
 
 @kernel(error_model="numpy", inline="always")
@@ -178,13 +202,8 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
     :func:`_quadric_rows`."""
     live = 0
     for i in range(nb):
-        LL = buf[_RL + i]
-        MM = buf[_RM + i]
-        NN = buf[_RN + i]
-        t0 = (zvj - buf[_RZ + i]) / NN
-        xx = buf[_RX + i] + t0 * LL
-        yy = buf[_RY + i] + t0 * MM
-        s, have = quadric_root(cj, kj, xx, yy, LL, MM, NN)
+        x0, y0, z0, LL, MM, NN = _ray(buf, i)
+        _t0, xx, yy, s, have = vertex_plane_root(cj, kj, zvj, x0, y0, z0, LL, MM, NN)
         s = s if have else 0.0
         xx += s * LL
         yy += s * MM
@@ -206,11 +225,7 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
         live = 0
         for i in range(nb):
             act = buf[_RA + i] != 0.0
-            LL = buf[_RL + i]
-            MM = buf[_RM + i]
-            NN = buf[_RN + i]
-            xx = buf[_RX + i]
-            yy = buf[_RY + i]
+            xx, yy, _z, LL, MM, NN = _ray(buf, i)
             zl = buf[_RZL + i]
             dsag = buf[_RDC + i]
             gp = NN - 2.0 * dsag * (xx * LL + yy * MM)
@@ -239,14 +254,9 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
     _asphere_sag_rows(buf, nb, cj, kj, asph, j)
     mu2 = mu * mu
     carried = 1.0 if carry else 0.0
-    # the test applies (check, a refracting surface) or lim = −inf: one compare in the loop
-    lim = backward_limit(zvj) if (check and mu != 1.0) else -np.inf
+    lim = _path_limit(zvj, mu, check)
     for i in range(nb):
-        LL = buf[_RL + i]
-        MM = buf[_RM + i]
-        NN = buf[_RN + i]
-        xx = buf[_RX + i]
-        yy = buf[_RY + i]
+        xx, yy, z0, LL, MM, NN = _ray(buf, i)
         dsag = buf[_RDC + i]
         nx = -2.0 * xx * dsag
         ny = -2.0 * yy * dsag
@@ -259,24 +269,16 @@ def _asphere_rows(buf, nb, cj, kj, asph, j, zvj, sd2, mu, jp1, check, carry):
         refract = mu != 1.0
         missed = not math.isfinite(dsag)
         clipped = xx * xx + yy * yy > sd2
-        # row _RZ still holds the start point's z; along the line the path is Δz / N (N > 0 here)
-        z0 = buf[_RZ + i]
+        # row _RZ still holds the start point's z0; along the line the path is Δz / N (N > 0 here)
         z1 = zvj + buf[_RZL + i]
         tt = (z1 - z0) / NN + buf[_RT + i] * carried
-        back = tt < lim
         buf[_RT + i] = tt
-        code = float(STATUS_TIR) if (refract and sin2t > 1.0) else 0.0
-        code = float(STATUS_CLIPPED) if clipped else code
-        code = float(STATUS_BACKWARD) if back else code
-        code = float(STATUS_MISSED) if missed else code
+        code = _failure(refract and sin2t > 1.0, clipped, tt < lim, missed)
         buf[_RZ + i] = z1
         buf[_RL + i] = L2 * inv if refract else LL
         buf[_RM + i] = M2 * inv if refract else MM
         buf[_RN + i] = N2 * inv if refract else NN
-        old = buf[_RS + i]
-        fresh = old == 0.0 and code != 0.0
-        buf[_RS + i] = code if old == 0.0 else old
-        buf[_RF + i] = jp1 if fresh else buf[_RF + i]
+        _record(buf, i, code, jp1)
 
 
 @kernel(error_model="numpy")
@@ -289,12 +291,7 @@ def _general_rows(buf, nb, kind, c, k, asph, geo, j, mu, sdj, clip, check, actin
     for i in range(nb):
         if buf[_RS + i] != 0.0:
             continue
-        x = buf[_RX + i]
-        y = buf[_RY + i]
-        z = buf[_RZ + i]
-        L = buf[_RL + i]
-        M = buf[_RM + i]
-        N = buf[_RN + i]
+        x, y, z, L, M, N = _ray(buf, i)
         if (fl & F_FRAME) != 0:
             x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
         st = STATUS_OK
@@ -306,12 +303,7 @@ def _general_rows(buf, nb, kind, c, k, asph, geo, j, mu, sdj, clip, check, actin
             )  # fmt: skip
             t = path_length(x0, y0, z0, x, y, z, L0, M0, N0)
             buf[_RT + i] = t + (buf[_RT + i] if carry else 0.0)
-        buf[_RX + i] = x
-        buf[_RY + i] = y
-        buf[_RZ + i] = z
-        buf[_RL + i] = L
-        buf[_RM + i] = M
-        buf[_RN + i] = N
+        _set_ray(buf, i, x, y, z, L, M, N)
         if st != STATUS_OK:
             buf[_RS + i] = float(st)
             buf[_RF + i] = jp1

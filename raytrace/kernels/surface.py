@@ -167,6 +167,51 @@ def asphere_sag(c, k, asph, j, rho):
     return z, dz, True
 
 
+@kernel(error_model="numpy", inline="always")
+def newton_step(x, y, zl, sag, gp, L, M, N):
+    """One Newton step along the unit direction (L, M, N) toward the surface z = sag: the point
+    (x, y, zl) (surface frame, zl from the vertex) moves by ``ds = −(zl − sag) / gp``, with gp
+    the derivative of zl − sag along the ray. Returns (ok, x, y, zl, done): ok False (the
+    caller's MISSED) where gp is 0 or not finite; done when |ds| <= NEWTON_TOL (1 + |x| + |y| +
+    |zl|), the stopping rule of every Newton intersection (module docstring)."""
+    if gp == 0.0 or not math.isfinite(gp):
+        return False, x, y, zl, False
+    ds = -(zl - sag) / gp
+    x += ds * L
+    y += ds * M
+    zl += ds * N
+    return True, x, y, zl, abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl))
+
+
+@kernel(error_model="numpy", inline="always")
+def newton_intersect(sag_gp, params, x, y, zl, L, M, N):
+    """The intersection of the ray through (x, y, zl) (surface frame, zl from the vertex) along
+    the unit direction (L, M, N) with the surface z = sag, by :func:`newton_step` from that
+    point, at most ``NEWTON_MAX`` steps. ``sag_gp(params, x, y, L, M, N)`` gives (ok, sag, gp)
+    at (x, y): the sag, the derivative of zl − sag along the ray, ok False outside the
+    surface's domain. Returns (ok, x, y, zl); ok False when the iteration leaves the domain,
+    stalls or does not converge (the caller's MISSED)."""
+    for _ in range(NEWTON_MAX):
+        ok, sag, gp = sag_gp(params, x, y, L, M, N)
+        if not ok:
+            return False, x, y, zl
+        ok, x, y, zl, done = newton_step(x, y, zl, sag, gp, L, M, N)
+        if not ok:
+            return False, x, y, zl
+        if done:
+            return True, x, y, zl
+    return False, x, y, zl
+
+
+@kernel(error_model="numpy", inline="always")
+def _asphere_sag_gp(params, x, y, L, M, N):
+    """(ok, sag, gp) of the even asphere ``params`` = (c, k, asph, j) (:func:`asphere_sag`)
+    for :func:`newton_intersect`."""
+    c, k, asph, j = params
+    sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
+    return ok, sag, N - 2.0 * dsag * (x * L + y * M)
+
+
 _qbfs_sum = kernel(error_model="numpy", inline="always")(qbfs_sum)
 
 
@@ -217,13 +262,9 @@ def qtype_newton(con, c, k, coef, j, x, y, zl, L, M, N):
         if it == NEWTON_MAX:
             break
         gp = N - 2.0 * dsag * (x * L + y * M)
-        if gp == 0.0 or not math.isfinite(gp):
+        ok, x, y, zl, done = newton_step(x, y, zl, sag, gp, L, M, N)
+        if not ok:
             return False, x, y, zl, 0.0
-        ds = -(zl - sag) / gp
-        x += ds * L
-        y += ds * M
-        zl += ds * N
-        done = abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl))
     return False, x, y, zl, 0.0
 
 
@@ -241,6 +282,26 @@ def snell(LL, MM, NN, nx, ny, nz, mu, mu2):
 
 
 @kernel(error_model="numpy", inline="always")
+def unit(x, y, z):
+    """The vector (x, y, z) divided by its length."""
+    inv = 1.0 / math.sqrt(x * x + y * y + z * z)
+    return x * inv, y * inv, z * inv
+
+
+@kernel(error_model="numpy", inline="always")
+def refract(L, M, N, nx, ny, nz, mu):
+    """:func:`snell` at the normal (nx, ny, nz) of any length, the refracted direction
+    renormalised (the scalar path; module docstring, "Refraction"). Returns (tir, L', M', N');
+    on total internal reflection (tir True) the direction is returned unchanged."""
+    nx, ny, nz = unit(nx, ny, nz)
+    L2, M2, N2, sin2t = snell(L, M, N, nx, ny, nz, mu, mu * mu)
+    if sin2t > 1.0:
+        return True, L, M, N
+    L2, M2, N2 = unit(L2, M2, N2)
+    return False, L2, M2, N2
+
+
+@kernel(error_model="numpy", inline="always")
 def quadric_root(c, k, x, y, L, M, N):
     """Distance s along the unit direction (L, M, N) from the point (x, y) on a surface's vertex
     tangent plane to the quadric of curvature c and conic k, in the cancellation-free form
@@ -252,6 +313,19 @@ def quadric_root(c, k, x, y, L, M, N):
     D = B * B - A * C
     den = B + math.sqrt(max(D, 0.0))
     return C / den, D >= 0.0 and den > 0.0
+
+
+@kernel(error_model="numpy", inline="always")
+def vertex_plane_root(c, k, zvj, x, y, z, L, M, N):
+    """The ray (x, y, z) + t (L, M, N) (axis frame, travelling toward +z) carried to the vertex
+    tangent plane z = zvj of a surface, and its quadric root from there: (t0, x1, y1, s, hit)
+    with t0 the path (mm) to the plane, (x1, y1) the point on it and s, hit as
+    :func:`quadric_root`."""
+    t0 = (zvj - z) / N
+    x1 = x + t0 * L
+    y1 = y + t0 * M
+    s, hit = quadric_root(c, k, x1, y1, L, M, N)
+    return t0, x1, y1, s, hit
 
 
 @kernel(error_model="numpy", inline="always")
@@ -274,6 +348,16 @@ def reframe(geo, j, x, y, z, L, M, N):
     Mn = m3 * L + m4 * M + m5 * N
     Nn = m6 * L + m7 * M + m8 * N
     return xn, yn, zn, Ln, Mn, Nn
+
+
+@kernel(error_model="numpy", inline="always")
+def enter(geo, j, x, y, z, L, M, N):
+    """The ray moved into surface j's axis frame where j is flagged ``F_FRAME`` (:func:`reframe`),
+    and whether j is not traced (``F_SKIP``): (skip, x, y, z, L, M, N)."""
+    fl = int(geo[j, G_FLAGS])
+    if (fl & F_FRAME) != 0:
+        x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
+    return (fl & F_SKIP) != 0, x, y, z, L, M, N
 
 
 @kernel(error_model="numpy", inline="always")
@@ -363,22 +447,8 @@ def surface_step(
             y = y + s * M
             zl = s * N
             if kind == KIND_ASPHERE:
-                converged = False
-                for _ in range(NEWTON_MAX):
-                    sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
-                    if not ok:
-                        return STATUS_MISSED, x, y, z, L, M, N
-                    gp = N - 2.0 * dsag * (x * L + y * M)
-                    if gp == 0.0 or not math.isfinite(gp):
-                        return STATUS_MISSED, x, y, z, L, M, N
-                    ds = -(zl - sag) / gp
-                    x += ds * L
-                    y += ds * M
-                    zl += ds * N
-                    if abs(ds) <= NEWTON_TOL * (1.0 + abs(x) + abs(y) + abs(zl)):
-                        converged = True
-                        break
-                if not converged:
+                ok, x, y, zl = newton_intersect(_asphere_sag_gp, (c, k, asph, j), x, y, zl, L, M, N)
+                if not ok:
                     return STATUS_MISSED, x, y, z, L, M, N
                 sag, dsag, ok = asphere_sag(c, k, asph, j, x * x + y * y)
                 if not ok:
@@ -406,31 +476,13 @@ def surface_step(
         if (fl & F_APERTURE) != 0 and outside_aperture(geo, j, x, y):
             return STATUS_CLIPPED, x, y, z, L, M, N
     if (fl & F_MIRROR) != 0:
-        inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        nx *= inv
-        ny *= inv
-        nz *= inv
+        nx, ny, nz = unit(nx, ny, nz)
         g = 2.0 * (L * nx + M * ny + N * nz)
-        L = L - g * nx
-        M = M - g * ny
-        N = N - g * nz
-        inv = 1.0 / math.sqrt(L * L + M * M + N * N)
-        L *= inv
-        M *= inv
-        N *= inv
+        L, M, N = unit(L - g * nx, M - g * ny, N - g * nz)
     elif mu != 1.0:
-        inv = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
-        nx *= inv
-        ny *= inv
-        nz *= inv
-        L2, M2, N2, sin2t = snell(L, M, N, nx, ny, nz, mu, mu * mu)
-        if sin2t > 1.0:
+        tir, L, M, N = refract(L, M, N, nx, ny, nz, mu)
+        if tir:
             return STATUS_TIR, x, y, z, L, M, N
-        L, M, N = L2, M2, N2
-        inv = 1.0 / math.sqrt(L * L + M * M + N * N)
-        L *= inv
-        M *= inv
-        N *= inv
     return STATUS_OK, x, y, z, L, M, N
 
 
@@ -465,10 +517,8 @@ def trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L,
                 tacc += path_length(x0, y0, z0, x, y, z, L0, M0, N0)
         return STATUS_OK, 0, x, y, z, L, M, N
     for j in range(j0, j1):
-        fl = int(geo[j, G_FLAGS])
-        if (fl & F_FRAME) != 0:
-            x, y, z, L, M, N = reframe(geo, j, x, y, z, L, M, N)
-        if (fl & F_SKIP) != 0:
+        skip, x, y, z, L, M, N = enter(geo, j, x, y, z, L, M, N)
+        if skip:
             continue
         x0, y0, z0, L0, M0, N0 = x, y, z, L, M, N
         st, x, y, z, L, M, N = surface_step(

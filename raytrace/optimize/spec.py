@@ -294,6 +294,33 @@ def _as_float(v) -> float:
     return float(v) if not isinstance(v, str) else float(v.strip().lower())
 
 
+def _same(v):
+    return v
+
+
+#: (test, words, conversion) of a setting's value, for :func:`_take`
+_POSITIVE_INT = (lambda v: _is_int(v) and v >= 1, "a positive integer", _same)
+_POSITIVE = (lambda v: _is_num(v) and v > 0, "a positive number", float)
+_NON_NEGATIVE = (lambda v: _is_num(v) and v >= 0, "a non-negative number", float)
+_BOOL = (lambda v: isinstance(v, bool), "true or false", _same)
+
+
+def _int_at_least(lo: int) -> tuple:
+    return (lambda v: _is_int(v) and v >= lo, f"an integer >= {lo}", _same)
+
+
+def _take(d: dict, kinds: dict, kw: dict, probs: _Problems, at: str = "") -> None:
+    """Each key of ``kinds`` that ``d`` holds into ``kw`` (converted) when its value passes the
+    test, else the problem "``at``: 'key' must be <words>, got <value>" (no ``at``: top level)."""
+    prefix = f"{at}: " if at else ""
+    for k, (test, words, convert) in kinds.items():
+        if k in d:
+            if test(d[k]):
+                kw[k] = convert(d[k])
+            else:
+                probs.add(f"{prefix}{k!r} must be {words}, got {d[k]!r}")
+
+
 def _range(v) -> bool:
     return (
         isinstance(v, list)
@@ -433,16 +460,7 @@ def _glass_settings(d: dict, base: GlassSettings, at: str, probs: _Problems) -> 
             probs.add(f"{at}: 'glasses' must be a list of glass names, got {g!r}")
         else:
             kw["glasses"] = tuple(g)
-    if "neighbours" in d:
-        if _is_int(d["neighbours"]) and d["neighbours"] >= 1:
-            kw["neighbours"] = d["neighbours"]
-        else:
-            probs.add(f"{at}: 'neighbours' must be a positive integer, got {d['neighbours']!r}")
-    if "model_phase" in d:
-        if isinstance(d["model_phase"], bool):
-            kw["model_phase"] = d["model_phase"]
-        else:
-            probs.add(f"{at}: 'model_phase' must be true or false, got {d['model_phase']!r}")
+    _take(d, {"neighbours": _POSITIVE_INT, "model_phase": _BOOL}, kw, probs, at)
     return replace(base, **kw)
 
 
@@ -474,24 +492,16 @@ TOP_KEYS = (
 
 def _search_settings(d: dict, at: str, probs: _Problems) -> SearchSettings:
     kw: dict = {}
-    for k, lo in (("starts", 1), ("seed", 0), ("hops", 0), ("workers", 1)):
-        if k in d:
-            if _is_int(d[k]) and d[k] >= lo:
-                kw[k] = d[k]
-            else:
-                probs.add(f"{at}: {k!r} must be an integer >= {lo}, got {d[k]!r}")
-    if "local_evaluations" in d:
-        v = d["local_evaluations"]
-        if _is_int(v) and v >= 1:
-            kw["local_evaluations"] = v
-        else:
-            probs.add(f"{at}: 'local_evaluations' must be a positive integer, got {v!r}")
-    for k in ("perturbation", "hop_perturbation"):
-        if k in d:
-            if _is_num(d[k]) and d[k] >= 0:
-                kw[k] = float(d[k])
-            else:
-                probs.add(f"{at}: {k!r} must be a non-negative number, got {d[k]!r}")
+    kinds = {
+        "starts": _int_at_least(1),
+        "seed": _int_at_least(0),
+        "hops": _int_at_least(0),
+        "workers": _int_at_least(1),
+        "local_evaluations": _POSITIVE_INT,
+        "perturbation": _NON_NEGATIVE,
+        "hop_perturbation": _NON_NEGATIVE,
+    }
+    _take(d, kinds, kw, probs, at)
     if "time" in d:
         try:
             kw["time_budget_s"] = parse_duration(d["time"])
@@ -547,21 +557,8 @@ def read_spec(path: str | Path) -> DesignSpec:
         if k in d and not isinstance(d[k], str):
             probs.add(f"{k!r} must be a string, got {d[k]!r}")
     top: dict = {}
-    if "max_evaluations" in d:
-        if _is_int(d["max_evaluations"]) and d["max_evaluations"] >= 1:
-            top["max_evaluations"] = d["max_evaluations"]
-        else:
-            probs.add(f"'max_evaluations' must be a positive integer, got {d['max_evaluations']!r}")
-    if "tolerance" in d:
-        if _is_num(d["tolerance"]) and d["tolerance"] > 0:
-            top["tolerance"] = float(d["tolerance"])
-        else:
-            probs.add(f"'tolerance' must be a positive number, got {d['tolerance']!r}")
-    if "merit_goal" in d:
-        if _is_num(d["merit_goal"]) and d["merit_goal"] >= 0:
-            top["merit_goal"] = float(d["merit_goal"])
-        else:
-            probs.add(f"'merit_goal' must be a non-negative number, got {d['merit_goal']!r}")
+    kinds = {"max_evaluations": _POSITIVE_INT, "tolerance": _POSITIVE, "merit_goal": _NON_NEGATIVE}
+    _take(d, kinds, top, probs)
 
     glass = GlassSettings()
     if "glass" in d:
@@ -579,11 +576,7 @@ def read_spec(path: str | Path) -> DesignSpec:
             probs.add("'global' must be a table ([global])")
 
     variables = []
-    for i, v in enumerate(_list(d, "variables", probs), 1):
-        at = f"variables[{i}]"
-        if not isinstance(v, dict):
-            probs.add(f"{at}: must be a table {{ kind = ..., surface = ... }}")
-            continue
+    for at, v in _tables(d, "variables", "{ kind = ..., surface = ... }", probs):
         kind = v.get("kind")
         if not isinstance(kind, str):
             probs.add(f"{at}: needs 'kind' (one of {', '.join(VARIABLE_KINDS)})")
@@ -608,11 +601,7 @@ def read_spec(path: str | Path) -> DesignSpec:
         variables.append(Variable(kind, s, _as_float(lo), _as_float(hi), gs))
 
     pickups = []
-    for i, v in enumerate(_list(d, "pickups", probs), 1):
-        at = f"pickups[{i}]"
-        if not isinstance(v, dict):
-            probs.add(f"{at}: must be a table {{ kind, surface, source, factor, offset }}")
-            continue
+    for at, v in _tables(d, "pickups", "{ kind, surface, source, factor, offset }", probs):
         probs.unknown_keys(v, ("kind", "surface", "source", "factor", "offset"), at)
         kind = v.get("kind")
         if not isinstance(kind, str) or kind not in PICKUP_KINDS:
@@ -667,6 +656,17 @@ def _list(d: dict, key: str, probs: _Problems) -> list:
         probs.add(f"{key!r} must be a list of tables, [ {{ ... }}, ... ]")
         return []
     return v
+
+
+def _tables(d: dict, key: str, form: str, probs: _Problems):
+    """(``key[i]``, entry) for each entry of the list ``d[key]`` that is a table; one that is not
+    is a problem ("must be a table ``form``")."""
+    for i, v in enumerate(_list(d, key, probs), 1):
+        at = f"{key}[{i}]"
+        if isinstance(v, dict):
+            yield at, v
+        else:
+            probs.add(f"{at}: must be a table {form}")
 
 
 def start_lens(spec: DesignSpec) -> Lens:

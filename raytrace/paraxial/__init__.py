@@ -1,6 +1,6 @@
-"""Paraxial optics: first-order data of a centred lens (:mod:`.firstorder`), Pestrecov's constants
-of orthoscopy (:mod:`.orthoscopy`) and the object / image-plane vocabulary (:mod:`.conjugates`).
-No numba here: paraxial-only commands stay fast to start."""
+"""Paraxial optics: first-order data of a centred lens and the one y-nu trace (:mod:`.firstorder`),
+Pestrecov's constants of orthoscopy (:mod:`.orthoscopy`) and the object / image-plane vocabulary
+(:mod:`.conjugates`). No numba here: paraxial-only commands stay fast to start."""
 
 from .conjugates import (
     ImagePlane,
@@ -12,13 +12,14 @@ from .conjugates import (
     resolve_object_distance,
     resolve_paraxial,
 )
-from .firstorder import ParaxialResult, paraxial
+from .firstorder import ParaxialResult, paraxial, ynu_matrix, ynu_trace
 from .orthoscopy import (
     PestrecovConstants,
     distortion_slope,
     ideal_heights,
     orthoscopy_abscissa,
     orthoscopy_constant_slope,
+    orthoscopy_constants,
     paraxial_chief_heights,
     pestrecov_constants,
 )
@@ -35,10 +36,13 @@ __all__ = [
     "object_distance_for_scale",
     "orthoscopy_abscissa",
     "orthoscopy_constant_slope",
+    "orthoscopy_constants",
     "paraxial",
     "paraxial_chief_heights",
     "pestrecov_constants",
     "plane_z",
     "resolve_object_distance",
     "resolve_paraxial",
+    "ynu_matrix",
+    "ynu_trace",
 ]

@@ -170,38 +170,55 @@ def require_centred(lens: Lens) -> None:
     )
 
 
-def _trace(
+#: a number for one lens, or an (I,) array over instances (:func:`ynu_trace`)
+Scalars = float | np.ndarray
+
+
+def ynu_trace(
     c: np.ndarray,
     t: np.ndarray,
     n_in: np.ndarray,
     n_out: np.ndarray,
-    y: float,
-    nu: float,
+    y: Scalars,
+    nu: Scalars,
     upto: int,
-) -> tuple[float, float]:
-    """Paraxial trace of (y, n·u) at the first vertex through surfaces [0, upto).
+    start: int = 0,
+) -> tuple[Scalars, Scalars]:
+    """Paraxial trace of (y, n·u) through surfaces [start, upto): transfer ``y += t n'u' / n'``
+    to each surface, then refraction ``n'u' = n u − y (n' − n) c`` (the module's y-nu trace, the
+    one implementation).
 
-    Returns (y, n'u') just after surface ``upto-1`` (or at the first vertex for upto=0).
+    ``c``, ``t``, ``n_in``, ``n_out`` are indexed by surface first (curvatures 1/mm, thicknesses
+    mm, indices before and after each surface, as :func:`_system` gives them): ``c[i]`` is a
+    number for one lens, or an (I,) array for I instances traced at once (``y``, ``nu`` a number
+    or (I,), broadcast). (y, nu) is the ray at the first vertex for ``start`` = 0, else just
+    after surface ``start-1`` (refracted there, not yet transferred), as a trace with
+    ``upto=start`` returns it. Returns (y, n'u') just after surface ``upto-1``: the height on
+    that surface (mm) and the reduced slope after it.
     """
-    for i in range(upto):
+    for i in range(start, upto):
+        if i:
+            y = y + t[i - 1] * nu / n_out[i - 1]
         nu = nu - y * (n_out[i] - n_in[i]) * c[i]
-        if i + 1 < upto:
-            y = y + t[i] * nu / n_out[i]
     return y, nu
 
 
-def _matrix(c, t, n_in, n_out, upto: int) -> np.ndarray:
-    """2×2 matrix mapping (y, nu) at the first vertex to (y, n'u') after surface upto-1."""
-    a = _trace(c, t, n_in, n_out, 1.0, 0.0, upto)
-    b = _trace(c, t, n_in, n_out, 0.0, 1.0, upto)
-    return np.array([[a[0], b[0]], [a[1], b[1]]])
+def ynu_matrix(
+    c: np.ndarray, t: np.ndarray, n_in: np.ndarray, n_out: np.ndarray, upto: int
+) -> tuple[tuple[Scalars, Scalars], tuple[Scalars, Scalars]]:
+    """``((A, B), (C, D))``: the 2×2 matrix mapping (y, nu) at the first vertex to (y, n'u')
+    after surface ``upto-1`` — :func:`ynu_trace` of (1, 0) and (0, 1); numbers, or (I,) arrays
+    over instances (arguments as in :func:`ynu_trace`)."""
+    a = ynu_trace(c, t, n_in, n_out, 1.0, 0.0, upto)
+    b = ynu_trace(c, t, n_in, n_out, 0.0, 1.0, upto)
+    return (a[0], b[0]), (a[1], b[1])
 
 
 def _entrance_pupil(c, t, n_in, n_out, stop: int) -> tuple[float, float, float]:
     """(a, b, z_E0): the stop height ``a y1 + b n u1`` of a paraxial ray per unit height / unit
     reduced slope at the first vertex, and the paraxial entrance pupil (absolute z; inf for an
     object-space telecentric stop)."""
-    (a, b), _ = _matrix(c, t, n_in, n_out, stop + 1)
+    (a, b), _ = ynu_matrix(c, t, n_in, n_out, stop + 1)
     z_E0 = math.inf if a == 0.0 else float(b * n_in[0] / a)
     return float(a), float(b), z_E0
 
@@ -239,7 +256,7 @@ def entrance_pupil_diameter(
             if not h > 0.0:
                 raise LensError(f"{lens.name}: float by stop size: the stop is at an image")
             return 2.0 * ap.value / h
-        _, nuk = _trace(c, t, n_in, n_out, y1, nu1, len(c))
+        _, nuk = ynu_trace(c, t, n_in, n_out, y1, nu1, len(c))
         if nuk == 0.0:
             raise LensError(f"{lens.name}: a working F/# needs a lens that is not afocal")
         return 2.0 * (1.0 / (2.0 * abs(nuk))) / ap.value
@@ -282,7 +299,7 @@ def aim_geometry(
     z_obj = -math.inf if math.isinf(object_distance) else -float(object_distance)
     efl = math.nan
     if lens.aperture.kind == "fnumber":
-        (_, _), (C, _) = _matrix(c, t, n_in, n_out, len(c))
+        (_, _), (C, _) = ynu_matrix(c, t, n_in, n_out, len(c))
         efl = -1.0 / C if C != 0.0 else math.inf
     epd = entrance_pupil_diameter(
         lens, efl, float(n_in[0]), z_E0, z_obj, system=(c, t, n_in, n_out)
@@ -311,7 +328,7 @@ def paraxial(
     ns = len(c)
     n0, nk = float(n_in[0]), float(n_out[-1])
     z_last = float(np.sum(t))
-    (A, B), (C, D) = _matrix(c, t, n_in, n_out, ns)
+    (A, B), (C, D) = ynu_matrix(c, t, n_in, n_out, ns)
     power_scale = float(np.sum(np.abs((n_out - n_in) * c))) + 1e-300
     if abs(C) < 1e-9 * power_scale:
         raise LensError(f"{lens.name}: the lens is afocal (zero power); focal data undefined")
@@ -333,7 +350,7 @@ def paraxial(
         yc1, nuc1 = 1.0, 0.0  # object-space telecentric: chief ray parallel to the axis
     else:
         yc1, nuc1 = -b * n0 / a, n0  # u1 = 1
-    yck, nuck = _trace(c, t, n_in, n_out, yc1, nuc1, ns)
+    yck, nuck = ynu_trace(c, t, n_in, n_out, yc1, nuc1, ns)
     uck = nuck / nk
     z_E0p = math.inf if uck == 0.0 else z_last - yck / uck
     m_e = (nuc1 / n0) / uck if uck != 0.0 else math.inf
@@ -344,7 +361,7 @@ def paraxial(
     epd = entrance_pupil_diameter(lens, efl, n0, z_E0, z_obj, system=(c, t, n_in, n_out))
     ym1, num1 = _marginal_start(lens, epd, n0, z_E0, z_obj)
     stop_radius = abs(a * ym1 + b * num1)
-    ymk, numk = _trace(c, t, n_in, n_out, ym1, num1, ns)
+    ymk, numk = ynu_trace(c, t, n_in, n_out, ym1, num1, ns)
     umk = numk / nk
     if math.isinf(z_E0p):
         xpd = math.inf

@@ -235,12 +235,20 @@ def orthoscopy_abscissa(par: ParaxialResult, fields, field_kind: str) -> np.ndar
     return t if par.infinite else par.p0 * t
 
 
+def orthoscopy_constants(par: ParaxialResult, s_prime) -> np.ndarray:
+    """Pestrecov's constant of orthoscopy K0 (Eq. 8: F0 in mm for an object at infinity, M0 for
+    a finite one; :attr:`PestrecovConstants.scale`) in each plane at ``s_prime`` (mm from H'):
+    (planes,), the planes flattened."""
+    sp = np.asarray(s_prime, dtype=float)
+    return np.array([pestrecov_constants(par, float(v)).scale for v in sp.ravel()])
+
+
 def ideal_heights(par: ParaxialResult, x, s_prime) -> np.ndarray:
     """Ideal (orthoscopic) image sizes ``y0' = K0·x`` (mm), Eq. (8)–(9), in the plane(s) at
     ``s_prime`` (mm from H'): shape ``x.shape`` for a scalar plane, (planes, fields) otherwise."""
     xa = np.asarray(x, dtype=float)
     sp = np.asarray(s_prime, dtype=float)
-    k = np.array([pestrecov_constants(par, float(v)).scale for v in sp.ravel()])
+    k = orthoscopy_constants(par, sp)
     if sp.ndim == 0:
         return k[0] * xa
     return k[:, None] * xa.reshape(1, -1)

@@ -59,6 +59,7 @@ from ..kernels.instances import KIND_IRREGULAR
 from ..lens import Lens
 from ..materials import LAMBDA_C, LAMBDA_D, LAMBDA_F, fixed_index
 from ..packing import pack
+from ..paraxial import ynu_matrix, ynu_trace
 from .spec import ToleranceSpec, ToleranceSpecError, check_against_lens
 
 #: OpticStudio's element-move types, and the surface-move types
@@ -498,36 +499,25 @@ def paraxial_batch(
     arrays: InstanceArrays, object_distance: float, object_per_t: float | None = None
 ) -> ParaxialBatch:
     """Paraxial marginal, system and chief rays of every instance's centred part (its decenters
-    and tilts left out, as :meth:`Lens.nominal` does): the y-nu trace ``n'u' = nu − y (n' − n)
-    c``, ``y += t u'`` of :func:`raytrace.paraxial.paraxial`, over instances at once (tested
-    equal to :func:`raytrace.paraxial.paraxial` on the instances' lenses). ``object_per_t``: for a
-    finite object, the object height (mm) per unit field abscissa t (Pestrecov's nominal
-    ``p0 = z_object − z_E0`` of the nominal lens); unused for an object at infinity."""
+    and tilts left out, as :meth:`Lens.nominal` does): the y-nu trace of
+    :func:`raytrace.paraxial.paraxial` (:func:`raytrace.paraxial.ynu_matrix`) over instances at
+    once (tested equal to :func:`raytrace.paraxial.paraxial` on the instances' lenses).
+    ``object_per_t``: for a finite object, the object height (mm) per unit field abscissa t
+    (Pestrecov's nominal ``p0 = z_object − z_E0`` of the nominal lens); unused for an object at
+    infinity."""
     n = arrays.n_surfaces
-    c = arrays.c[:, :n]
-    n_in = arrays.n_in[:, :n]
-    n_out = arrays.n_out[:, :n]
-    t = arrays.thickness
-    I = c.shape[0]
-    stop = arrays.stop
-
-    def trace(y, nu, upto=n):
-        """(y, nu) after surface upto − 1; y_stop: height at the stop surface."""
-        y_stop = y
-        for j in range(upto):
-            if j == stop:
-                y_stop = y
-            nu = nu - y * (n_out[:, j] - n_in[:, j]) * c[:, j]
-            if j + 1 < n:
-                y = y + t[:, j] * nu / n_out[:, j]
-        return y, nu, y_stop
-
-    # system matrix columns: (y, nu) = (1, 0) and (0, 1) at the first vertex
-    A, C, sA = trace(np.ones(I), np.zeros(I))
-    B, D, sB = trace(np.zeros(I), np.ones(I))
+    # surface first, as ynu_matrix reads them: row j holds surface j of every instance
+    c, t = arrays.c[:, :n].T, arrays.thickness.T
+    n_in, n_out = arrays.n_in[:, :n].T, arrays.n_out[:, :n].T
+    # the rays (y, nu) = (1, 0) and (0, 1) at the first vertex: their heights sA, sB on the stop,
+    # then on to the last surface (A, B) and their slopes there (C, D): the system matrix
+    stop = arrays.stop + 1
+    (sA, sB), (sC, sD) = ynu_matrix(c, t, n_in, n_out, stop)
+    A, C = ynu_trace(c, t, n_in, n_out, sA, sC, n, start=stop)
+    B, D = ynu_trace(c, t, n_in, n_out, sB, sD, n, start=stop)
     z_last = arrays.vertex_z[:, -1]
-    nk = n_out[:, -1]
-    n0 = n_in[:, 0]
+    nk = n_out[-1]
+    n0 = n_in[0]
     efl = -1.0 / C
     if math.isinf(object_distance):
         z_img = z_last - A * nk / C

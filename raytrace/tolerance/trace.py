@@ -15,11 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import TraceError
-from ..kernels.codes import STATUS_OK
 from ..lens import Lens
 from ..trace.chief import transfer
 from ..trace.chief2d import aim_2d
 from ..trace.rays import PARALLEL_LOCK
+from ..trace.results import RayStatus
 from .model import InstanceArrays, pack_instances
 from .spec import ToleranceSpec
 
@@ -125,7 +125,7 @@ def _inverse_jacobians(arr, finite, z_obj, f1, f2, u, hscale) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class InstanceChiefRays:
+class InstanceChiefRays(RayStatus):
     """Chief rays of I instances × F fields: ``last`` (I, 6, F) final segments (x, y, z, L, M,
     N) in the image frame (mm; NaN where failed), ``status`` (I, F) int8, ``evals`` (I, F)
     traces to the stop, ``stop_residual`` (I, 2, F) mm."""
@@ -134,10 +134,6 @@ class InstanceChiefRays:
     status: np.ndarray
     evals: np.ndarray
     stop_residual: np.ndarray
-
-    @property
-    def ok(self) -> np.ndarray:
-        return self.status == STATUS_OK
 
     def points_at(self, z_planes) -> np.ndarray:
         """(I, F, 2) points (x', y') in mm on the planes z = ``z_planes`` ((I,) or a scalar;

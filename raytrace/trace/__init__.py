@@ -3,8 +3,7 @@ the real stop (:mod:`.chief`; on a 2-D field grid: :mod:`.chief2d`). The names l
 (a command that aims chief rays does not import the fans or the 2-D grid), and the numba kernels
 with them."""
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ..kernels.codes import (
     STATUS_AIM_FAILED,
@@ -15,16 +14,17 @@ from ..kernels.codes import (
     STATUS_OK,
     STATUS_TIR,
 )
+from ..lazy import lazy_names
 
 #: public name -> submodule, loaded on first use
 _NAMES: dict[str, str] = {
-    **dict.fromkeys(("ChiefRays", "ChromaticChiefRays", "aim", "chief_rays"), "chief"),
-    **dict.fromkeys(("ChiefRays2D", "aim_2d", "chief_rays_2d"), "chief2d"),
-    **dict.fromkeys(("RayFan", "SpotDiagram", "ray_fan", "spot_diagram"), "fans"),
-    **dict.fromkeys(("Bundle", "aimed_bundle", "pupil_points"), "pupil"),
+    **dict.fromkeys(("ChiefRays", "ChromaticChiefRays", "aim", "chief_rays"), ".chief"),
+    **dict.fromkeys(("ChiefRays2D", "aim_2d", "chief_rays_2d"), ".chief2d"),
+    **dict.fromkeys(("RayFan", "SpotDiagram", "ray_fan", "spot_diagram"), ".fans"),
+    **dict.fromkeys(("Bundle", "aimed_bundle", "pupil_points"), ".pupil"),
     **dict.fromkeys(
         ("PARALLEL_THRESHOLD", "RayBatch", "RayPaths", "packed_lens", "ray_paths", "trace_rays"),
-        "rays",
+        ".rays",
     ),
 }
 
@@ -36,18 +36,7 @@ if TYPE_CHECKING:
     from .rays import PARALLEL_THRESHOLD, RayBatch, RayPaths, packed_lens, ray_paths, trace_rays
 
 
-def __getattr__(name: str) -> Any:
-    mod = _NAMES.get(name)
-    if mod is None:
-        raise AttributeError(f"module 'raytrace.trace' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{mod}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_NAMES))
-
+__getattr__, __dir__ = lazy_names(__name__, _NAMES)
 
 __all__ = [
     "PARALLEL_THRESHOLD",

@@ -28,11 +28,11 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import LensError, TraceError
-from ..kernels.codes import STATUS_NAMES, STATUS_OK
 from ..lens import Lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
+from .results import RayStatus, field_unit, object_words, status_name
 
 
 class ApertureWarning(UserWarning):
@@ -131,8 +131,25 @@ def aim_start(
     return -z_E0, np.maximum(1.0, r_stop)
 
 
+def aim_outputs(nw: int, n: int, dims: int) -> tuple[np.ndarray, ...]:
+    """The empty output arrays of the aim kernels (:mod:`raytrace.kernels.aim`, ``dims`` = 1,
+    and :mod:`raytrace.kernels.aim2d`, ``dims`` = 2) for ``nw`` wavelengths × ``n`` fields:
+    ``start`` and ``last`` (nw, 4, n) rays (y, z, M, N) or (nw, 6, n) (x, y, z, L, M, N),
+    ``status`` (nw, n) int8, ``surface`` and ``evals`` (nw, n) int32, ``residual`` (nw, n) or
+    (nw, 2, n)."""
+    ray = (nw, 2 + 2 * dims, n)
+    return (
+        np.empty(ray),
+        np.empty(ray),
+        np.empty((nw, n), dtype=np.int8),
+        np.empty((nw, n), dtype=np.int32),
+        np.empty((nw, n), dtype=np.int32),
+        np.empty((nw, n) if dims == 1 else (nw, 2, n)),
+    )
+
+
 @dataclass(frozen=True, eq=False)
-class ChiefRays:
+class ChiefRays(RayStatus):
     """Real chief rays (meridional plane x = 0), arrays over fields in the order given.
 
     Attributes
@@ -187,14 +204,9 @@ class ChiefRays:
     tolerance: float
 
     @property
-    def ok(self) -> np.ndarray:
-        """Boolean mask of fields whose chief ray reached the last surface."""
-        return self.status == STATUS_OK
-
-    @property
     def status_names(self) -> list[str]:
         """Status per field as words (``"ok"``, ``"aim_failed"``, ...)."""
-        return [STATUS_NAMES.get(int(s), str(int(s))) for s in self.status]
+        return [status_name(s) for s in self.status]
 
     @property
     def tan_out(self) -> np.ndarray:
@@ -220,18 +232,16 @@ class ChiefRays:
         return int(self.fields.size)
 
     def __repr__(self) -> str:
-        unit = "deg" if self.field_kind == "angle" else "mm"
-        obj = "inf" if math.isinf(self.object_distance) else f"{self.object_distance:g} mm"
-        bad = int(np.count_nonzero(self.status != STATUS_OK))
+        unit, obj = field_unit(self.field_kind), object_words(self.object_distance)
         fl = ", ".join(f"{v:g}" for v in self.fields[:6]) + (", ..." if len(self) > 6 else "")
         return (
             f"ChiefRays({len(self)} fields [{fl}] {unit}, object {obj}, "
-            f"{self.wavelength:g} nm, {bad} failed)"
+            f"{self.wavelength:g} nm, {self.n_failed} failed)"
         )
 
 
 @dataclass(frozen=True, eq=False)
-class ChromaticChiefRays:
+class ChromaticChiefRays(RayStatus):
     """Real chief rays at several wavelengths, aimed in one kernel call (wavelength × field).
 
     ``rays[i]`` is the :class:`ChiefRays` at ``wavelengths[i]``; every wavelength has the same
@@ -276,13 +286,7 @@ class ChromaticChiefRays:
 
     def at(self, wavelength: float) -> ChiefRays:
         """The rays at ``wavelength`` (nm; one of :attr:`wavelengths`)."""
-        hit = np.nonzero(self.wavelengths == float(wavelength))[0]
-        if hit.size == 0:
-            raise TraceError(
-                f"{wavelength:g} nm is not one of the traced wavelengths "
-                f"({', '.join(f'{w:g}' for w in self.wavelengths)} nm)"
-            )
-        return self.rays[int(hit[0])]
+        return self.rays[wavelength_index(self.wavelengths, wavelength, "the traced wavelengths")]
 
     def stacked(self, name: str) -> np.ndarray:
         """Attribute ``name`` of every wavelength's :class:`ChiefRays`, stacked: (n_w, n)."""
@@ -291,11 +295,6 @@ class ChromaticChiefRays:
     @property
     def status(self) -> np.ndarray:
         return self.stacked("status")
-
-    @property
-    def ok(self) -> np.ndarray:
-        """(n_wavelengths, n_fields) mask of rays that reached the last surface."""
-        return self.status == STATUS_OK
 
     @property
     def y_last(self) -> np.ndarray:
@@ -312,11 +311,22 @@ class ChromaticChiefRays:
 
     def __repr__(self) -> str:
         wl = ", ".join(f"{w:g}" for w in self.wavelengths)
-        bad = int(np.count_nonzero(self.status != STATUS_OK))
         return (
             f"ChromaticChiefRays({self.fields.size} fields x {self.n_wavelengths} wavelengths "
-            f"[{wl}] nm, reference {self.reference_wavelength:g} nm, {bad} failed)"
+            f"[{wl}] nm, reference {self.reference_wavelength:g} nm, {self.n_failed} failed)"
         )
+
+
+def wavelength_index(wavelengths: np.ndarray, wavelength: float, among: str) -> int:
+    """The index of ``wavelength`` (nm) in ``wavelengths`` (nm; the first match). Raises
+    :class:`TraceError` listing them when it is none of them: "... is not one of ``among``"."""
+    hit = np.nonzero(wavelengths == float(wavelength))[0]
+    if hit.size == 0:
+        raise TraceError(
+            f"{wavelength:g} nm is not one of {among} "
+            f"({', '.join(f'{w:g}' for w in wavelengths)} nm)"
+        )
+    return int(hit[0])
 
 
 def chief_rays(
@@ -483,14 +493,8 @@ def aim(
     else:
         kf = f
     n = f.size
-    start = np.empty((nw, 4, n))
-    last = np.empty((nw, 4, n))
-    status = np.empty((nw, n), dtype=np.int8)
-    surface = np.empty((nw, n), dtype=np.int32)
-    evals = np.empty((nw, n), dtype=np.int32)
-    residual = np.empty((nw, n))
     kf = np.ascontiguousarray(kf, dtype=np.float64)
-    outs = (start, last, status, surface, evals, residual)
+    outs = start, last, status, surface, evals, residual = aim_outputs(nw, n, 1)
     if n <= AIM_CHUNK:
         aim_chief(su.packed.lens_arrays, su.packed.stop, 1 if finite else 0, z_obj, kf,
                   su.slope0, su.tol, su.hscale, bool(clip), *outs)  # fmt: skip

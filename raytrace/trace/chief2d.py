@@ -37,12 +37,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import LensError, TraceError
-from ..kernels.codes import STATUS_NAMES, STATUS_OK
 from ..lens import Lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
-from .chief import aim_start, aim_tolerance, checked_aim_request, transfer
+from .chief import aim_outputs, aim_start, aim_tolerance, checked_aim_request, transfer
+from .results import RayStatus, field_unit, object_words, status_name
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,7 +66,7 @@ def _setup(lens: Lens, wavelength: float, object_distance: float) -> _Setup2D:
 
 
 @dataclass(frozen=True, eq=False)
-class ChiefRays2D:
+class ChiefRays2D(RayStatus):
     """Real chief rays of a 2-D set of fields. Every array has the broadcast ``shape`` of the
     fields given (e.g. (ny, nx) for a meshgrid).
 
@@ -131,14 +131,9 @@ class ChiefRays2D:
         return self.status.shape
 
     @property
-    def ok(self) -> np.ndarray:
-        """Mask of fields whose chief ray reached the last surface."""
-        return self.status == STATUS_OK
-
-    @property
     def status_names(self) -> np.ndarray:
         """Status per field as words (``"ok"``, ``"aim_failed"``, ...), same shape."""
-        names = [STATUS_NAMES.get(int(s), str(int(s))) for s in self.status.ravel()]
+        names = [status_name(s) for s in self.status.ravel()]
         return np.array(names, dtype=object).reshape(self.shape)
 
     @property
@@ -167,12 +162,10 @@ class ChiefRays2D:
         return int(self.status.size)
 
     def __repr__(self) -> str:
-        unit = "deg" if self.field_kind == "angle" else "mm"
-        obj = "inf" if math.isinf(self.object_distance) else f"{self.object_distance:g} mm"
-        bad = int(np.count_nonzero(self.status != STATUS_OK))
+        unit, obj = field_unit(self.field_kind), object_words(self.object_distance)
         return (
             f"ChiefRays2D({len(self)} fields {self.shape} ({unit}), object {obj}, "
-            f"{self.wavelength:g} nm, {bad} failed)"
+            f"{self.wavelength:g} nm, {self.n_failed} failed)"
         )
 
 
@@ -274,13 +267,7 @@ def aim_2d(
             p0 = z_obj - su.z_E0
             f1, f2 = p0 * f1, p0 * f2
     slope0, hscale = aim_start(np.array([su.z_E0]), od, np.array([su.r_stop]))
-    n = f1.size
-    start = np.empty((1, 6, n))
-    last = np.empty((1, 6, n))
-    status = np.empty((1, n), dtype=np.int8)
-    surface = np.empty((1, n), dtype=np.int32)
-    evals = np.empty((1, n), dtype=np.int32)
-    residual = np.empty((1, 2, n))
+    outs = start, last, status, surface, evals, residual = aim_outputs(1, f1.size, 2)
     aim_chief_2d(
         su.packed.lens_arrays,
         su.packed.stop,
@@ -292,12 +279,7 @@ def aim_2d(
         np.array([su.tol]),
         hscale,
         bool(clip),
-        start,
-        last,
-        status,
-        surface,
-        evals,
-        residual,
+        *outs,
     )
 
     def r(a):

@@ -22,6 +22,7 @@ from ..paraxial import ImagePlane, image_planes, plane_z, resolve_paraxial
 from .chief import aim
 from .pupil import aimed_bundle, pupil_points
 from .rays import trace_rays
+from .results import RayStatus, field_unit
 
 
 def _field(lens: Lens, field_deg, object_height_mm, finite: bool) -> tuple[float, str]:
@@ -52,7 +53,11 @@ def _trace_field(
     object_scale,
     wavelength,
     clip,
-):
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+    """Trace rays at pupil points (px, py) about the real chief ray of one field: (ε_x, ε_y,
+    status) per ray in the image plane, and the keywords that :class:`RayFan` and
+    :class:`SpotDiagram` share (field, field_kind, object_distance, z_plane, chief_height,
+    wavelength)."""
     par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength)
     od = par.object_distance
     f, kind = _field(lens, field_deg, object_height_mm, not par.infinite)
@@ -74,7 +79,15 @@ def _trace_field(
     rb = trace_rays(lens, b.origins, b.directions, wavelength=wavelength, clip=clip)
     x, y = rb.at_plane(z)
     yc = float(cr.heights_at(z)[0])
-    return f, kind, od, z, par, x, y - yc, rb.status, yc
+    common = dict(
+        field=f,
+        field_kind=kind,
+        object_distance=od,
+        z_plane=z,
+        chief_height=yc,
+        wavelength=par.wavelength,
+    )
+    return x, y - yc, rb.status, common
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,7 +118,7 @@ class RayFan:
         return self.ey if self.axis == "y" else self.ex
 
     def __repr__(self) -> str:
-        unit = "deg" if self.field_kind == "angle" else "mm"
+        unit = field_unit(self.field_kind)
         e = self.aberration
         m = float(np.nanmax(np.abs(e))) if np.isfinite(e).any() else math.nan
         return (
@@ -159,28 +172,16 @@ def ray_fan(
     if axis not in ("x", "y"):
         raise TraceError(f"axis must be 'y' (tangential) or 'x' (sagittal), got {axis!r}")
     px, py = pupil_points("fan_y" if axis == "y" else "fan_x", int(n))
-    f, kind, od, z, par, x, dy, st, yc = _trace_field(
+    x, dy, st, common = _trace_field(
         lens, field_deg, object_height_mm, px, py, plane=plane, s_prime=s_prime,
         from_last_vertex=from_last_vertex, defocus=defocus, object_distance=object_distance,
         object_s=object_s, object_scale=object_scale, wavelength=wavelength, clip=clip,
     )  # fmt: skip
-    return RayFan(
-        pupil=py if axis == "y" else px,
-        ex=x,
-        ey=dy,
-        status=st,
-        axis=axis,
-        field=f,
-        field_kind=kind,
-        object_distance=od,
-        z_plane=z,
-        chief_height=yc,
-        wavelength=par.wavelength,
-    )
+    return RayFan(pupil=py if axis == "y" else px, ex=x, ey=dy, status=st, axis=axis, **common)
 
 
 @dataclass(frozen=True, eq=False)
-class SpotDiagram:
+class SpotDiagram(RayStatus):
     """The spot of one field: ray intercepts relative to the real chief ray (mm).
 
     x, y: intercepts minus the chief ray's (mm; NaN where a ray failed); px, py: their pupil
@@ -207,10 +208,11 @@ class SpotDiagram:
 
     @property
     def n_ok(self) -> int:
-        return int(np.count_nonzero(self.status == STATUS_OK))
+        """How many rays reached the image plane."""
+        return self.status.size - self.n_failed
 
     def __repr__(self) -> str:
-        unit = "deg" if self.field_kind == "angle" else "mm"
+        unit = field_unit(self.field_kind)
         return (
             f"SpotDiagram(field {self.field:g} {unit}, {self.n_ok}/{self.x.size} rays, "
             f"RMS radius {self.rms_radius * 1000:.4g} um, geometric radius "
@@ -261,14 +263,16 @@ def spot_diagram(
     if pattern not in ("hexapolar", "rings", "square"):
         raise TraceError(f"pattern must be hexapolar, rings or square, got {pattern!r}")
     px, py = pupil_points(pattern, int(n))
-    f, kind, od, z, par, x, dy, st, yc = _trace_field(
+    x, dy, st, common = _trace_field(
         lens, field_deg, object_height_mm, px, py, plane=plane, s_prime=s_prime,
         from_last_vertex=from_last_vertex, defocus=defocus, object_distance=object_distance,
         object_s=object_s, object_scale=object_scale, wavelength=wavelength, clip=clip,
     )  # fmt: skip
     ok = st == STATUS_OK
     if not ok.any():
-        raise TraceError(f"{lens.name}: no ray of field {f:g} reaches the image plane")
+        raise TraceError(
+            f"{lens.name}: no ray of field {common['field']:g} reaches the image plane"
+        )
     cx, cy = float(np.mean(x[ok])), float(np.mean(dy[ok]))
     r2 = (x[ok] - cx) ** 2 + (dy[ok] - cy) ** 2
     return SpotDiagram(
@@ -281,10 +285,5 @@ def spot_diagram(
         centroid_y=cy,
         rms_radius=float(np.sqrt(np.mean(r2))),
         geometric_radius=float(np.sqrt(np.max(r2))),
-        field=f,
-        field_kind=kind,
-        object_distance=od,
-        z_plane=z,
-        chief_height=yc,
-        wavelength=par.wavelength,
+        **common,
     )

@@ -19,9 +19,10 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import TraceError
-from ..kernels.codes import STATUS_NAMES, STATUS_OK
+from ..kernels.codes import STATUS_NAMES
 from ..lens import Lens
 from ..packing import PackedLens, pack
+from .results import RayStatus
 
 #: Batches of at least this many rays use the prange kernel (when more than one thread is
 #: allowed). Measured on the 2-core development machine (benchmarks/bench_core.py crossover,
@@ -41,7 +42,7 @@ PARALLEL_LOCK = threading.RLock()
 
 
 @dataclass(frozen=True, eq=False)
-class RayBatch:
+class RayBatch(RayStatus):
     """Result of :func:`trace_rays`: the final segment of each ray.
 
     x, y, z: point on the last surface (mm); L, M, N: direction cosines after it; in the image
@@ -58,11 +59,6 @@ class RayBatch:
     N: np.ndarray
     status: np.ndarray
     surface: np.ndarray
-
-    @property
-    def ok(self) -> np.ndarray:
-        """Boolean mask of rays with status OK."""
-        return self.status == STATUS_OK
 
     @property
     def positions(self) -> np.ndarray:
