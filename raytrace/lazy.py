@@ -1,6 +1,7 @@
 """Public names that load on first use: the module-level ``__getattr__`` and ``__dir__`` that the
-packages :mod:`raytrace.trace`, :mod:`distortion` and :mod:`orthoscope` share (PEP 562), so that
-importing a package costs only what a command uses (docs/design.md, "Performance")."""
+packages :mod:`raytrace.trace` and :mod:`distortion` share (PEP 562), so that importing a
+package costs only what a command uses (docs/design.md, "Performance"). :mod:`orthoscope` keeps
+its own: importing it must not import numpy, which any module of this package does."""
 
 from __future__ import annotations
 

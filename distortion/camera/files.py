@@ -231,7 +231,10 @@ def _opencv_from_nodes(nodes: dict, path: Path) -> CameraModel:
             h,
             **pinhole,
             alpha=skew / fx,
-            **dict(zip(("k1", "k2", "k3", "k4"), d, strict=True)),
+            k1=d[0],
+            k2=d[1],
+            k3=d[2],
+            k4=d[3],
         )
     if kind not in ("", "opencv", "plumb_bob", "rational_polynomial", "standard"):
         raise DataError(f"{path}: unknown distortion_model {kind!r} (opencv or fisheye)")

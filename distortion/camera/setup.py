@@ -62,6 +62,8 @@ import os
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
+from raytrace.trace.results import object_words
+
 from ..errors import DataError
 from .sensor import Sensor
 
@@ -233,7 +235,7 @@ class CameraGeometry:
     @property
     def object_label(self) -> str:
         """The object plane in a repr: ``inf``, or its distance from the first vertex (mm)."""
-        return "inf" if self.infinite else f"{self.object_distance:g} mm"
+        return object_words(self.object_distance)
 
     def __repr__(self) -> str:
         return (

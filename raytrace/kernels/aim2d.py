@@ -67,10 +67,12 @@ def start_ray_2d(finite, z_obj, f1, f2, u1, u2):
     return f1, f2, z_obj, u1 * nrm, u2 * nrm, nrm
 
 
-@kernel(error_model="numpy", inline="always")
+@kernel(error_model="numpy")
 def _trace_lens(lens, j0, j1, clip, x, y, z, L, M, N):
     """:func:`trace_span` of the packed lens ``lens`` = (kind, c, k, asph, geo, n_in, n_out, sd)
-    at one wavelength."""
+    at one wavelength. Not inlined: the span is compiled once, and every caller (the stop
+    residual, the two spans of the final trace) calls it (inlining it into each tripled the
+    surface step's code and made the cold compile about 1.5x slower)."""
     kind, c, k, asph, geo, n_in, n_out, sd = lens
     return trace_span(kind, c, k, asph, geo, n_in, n_out, sd, j0, j1, clip, x, y, z, L, M, N)
 

@@ -511,10 +511,10 @@ def paraxial_batch(
     n_in, n_out = arrays.n_in[:, :n].T, arrays.n_out[:, :n].T
     # the rays (y, nu) = (1, 0) and (0, 1) at the first vertex: their heights sA, sB on the stop,
     # then on to the last surface (A, B) and their slopes there (C, D): the system matrix
-    stop = arrays.stop + 1
-    (sA, sB), (sC, sD) = ynu_matrix(c, t, n_in, n_out, stop)
-    A, C = ynu_trace(c, t, n_in, n_out, sA, sC, n, start=stop)
-    B, D = ynu_trace(c, t, n_in, n_out, sB, sD, n, start=stop)
+    after_stop = arrays.stop + 1
+    (sA, sB), (sC, sD) = ynu_matrix(c, t, n_in, n_out, after_stop)
+    A, C = ynu_trace(c, t, n_in, n_out, sA, sC, n, start=after_stop)
+    B, D = ynu_trace(c, t, n_in, n_out, sB, sD, n, start=after_stop)
     z_last = arrays.vertex_z[:, -1]
     nk = n_out[-1]
     n0 = n_in[0]

@@ -1,6 +1,6 @@
-"""What the ray-trace results share: the one reading of the kernels' status codes
-(:mod:`raytrace.kernels.codes`) for every result that carries a ``status`` array, and the words
-their summaries use for fields and objects."""
+"""What the ray-trace results share: the reading of the kernels' status codes
+(:mod:`raytrace.kernels.codes`) for every result that carries a ``status`` array (``ok``,
+``n_failed``, :func:`status_name`), and the words their summaries use for fields and objects."""
 
 from __future__ import annotations
 
