@@ -328,12 +328,12 @@ def _as_curve(d, plane: int, at=None) -> DistortionCurve:
             raise CalibrationError(
                 f"plane={plane}: the result has {d.n_planes} image plane(s) (0-based index)"
             )
-        from raytrace.kernels.codes import STATUS_NAMES
+        from raytrace.trace.results import status_name
 
         for a in np.atleast_1d(np.asarray(at if at is not None else [], dtype=float)):
             hit = np.nonzero(np.isclose(d.fields, a, rtol=0, atol=1e-9 * max(1.0, abs(a))))[0]
             if hit.size and d.status[hit[0]] != 0:
-                name = STATUS_NAMES.get(int(d.status[hit[0]]), str(int(d.status[hit[0]])))
+                name = status_name(d.status[hit[0]])
                 raise CalibrationError(
                     f"field {a:g} could not be traced (status {name}): calibrate at fields "
                     "the lens passes"

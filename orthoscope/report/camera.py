@@ -21,7 +21,7 @@ from distortion.camera import (
 )
 from distortion.camera.models import OPENCV_ORDERS
 from distortion.errors import DataError
-from raytrace.kernels.codes import STATUS_NAMES
+from raytrace.trace.results import status_name
 
 from .text import csv_text
 from .units import PARAMETER_UNITS
@@ -127,7 +127,7 @@ def _status_line(points: CameraPoints) -> list[str]:
     counts: dict[str, int] = {}
     for s in points.status:
         if s != 0:
-            k = STATUS_NAMES.get(int(s), str(int(s)))
+            k = status_name(s)
             counts[k] = counts.get(k, 0) + 1
     return [
         f"{points.n_failed} of {points.status.size} chief rays not traced (left out of the fit): "
@@ -304,7 +304,7 @@ def points_csv(tc: TracedCamera) -> str:
             *pts.image_px[i],
             *pts.image_mm[i],
             *res[i],
-            STATUS_NAMES.get(int(pts.status[i]), str(int(pts.status[i]))),
+            status_name(pts.status[i]),
         ]
         for i in range(pts.status.size)
     ]

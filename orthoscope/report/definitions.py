@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from distortion.definitions import ProjectionDistortion
 from raytrace.kernels.codes import STATUS_NAMES
+from raytrace.trace.results import status_name
 
 from .jsonout import float_list
 from .text import csv_text, format_columns
@@ -84,7 +85,7 @@ def projection_to_dict(res: ProjectionDistortion) -> dict:
             {
                 "wavelength_nm": float(res.wavelengths[k]),
                 "efl_mm": float(res.efl[k]),
-                "status": [STATUS_NAMES.get(int(c), str(int(c))) for c in res.status[k]],
+                "status": [status_name(c) for c in res.status[k]],
                 "planes": [
                     {
                         "z_mm": float(res.z_planes[i]),
@@ -141,7 +142,7 @@ def projection_csv(res: ProjectionDistortion) -> str:
                         float(res.yp[k, i, j]),
                         float(res.D[k, i, j]),
                         float(100.0 * res.Dr[k, i, j]),
-                        STATUS_NAMES.get(int(res.status[k, j]), str(int(res.status[k, j]))),
+                        status_name(res.status[k, j]),
                     ]
                 )
     return csv_text(header, rows)

@@ -8,6 +8,7 @@ from distortion.characteristic import CharacteristicDistortion
 from distortion.compensation import CompensationResult
 from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 from raytrace.kernels.codes import STATUS_NAMES
+from raytrace.trace.results import status_name
 
 from .jsonout import float_list
 from .text import csv_text, format_columns
@@ -101,7 +102,7 @@ def characteristic_to_dict(res: CharacteristicDistortion) -> dict:
         "fields": float_list(res.fields),
         "x": float_list(res.x),
         "y_mm": float_list(res.y),
-        "status": [STATUS_NAMES.get(int(c), str(int(c))) for c in res.status],
+        "status": [status_name(c) for c in res.status],
         "gaussian_constant": res.gaussian_constant,
         "planes": [
             {

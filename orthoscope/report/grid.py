@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from distortion.grid import BrownConradyFit, DistortionGrid, GridDecomposition
-from raytrace.kernels.codes import STATUS_NAMES
+from raytrace.trace.results import status_name
 
 from .units import PARAMETER_UNITS
 
@@ -72,7 +72,7 @@ def format_grid(
         st = {}
         for s in grid.status.ravel():
             if s != 0:
-                name = STATUS_NAMES.get(int(s), str(int(s)))
+                name = status_name(s)
                 st[name] = st.get(name, 0) + 1
         lines.append(f"{bad} field(s) not traced: " + ", ".join(f"{n} {v}" for n, v in st.items()))
     sym = "M0" if grid.finite else "F0"
@@ -211,7 +211,7 @@ def grid_to_dict(
         "field_y": grid.field_y,
         "t_x": grid.tx,
         "t_y": grid.ty,
-        "status": [STATUS_NAMES.get(int(s), str(int(s))) for s in grid.status.ravel()],
+        "status": [status_name(s) for s in grid.status.ravel()],
         "reference_point": grid.reference_point,
         "planes": [
             {

@@ -10,6 +10,7 @@ import numpy as np
 from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE
 from distortion.telecentricity import PupilAnalysis
 from raytrace.kernels.codes import STATUS_NAMES
+from raytrace.trace.results import status_name
 
 from .jsonout import float_list
 from .text import csv_text, format_columns
@@ -110,7 +111,7 @@ def pupils_to_dict(pa: PupilAnalysis) -> dict:
         "entrance_pupil_shift_mm": float_list(pa.entrance_pupil_shift),
         "height_at_E0_mm": float_list(pa.height_at_E0),
         "viewpoint_offset_mm": float_list(pa.viewpoint_offset),
-        "status": [STATUS_NAMES.get(int(c), str(int(c))) for c in pa.status],
+        "status": [status_name(c) for c in pa.status],
     }
 
 
