@@ -14,7 +14,11 @@ Measured per revision:
 
 * bulk throughput: 1e6 random rays through the Cooke triplet (``cooke-triplet-f4``), 1 and 2
   threads, best of 5 calls inside the process, in M ray-surfaces/s (6 refracting surfaces); for
-  one thread also per CPU-second of the process (``bulk_mrs_1t_cpu``: steadier on a busy machine);
+  one thread also per CPU-second of the process (``bulk_mrs_1t_cpu``: steadier on a busy machine).
+  Each call's results are released before the next, so that the calls reuse memory: when they
+  were kept, every call paid the first-touch page faults of fresh 8 MB output arrays, which moved
+  this row by 10-40 % between processes of the same code. Differences of a few per cent are
+  resolved only in one process: ``benchmarks/kernel_ab.py``;
 * the 50-field chief-ray curve (Cooke, 0–20°): median of 300 calls, ms;
 * CLI wall time and CPU time (user + system of the child, ``os.wait4``: a busy machine inflates
   it far less than the wall time), warm: ``distortion topogon-like-pestrecov``, ``paraxial
@@ -75,7 +79,7 @@ for th in (1, 2):
     best = best_cpu = 1e9
     for _ in range(5):
         t0 = time.perf_counter(); c0 = time.process_time()
-        rb = tr(p, rays, th); rb.at_plane(p.z_image)
+        rb = tr(p, rays, th); xy = rb.at_plane(p.z_image); del rb, xy
         best = min(best, time.perf_counter() - t0)
         if th == 1:
             best_cpu = min(best_cpu, time.process_time() - c0)

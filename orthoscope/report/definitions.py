@@ -5,7 +5,6 @@ the focal length it uses."""
 from __future__ import annotations
 
 from distortion.definitions import ProjectionDistortion
-from raytrace.kernels.codes import STATUS_NAMES
 from raytrace.trace.results import status_name
 
 from .jsonout import float_list
@@ -57,7 +56,7 @@ def format_projection(res: ProjectionDistortion, *, decimals: int = 4, layout: s
                 )
             )
     bad = [
-        f"{res.wavelengths[k]:g} nm, {v:g} deg: {STATUS_NAMES.get(int(c), c)}"
+        f"{res.wavelengths[k]:g} nm, {v:g} deg: {status_name(c)}"
         for k in range(res.n_wavelengths)
         for v, c in zip(res.fields, res.status[k], strict=True)
         if c != 0

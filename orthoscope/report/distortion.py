@@ -7,7 +7,6 @@ from distortion.calibration import CalibrationResult
 from distortion.characteristic import CharacteristicDistortion
 from distortion.compensation import CompensationResult
 from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
-from raytrace.kernels.codes import STATUS_NAMES
 from raytrace.trace.results import status_name
 
 from .jsonout import float_list
@@ -65,9 +64,7 @@ def format_characteristic(
     ]
     flabel = {ANGLE: "α (deg)", HEIGHT: "y (mm)", NOMINAL_ANGLE: "nominal α (deg)"}[res.field_kind]
     bad = [
-        f"{v:g}: {STATUS_NAMES.get(int(c), c)}"
-        for v, c in zip(res.fields, res.status, strict=True)
-        if c != 0
+        f"{v:g}: {status_name(c)}" for v, c in zip(res.fields, res.status, strict=True) if c != 0
     ]
     tail = ["fields not traced: " + ", ".join(bad)] if bad else []
     if res.n_planes == 1:
@@ -239,7 +236,7 @@ def characteristic_csv(res: CharacteristicDistortion) -> str:
                     float(res.yp[p, i]) if ok else None,
                     float(res.D0[p, i]) if ok else None,
                     float(100.0 * res.Dr[p, i]) if ok else None,
-                    STATUS_NAMES[int(res.status[i])],
+                    status_name(res.status[i]),
                 ]
             )
     head = ["s_prime_mm", "defocus_mm", fname, "y_mm", "y0p_mm", "yp_mm", "D0_mm", "Dr_pct"]

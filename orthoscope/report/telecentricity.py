@@ -9,7 +9,6 @@ import numpy as np
 
 from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE
 from distortion.telecentricity import PupilAnalysis
-from raytrace.kernels.codes import STATUS_NAMES
 from raytrace.trace.results import status_name
 
 from .jsonout import float_list
@@ -63,11 +62,7 @@ def format_pupils(pa: PupilAnalysis, *, decimals: int = 4, layout: str = "rows")
         ("height at E0 (mm)", pa.height_at_E0, decimals, True),
         ("viewpoint offset (mm)", pa.viewpoint_offset, decimals, True),
     ]
-    bad = [
-        f"{v:g}: {STATUS_NAMES.get(int(c), c)}"
-        for v, c in zip(pa.fields, pa.status, strict=True)
-        if c != 0
-    ]
+    bad = [f"{v:g}: {status_name(c)}" for v, c in zip(pa.fields, pa.status, strict=True) if c != 0]
     tail = ["fields not traced: " + ", ".join(bad)] if bad else []
     at_inf = [f"{v:g}" for v, z in zip(pa.fields, pa.exit_pupil_z, strict=True) if np.isinf(z)]
     if at_inf:
