@@ -109,6 +109,13 @@ class PackedLens:
     n_lens_surfaces: int | None = None
 
     def __post_init__(self) -> None:
+        # numba compiles a kernel once per array type, and a read-only array is another type:
+        # every array here is writeable, so that each kernel is compiled once (a cached pack is
+        # not to be written to all the same)
+        for name in ("kind", "c", "k", "asph", "zv", "n_in", "n_out", "sd", "n_in_w", "n_out_w"):
+            a = getattr(self, name)
+            if isinstance(a, np.ndarray) and not a.flags.writeable:
+                object.__setattr__(self, name, a.copy())
         n = int(self.c.shape[0])
         geo = self.geo
         if geo is None or geo.shape[0] != n:
@@ -186,8 +193,8 @@ def pack(lens: Lens, wavelength: float | None = None, *, wavelengths=None) -> Pa
     for i, r in enumerate(rows):
         asph[i, : len(r)] = r
     idx = lens.indices(wl)  # (w, n + 1): object space, then after each surface
-    n_in_w = np.ascontiguousarray(idx[:, :-1])
-    n_out_w = np.ascontiguousarray(idx[:, 1:])
+    n_in_w = np.array(idx[:, :-1], order="C")  # copies: the cached indices are read-only
+    n_out_w = np.array(idx[:, 1:], order="C")
     kind = np.array([s.kind for s in ss], dtype=np.int64)
     c = np.array([s.curvature for s in ss], dtype=np.float64)
     k = np.array([s.conic for s in ss], dtype=np.float64)

@@ -76,3 +76,51 @@ def test_compile_notice_only_when_no_tracing_kernel_is_cached(monkeypatch, capsy
         err = capsys.readouterr().err
         assert ("compiling the ray-tracing kernels" in err) is expect, (warm, err)
     assert aim.aim_chief.__name__ == "aim_chief"
+
+
+def _array_types(sig):
+    """The array types in a numba signature, tuples of arrays included."""
+    from numba.core import types
+
+    for t in sig:
+        if isinstance(t, types.BaseTuple):
+            yield from _array_types(t.types)
+        elif isinstance(t, types.Array):
+            yield t
+
+
+def test_kernels_see_one_type_per_argument():
+    """numba compiles a kernel once per argument types, and a read-only array or a literal
+    argument is another type: each would compile the big kernels again (the cold compile of the
+    test suite had doubled this way). The packed lens arrays are writeable whether the indices
+    come from the read-only cache (one wavelength) or not (several), read-only ray inputs are
+    copied, and the called kernels get no literal arguments."""
+    import numpy as np
+    from numba.core import types
+
+    from raytrace.files.library import load_lens
+    from raytrace.kernels import aim, aim2d, bulk, paths
+    from raytrace.packing import pack
+    from raytrace.trace import chief_rays, chief_rays_2d, trace_rays
+    from raytrace.trace.rays import ray_paths
+
+    lens = load_lens("cooke-triplet-f4")
+    for p in (pack(lens), pack(lens, wavelengths=(486.1, 587.6, 656.3))):
+        for a in p.arrays + p.lens_arrays:
+            assert a.flags.writeable and a.flags.c_contiguous
+    ro = np.zeros(4)
+    ro.flags.writeable = False
+    rays = trace_rays(lens, (ro, ro, ro - 1.0), (ro, ro, ro + 1.0))
+    assert rays.ok.all()
+    ray_paths(lens, (ro, ro, ro - 1.0), (ro, ro, ro + 1.0))
+    chief_rays(lens, [0.0, 10.0])
+    chief_rays(lens, [0.0, 10.0], wavelengths="lens")
+    chief_rays_2d(lens, [0.0, 5.0], [0.0, 5.0])
+    # kernels loaded from the cache list no signatures; those compiled here (or earlier in this
+    # process) must have none with a read-only array or a literal
+    kernels = (aim.aim_chief, aim2d.aim_chief_2d, aim2d._trace_lens, bulk.trace_batch_serial,
+               bulk._general_rows, paths.trace_paths)  # fmt: skip
+    for k in kernels:
+        for sig in k.signatures:
+            assert not any(isinstance(t, types.Literal) for t in sig), (k, sig)
+            assert all(t.mutable for t in _array_types(sig)), (k, sig)

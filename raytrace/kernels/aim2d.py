@@ -83,7 +83,11 @@ def stop_point(span, lens, stop, finite, z_obj, f1, f2, u1, u2):
     j0, j1, clip, x, y, z, L, M, N)`` (:func:`_trace_lens`, or the instance kernels' trace of
     one instance) with the results of :func:`raytrace.kernels.surface.trace_span`."""
     x0, y0, z0, L0, M0, N0 = start_ray_2d(finite, z_obj, f1, f2, u1, u2)
-    st, sf, x, y, z, L, M, N = span(lens, 0, stop + 1, False, x0, y0, z0, L0, M0, N0)
+    # np.int64(0), np.bool_(False): typed arguments, not literals; a literal would compile
+    # ``span`` (a called kernel) once more for each literal value
+    st, sf, x, y, z, L, M, N = span(
+        lens, np.int64(0), stop + 1, np.bool_(False), x0, y0, z0, L0, M0, N0
+    )
     return st == STATUS_OK and math.isfinite(x) and math.isfinite(y), x, y
 
 
@@ -92,7 +96,7 @@ def trace_via_stop(span, lens, stop, ns, clip, x, y, z, L, M, N):
     """The ray traced through all ns surfaces with ``span`` (:func:`stop_point`), in two spans
     so that the point on the stop is kept: (status, surface_1based, x_stop, y_stop, x, y, z, L,
     M, N), the last six the final segment."""
-    st, sf, x, y, z, L, M, N = span(lens, 0, stop + 1, clip, x, y, z, L, M, N)
+    st, sf, x, y, z, L, M, N = span(lens, np.int64(0), stop + 1, clip, x, y, z, L, M, N)
     xs = x
     ys = y
     if st == STATUS_OK:

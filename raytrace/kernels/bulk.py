@@ -333,8 +333,10 @@ def _trace_block(kind, c, k, asph, geo, n_in, n_out, sd, clip, i0, i1, x, y, z, 
         buf[_RF + i] = 0.0 if good else 1.0
         buf[_RT + i] = 0.0
     coaxial = (int(geo[0, G_LENS]) & L_COAXIAL) != 0
-    check = False  # an acting surface was met: the backward-travel test applies (.surface)
-    carry = False  # dummy surfaces traced since the last acting one: row _RT holds their path
+    # np.bool_: typed, not literal False, so that the called kernel _general_rows is compiled
+    # once (with literals the first surface's call compiled a second copy)
+    check = np.bool_(False)  # an acting surface was met: the backward-travel test applies
+    carry = np.bool_(False)  # dummy surfaces traced since the last acting one (path in _RT)
     for j in range(c.shape[0]):
         mu = n_in[j] / n_out[j]
         acting = acts(geo, j, n_in, n_out)

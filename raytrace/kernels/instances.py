@@ -268,8 +268,8 @@ def _trace_one(lens, i, start, clip, last, status):
     out = last[i]
     for r in range(start.shape[1]):
         st, sf, x, y, z, L, M, N = _span(
-            inst, 0, ns, clip, start[0, r], start[1, r], start[2, r], start[3, r], start[4, r],
-            start[5, r],
+            inst, np.int64(0), ns, clip, start[0, r], start[1, r], start[2, r], start[3, r],
+            start[4, r], start[5, r],
         )  # fmt: skip
         status[i, r] = st
         put_segment(out, r, st == STATUS_OK, x, y, z, L, M, N)

@@ -107,9 +107,10 @@ def _columns(a, what: str) -> list[np.ndarray]:
 
 
 def _f64(a: np.ndarray, n: int) -> np.ndarray:
-    """A contiguous float64 1-D array of length n (one kernel specialisation only); a contiguous
-    float64 input is used without a copy (the structure-of-arrays form of :func:`trace_rays`)."""
-    if a.shape == (n,) and a.dtype == np.float64 and a.flags.c_contiguous:
+    """A contiguous, writeable float64 1-D array of length n (one kernel specialisation only: a
+    read-only array is another type to numba, and would compile the kernel again); such an input
+    is used without a copy (the structure-of-arrays form of :func:`trace_rays`)."""
+    if a.shape == (n,) and a.dtype == np.float64 and a.flags.c_contiguous and a.flags.writeable:
         return a
     return np.array(np.broadcast_to(a, (n,)), dtype=np.float64, order="C")
 
@@ -243,7 +244,7 @@ def ray_paths(
     packed = packed_lens(lens, wavelength)
     arrs = [np.atleast_1d(a) for a in _columns(origins, "origins") + _columns(directions, "dirs")]
     n = int(np.broadcast_shapes(*(a.shape for a in arrs))[0])
-    xs = [np.ascontiguousarray(np.broadcast_to(a, (n,)), dtype=np.float64) for a in arrs]
+    xs = [_f64(a, n) for a in arrs]
     ns = packed.n_lens_surfaces
     px, py, pz = (np.empty((n, ns)) for _ in range(3))
     st = np.empty(n, dtype=np.int8)
