@@ -90,11 +90,11 @@ def _array_types(sig):
 
 
 def test_kernels_see_one_type_per_argument():
-    """numba compiles a kernel once per argument types, and a read-only array or a literal
-    argument is another type: each would compile the big kernels again (the cold compile of the
-    test suite had doubled this way). The packed lens arrays are writeable whether the indices
-    come from the read-only cache (one wavelength) or not (several), read-only ray inputs are
-    copied, and the called kernels get no literal arguments."""
+    """numba compiles a kernel once for each set of argument types, and a read-only array or a
+    literal argument is another type: each would compile the big kernels again (the cold compile
+    of the test suite had doubled this way). The packed lens arrays are writeable whether the
+    indices come from the read-only cache (one wavelength) or not (several), read-only ray inputs
+    are copied, and the called kernels get no literal arguments."""
     import numpy as np
     from numba.core import types
 
@@ -116,8 +116,9 @@ def test_kernels_see_one_type_per_argument():
     chief_rays(lens, [0.0, 10.0])
     chief_rays(lens, [0.0, 10.0], wavelengths="lens")
     chief_rays_2d(lens, [0.0, 5.0], [0.0, 5.0])
-    # kernels loaded from the cache list no signatures; those compiled here (or earlier in this
-    # process) must have none with a read-only array or a literal
+    # a kernel lists the signatures it was loaded or compiled for in this process; a called
+    # kernel (_trace_lens, _general_rows) only those compiled here (not when its caller came
+    # from the cache). None may hold a read-only array or a literal.
     kernels = (aim.aim_chief, aim2d.aim_chief_2d, aim2d._trace_lens, bulk.trace_batch_serial,
                bulk._general_rows, paths.trace_paths)  # fmt: skip
     for k in kernels:
