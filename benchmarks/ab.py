@@ -235,8 +235,12 @@ def main() -> None:
               + "".join(f"{vb / med[k].get(m, float('nan')):8.3f}" for k in refs))  # fmt: skip
     out = HERE / "results"
     out.mkdir(exist_ok=True)
-    (out / "ab.json").write_text(
-        json.dumps({"refs": refs, "rounds": rows, "median": med, "load": [load0, load1]})
+    from raytrace.files.output import write_atomic
+
+    write_atomic(
+        out / "ab.json",
+        json.dumps({"refs": refs, "rounds": rows, "median": med, "load": [load0, load1]}),
+        overwrite=True,
     )
     print(f"wrote {out / 'ab.json'}")
 

@@ -25,6 +25,7 @@ import numba
 import numpy as np
 
 from raytrace.files.library import load_lens
+from raytrace.files.output import write_atomic
 from raytrace.kernels import bulk as K
 from raytrace.packing import pack
 from raytrace.trace import chief_rays, trace_rays
@@ -162,7 +163,7 @@ def main() -> None:
         )
     RESULTS.mkdir(parents=True, exist_ok=True)
     path = RESULTS / "bench_core.json"
-    path.write_text(json.dumps(res, indent=2))
+    write_atomic(path, json.dumps(res, indent=2), overwrite=True)
     print(f"\nwrote {path}")
 
 

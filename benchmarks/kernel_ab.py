@@ -95,6 +95,7 @@ def main() -> None:
     import numba
 
     from raytrace.files.library import load_lens
+    from raytrace.files.output import write_atomic
     from raytrace.kernels import bulk as this
     from raytrace.kernels.codes import G_ZV
     from raytrace.packing import pack
@@ -177,18 +178,14 @@ def main() -> None:
               f"{s['iqr'][1]:.3f}); of the 10th percentiles {s['p10_ratio']:.3f}")  # fmt: skip
     out = HERE / "results"
     out.mkdir(exist_ok=True)
-    (out / "kernel_ab.json").write_text(
-        json.dumps(
-            {
-                "refs": refs,
-                "threads": args.threads,
-                "rays": n,
-                "summary": summary,
-                "times_s": times,
-            },
-            indent=1,
-        )  # fmt: skip
-    )
+    record = {
+        "refs": refs,
+        "threads": args.threads,
+        "rays": n,
+        "summary": summary,
+        "times_s": times,
+    }
+    write_atomic(out / "kernel_ab.json", json.dumps(record, indent=1), overwrite=True)
     print(f"wrote {out / 'kernel_ab.json'}")
 
 

@@ -817,7 +817,9 @@ def main(argv=None) -> int:
     if not args.no_plots:
         res["plots"] = plots(res, out.with_suffix(""))
         print("plots: " + ", ".join(res["plots"]))
-    out.write_text(json.dumps(res, indent=1, default=float))
+    from raytrace.files.output import write_atomic
+
+    write_atomic(out, json.dumps(res, indent=1, default=float), overwrite=True)
     print(f"wrote {out}  (suite wall time {res['wall_s']:.0f} s)")
     return 0
 

@@ -248,7 +248,9 @@ def main(argv: list[str] | None = None) -> int:
     print("\n".join(summarize(res)))
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(res, indent=1))
+    from raytrace.files.output import write_atomic
+
+    write_atomic(out, json.dumps(res, indent=1), overwrite=True)
     print(f"wrote {out}")
     return 0
 

@@ -454,7 +454,9 @@ def main(argv=None) -> int:
     res["orthoscope"].pop("summary", None)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(res, indent=1, default=float))
+    from raytrace.files.output import write_atomic
+
+    write_atomic(out, json.dumps(res, indent=1, default=float), overwrite=True)
     print(f"wrote {out}  (wall time {res['wall_s']:.0f} s)")
     return 0
 
