@@ -564,7 +564,10 @@ def monte_carlo(
         if any(k not in on_disk for k, _, _ in chunks):
             client, close = _dask_client(executor)
         try:
-            shared = client.scatter(st, broadcast=True) if client is not None else None
+            # hash=False: a key of its own for each run. The default content-hashed key is the
+            # same for a second run with the same setup on the same client, and the first run's
+            # release of that key then deleted the second run's data ("lost dependencies")
+            shared = client.scatter(st, broadcast=True, hash=False) if client is not None else None
             for group in (first, rest):
                 for k, a, _ in group:
                     if k in on_disk:
