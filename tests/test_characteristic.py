@@ -176,6 +176,21 @@ def test_curve_calibration_and_output(triplet):
     assert len(d["planes"]) == 2 and d["status"] == [STATUS_NAMES[STATUS_OK]] * 5
 
 
+def test_untraced_fields_are_named_with_their_status_in_the_text(triplet):
+    # 60° is beyond the triplet's field (aim fails); the words are the kernels' status table's
+    from distortion.telecentricity import pupil_analysis
+    from orthoscope.report.telecentricity import format_pupils
+    from raytrace.trace.results import status_name
+
+    res = characteristic_distortion(triplet, [0.0, 10.0, 60.0])
+    assert res.status[2] != 0 and not res.status[:2].any()
+    line = f"fields not traced: 60: {status_name(res.status[2])}"
+    assert format_characteristic(res).splitlines()[-1] == line
+    pa = pupil_analysis(triplet, [0.0, 10.0, 60.0])
+    assert line in format_pupils(pa).splitlines()
+    assert "not traced" not in format_characteristic(characteristic_distortion(triplet, [10.0]))
+
+
 def test_bad_requests(triplet):
     with pytest.raises(TraceError, match="unknown distortion reference"):
         characteristic_distortion(triplet, [10.0], reference="zemax")

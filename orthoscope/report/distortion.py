@@ -10,7 +10,7 @@ from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 from raytrace.trace.results import status_name
 
 from .jsonout import float_list
-from .text import csv_text, format_columns
+from .text import csv_text, format_columns, untraced
 
 
 def format_curve(
@@ -63,10 +63,7 @@ def format_characteristic(
         f"{res.name} — distortion ({res.reference}); object distance {res.object_distance:g} mm"
     ]
     flabel = {ANGLE: "α (deg)", HEIGHT: "y (mm)", NOMINAL_ANGLE: "nominal α (deg)"}[res.field_kind]
-    bad = [
-        f"{v:g}: {status_name(c)}" for v, c in zip(res.fields, res.status, strict=True) if c != 0
-    ]
-    tail = ["fields not traced: " + ", ".join(bad)] if bad else []
+    tail = untraced(res.fields, res.status)
     if res.n_planes == 1:
         head.append(
             f"{res.plane_label(0)};  {s}0 = {res.constant[0]:.6f}{unit};  "

@@ -12,7 +12,7 @@ from distortion.telecentricity import PupilAnalysis
 from raytrace.trace.results import status_name
 
 from .jsonout import float_list
-from .text import csv_text, format_columns
+from .text import csv_text, format_columns, untraced
 
 _FIELD_LABEL = {ANGLE: "alpha (deg)", HEIGHT: "y (mm)", NOMINAL_ANGLE: "nominal alpha (deg)"}
 
@@ -62,8 +62,7 @@ def format_pupils(pa: PupilAnalysis, *, decimals: int = 4, layout: str = "rows")
         ("height at E0 (mm)", pa.height_at_E0, decimals, True),
         ("viewpoint offset (mm)", pa.viewpoint_offset, decimals, True),
     ]
-    bad = [f"{v:g}: {status_name(c)}" for v, c in zip(pa.fields, pa.status, strict=True) if c != 0]
-    tail = ["fields not traced: " + ", ".join(bad)] if bad else []
+    tail = untraced(pa.fields, pa.status)
     at_inf = [f"{v:g}" for v, z in zip(pa.fields, pa.exit_pupil_z, strict=True) if np.isinf(z)]
     if at_inf:
         tail.append(

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from raytrace.trace.results import status_name
+
 
 def fmt(v: float | None, width: int = 12, prec: int = 4) -> str:
     """A right-aligned number: ``-`` for None/NaN, ``inf``/``-inf`` for infinities."""
@@ -14,6 +16,13 @@ def fmt(v: float | None, width: int = 12, prec: int = 4) -> str:
     if isinstance(v, float) and math.isinf(v):
         return f"{('inf' if v > 0 else '-inf'):>{width}}"
     return f"{v:>{width}.{prec}f}"
+
+
+def untraced(fields: np.ndarray, status: np.ndarray) -> list[str]:
+    """``["fields not traced: 30: TIR, 45: missed"]`` for the fields whose status is not 0, or
+    ``[]`` when every field traced (status words: :func:`raytrace.trace.results.status_name`)."""
+    bad = [f"{v:g}: {status_name(c)}" for v, c in zip(fields, status, strict=True) if c != 0]
+    return ["fields not traced: " + ", ".join(bad)] if bad else []
 
 
 def _cell(v: float, dec: int, signed: bool) -> str:
