@@ -7,7 +7,8 @@ Referee: optiland 0.6.3, ``optiland.analysis.Distortion`` with ``distortion_type
 image surface, scale y'(1e-10 θmax)/tan(1e-10 θmax) or /(1e-10 θmax), percent = 100 (y' −
 y_ideal)/y_ideal). optiland aims the chief ray at the PARAXIAL entrance pupil by default; ours goes
 through the centre of the real stop. For the agreement test optiland's iterative aimer is set
-(tolerance 1e-14 mm at the stop), so both programs trace the same ray; the default paraxial aim is
+(tolerance 1e-13 mm at the stop; at 1e-14 optiland's aimer does not converge on the
+seven-element Twinplex-like lens), so both programs trace the same ray; the default paraxial aim is
 reproduced separately (test_optilands_default_paraxial_aim_is_reproduced), which bounds the
 difference: e.g. 0.039 % of Dr at 20° for the Cooke triplet, 0.11 % at 45° for the Topogon-like.
 """
@@ -33,7 +34,7 @@ from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index
 from raytrace.errors import TraceError
 
 #: bundled lenses (object at infinity; the Twinplex-like moved to infinity, so that its file's
-#: image plane — the Gaussian plane of its 44.8 mm object — is a strongly defocused plane there)
+#: image plane — the Gaussian plane of its 12.7 mm object — is a strongly defocused plane there)
 BUNDLED = (
     "cooke-triplet-f4",
     "topogon-us2031792-fig1",
@@ -51,10 +52,14 @@ REAL = (
     "rayoptics/US00583336-2-scaled.zmx",
 )
 N_POINTS = 11
-# agreement with optiland relative to the largest |Dr|: the issue's target was 1e-9; measured
-# today (optiland 0.6.3) at most 3.8e-12 over every lens, definition and wavelength below, so the
-# bound is ~10x that
-REL_TOL = 4e-11
+# agreement with optiland relative to the largest |Dr|: the issue's target was 1e-9. Measured
+# (optiland 0.6.3, 2026-11-24) at most 3.8e-12 over every lens, definition and wavelength below
+# except the seven-element Twinplex-like lens: 7.9e-11 for F-tan (1.2e-12 for F-theta). Its file
+# plane is ~530 mm behind the lens, far from the focus of an object at infinity, and both
+# definitions differ from optiland by the same 3.2e-11 percentage points: the chief ray's height
+# there, not the definition; the same number with optiland's aim tolerance 1e-12 or 1e-13 mm.
+# F-tan's |Dr| there is only 0.4 %, so the relative bound is ~1.3x that worst case.
+REL_TOL = 1e-10
 
 
 def _lens(name: str) -> Lens:
@@ -82,7 +87,7 @@ def test_f_tan_and_f_theta_agree_with_optiland(name):
     if lens.field.value == 0.0:
         pytest.fail(f"{name}: no field to compare")
     op = ola.build_optic(lens)
-    op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-14)  # the real stop centre
+    op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-13)  # the real stop centre
     theta = _fields(op)
     for ours_name, kind in (("f-tan-theta", "f-tan"), ("f-theta", "f-theta")):
         # optiland's image surface is the lens file's image plane (benchmarks/optiland_adapter.py)
@@ -102,7 +107,7 @@ def test_per_wavelength_agrees_with_optiland(wavelength):
     ola = benchmark_module("optiland_adapter", needs="optiland")
     lens = osc.load_lens("cooke-triplet-f4")
     op = ola.build_optic(lens, wavelength_nm=wavelength)
-    op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-14)
+    op.ray_tracer.set_aiming("iterative", max_iter=50, tol=1e-13)
     theta = _fields(op)
     r = projection_distortion(
         lens,
