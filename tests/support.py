@@ -15,7 +15,7 @@ from types import ModuleType
 import pytest
 
 from raytrace import AIR, Aperture, Field, Lens, Surface, fixed_index, model_glass
-from raytrace.optimize import DesignSpec, Operand, Variable
+from raytrace.optimize import DesignSpec, Operand, Variable, read_spec
 
 ROOT = Path(__file__).resolve().parents[1]  # the repository
 TEST_DATA = ROOT / "tests" / "data"
@@ -79,6 +79,13 @@ def time_limit(seconds: float):
     """Raise :class:`Hang` in the block after ``seconds`` (POSIX main thread; no limit
     otherwise): benchmarks/corpus.py's time limit."""
     return benchmark_module("corpus").time_limit(seconds, Hang(f"took more than {seconds} s"))
+
+
+def read_spec_text(tmp_path: Path, text: str) -> DesignSpec:
+    """Read a design spec written as TOML text (into ``tmp_path / "s.toml"``)."""
+    p = tmp_path / "s.toml"
+    p.write_text(text, encoding="utf-8")
+    return read_spec(p)
 
 
 def singlet(n=1.5, f=100.0, t=0.3, fnum=20.0) -> Lens:

@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import pytest
+from support import read_spec_text
 
 from raytrace.glass import catalog_glasses
 from raytrace.optimize import (
@@ -27,10 +28,7 @@ OK_VAR = 'variables = [ { kind = "curvature", surface = 1 } ]\n'
 OK_OP = 'operands = [ { type = "efl", target = 50 } ]\n'
 
 
-def _read(tmp_path: Path, text: str):
-    p = tmp_path / "s.toml"
-    p.write_text(text, encoding="utf-8")
-    return read_spec(p)
+_read = read_spec_text
 
 
 @pytest.mark.parametrize(

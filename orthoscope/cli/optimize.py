@@ -1,11 +1,13 @@
-"""CLI: ``orthoscope optimize SPEC.toml -o LENS.toml [--global ...]`` — a reproducible design run:
-damped least squares from the spec's start lens, or (``--global``) the global search with glass
-substitution (:func:`raytrace.optimize.global_optimize`)."""
+"""CLI: ``orthoscope optimize SPEC.toml -o LENS.toml [--method M] [--global ...]`` — a
+reproducible design run: damped least squares (or, with ``--method minimax`` / the spec's
+``method = "minimax"``, minimax) from the spec's start lens, or (``--global``) the global search
+with glass substitution (:func:`raytrace.optimize.global_optimize`)."""
 
 from __future__ import annotations
 
 import argparse
 import datetime as _dt
+import math
 import sys
 import time
 from dataclasses import replace
@@ -19,10 +21,11 @@ EXIT_NOT_CONVERGED = 1
 
 class _Progress:
     """One status line (iteration, merit, worst operand) on stderr, redrawn in place on a
-    terminal and printed every few seconds otherwise."""
+    terminal and printed every few seconds otherwise; ``label`` names the merit."""
 
-    def __init__(self, quiet: bool) -> None:
+    def __init__(self, quiet: bool, label: str = "merit") -> None:
         self.quiet = quiet
+        self.label = label
         self.tty = sys.stderr.isatty()
         self.last = 0.0
         self.best = float("inf")
@@ -36,8 +39,8 @@ class _Progress:
             return
         self.last = now
         line = (
-            f"eval {n:6d}  merit {merit:12.6g}  best {self.best:12.6g}  worst "
-            f"{worst.operand.label()} = {worst.value:.6g} (target {worst.operand.target:g})"
+            f"eval {n:6d}  {self.label} {merit:12.6g}  best {self.best:12.6g}  worst "
+            f"{worst.operand.label()} = {worst.value:.6g} ({_aim(worst.operand).strip()})"
         )
         if self.tty:
             sys.stderr.write("\r" + line[:150].ljust(150))
@@ -111,14 +114,19 @@ SAMPLES = [["optimize", "{specs}/twinplex-like-55-525.toml", "-o", "{tmp}/design
 OUTPUTS = [("-o", ".toml")]
 
 
+#: how the CLI names the merit of each method (OptimizationResult.merit)
+MERIT_NAMES = {"least_squares": "merit", "minimax": "max weighted residual"}
+
+
 def provenance_notes(lens, spec, res, start_name: str) -> str:
     """Notes of a designed lens: provenance line first (see raytrace.files.native)."""
     date = _dt.date.today().isoformat()
+    how = " --method minimax" if res.method == "minimax" else ""
     return (
         "provenance: derived\n"
-        f"Designed with 'orthoscope optimize {Path(spec.path).name}' from the start lens "
-        f"{start_name}; merit {res.merit:.9g} (start {res.merit_start:.9g}) after "
-        f"{res.evaluations} evaluations; {date}."
+        f"Designed with 'orthoscope optimize {Path(spec.path).name}{how}' from the start lens "
+        f"{start_name}; {MERIT_NAMES[res.method]} {res.merit:.9g} (start "
+        f"{res.merit_start:.9g}) after {res.evaluations} evaluations; {date}."
     )
 
 
@@ -142,25 +150,43 @@ def global_provenance_notes(spec, res, start_name: str) -> str:
     return text
 
 
+def _aim(op) -> str:
+    """What an operand aims at: its target, or its bounds (a one-sided operand)."""
+    if not op.bounded:
+        return f"{op.target:.6f}"
+    lo, hi = op.limits
+    return " ".join(
+        s
+        for s in (f">= {lo:.6g}" if lo > -math.inf else "", f"<= {hi:.6g}" if hi < math.inf else "")
+        if s
+    )
+
+
 def _operand_table(operands) -> list[dict]:
-    return [
-        {
-            "operand": o.operand.label(),
+    """One row per operand; a bound operand has ``min`` / ``max`` and no target (None)."""
+    rows = []
+    for o in operands:
+        op = o.operand
+        row = {
+            "operand": op.label(),
             "value": o.value,
-            "target": o.operand.target,
-            "weight": o.operand.weight,
+            "target": None if op.bounded else op.target,
+            "weight": op.weight,
             "residual": o.residual,
         }
-        for o in operands
-    ]
+        if op.bounded:
+            lo, hi = op.limits
+            row["min"] = lo if lo > -math.inf else None
+            row["max"] = hi if hi < math.inf else None
+        row["aim"] = _aim(op)
+        rows.append(row)
+    return rows
 
 
 def _print_table(table: list[dict]) -> None:
-    print(f"{'operand':40} {'value':>14} {'target':>14} {'weighted resid.':>16}")
+    print(f"{'operand':40} {'value':>14} {'target / bound':>20} {'weighted resid.':>16}")
     for r in table:
-        print(
-            f"{r['operand'][:40]:40} {r['value']:14.6f} {r['target']:14.6f} {r['residual']:16.6g}"
-        )
+        print(f"{r['operand'][:40]:40} {r['value']:14.6f} {r['aim']:>20} {r['residual']:16.6g}")
 
 
 def _search_overrides(args) -> dict:
@@ -198,6 +224,14 @@ def cmd_optimize(args) -> int:
             ),
         )
     spec = read_spec(args.spec)
+    if args.method is not None:
+        spec = replace(spec, method=args.method)
+    if args.global_search and spec.method == "minimax":
+        where = "--method minimax" if args.method else f'{spec.path} sets method = "minimax"'
+        raise CliError(
+            f"--global runs damped least squares only ({where}): drop --global for a minimax "
+            "run, or add --method least_squares for the global search"
+        )
     if args.max_evaluations is not None:
         if args.max_evaluations < 1:
             raise CliError("--max-evaluations must be at least 1")
@@ -262,7 +296,8 @@ def _result_json(spec, res, out, written, table, before=None, after=None) -> dic
 def _run_local(args, spec, lens, out, inputs) -> int:
     from raytrace.optimize import optimize
 
-    prog = _Progress(args.quiet or args.json)
+    name = MERIT_NAMES[spec.method]
+    prog = _Progress(args.quiet or args.json, "max|r|" if spec.method == "minimax" else "merit")
     res = optimize(lens, spec, progress=prog)
     prog.done()
     table = _operand_table(res.operands)
@@ -272,13 +307,21 @@ def _run_local(args, spec, lens, out, inputs) -> int:
         f"derived by orthoscope optimize from {spec.start} with {Path(spec.path).name}",
     )  # fmt: skip
     if args.json:
-        print_json(_result_json(spec, res, out, written, table))
+        extra = {"method": res.method, "merit_is": name, "violation": res.violation}
+        print_json(_result_json(spec, res, out, written, table, after=extra))
     else:
         print(f"{spec.name}: {res.message}")
         print(
-            f"merit {res.merit_start:.6g} -> {res.merit:.6g} in {res.evaluations} evaluations "
+            f"{name} {res.merit_start:.6g} -> {res.merit:.6g} in {res.evaluations} evaluations "
             f"({res.seconds:.1f} s)"
         )
+        if res.method == "minimax":
+            worst = max(res.operands, key=lambda o: abs(o.residual))
+            print(
+                f"method minimax: the merit is max |weight x (value - target)| over the target "
+                f"operands; largest bound violation {res.violation:.3g}; worst operand "
+                f"{worst.operand.label()}"
+            )
         _print_table(table)
         print(
             f"wrote {out}"
@@ -384,9 +427,12 @@ def register(sub: argparse._SubParsersAction) -> None:
             "surfaces, with bounds; glass = substitution among real catalog glasses, --global "
             "only), pick-ups, and operands with targets and weights (efl, m_e, HE0, HpE0p, "
             "distortion, distortion_rel, distortion_slope, image_height, landing_angle, "
-            "best_focus, rms_spot, axial_color, center_thickness, edge_thickness). Without "
-            "--global: damped least squares from the start lens; progress (evaluation, merit, "
-            "worst operand) goes to stderr. With --global: many starts and basin hops around "
+            "best_focus, rms_spot, axial_color, center_thickness, edge_thickness; any operand "
+            "may give min / max instead of a target: a one-sided bound). Without --global: "
+            "damped least squares from the start lens, or minimax (--method minimax, or the "
+            'spec\'s method = "minimax": the largest weighted residual is minimised, the '
+            "bounds are constraints); progress (evaluation, merit, worst operand) goes to "
+            "stderr. With --global: many starts and basin hops around "
             "damped least squares, glass substitution, in parallel worker processes; seeded "
             "and deterministic (the same seed gives the same lens whatever --workers); a "
             "progress bar on a terminal (tqdm) or plain lines; --time or Ctrl-C stops it and "
@@ -406,6 +452,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         required=True,
         metavar="LENS.toml",
         help="Where to write the designed lens.",
+    )
+    q.add_argument(
+        "--method",
+        choices=("least_squares", "minimax"),
+        help="Override the spec's method: damped least squares (merit: sum of squared weighted "
+        "residuals) or minimax (merit: the largest |weighted residual| of the target operands, "
+        "the operands with min / max as constraints; not with --global).",
     )
     q.add_argument(
         "--max-evaluations",

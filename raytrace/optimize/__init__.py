@@ -1,13 +1,15 @@
 """Lens design optimization: specs (:mod:`.spec`; the language in ``docs/spec.md``), operands
-(:mod:`.operands`), damped least squares (:mod:`.solver`), the glass-substitution pool
-(:mod:`.glasses`) and the global search (:mod:`.global_search`). Imports scipy; nothing else in
-the engine needs it."""
+(:mod:`.operands`), damped least squares (:mod:`.solver`), minimax by sequential linear
+programming (:mod:`.minimax`; run it as ``optimize(lens, spec, method="minimax")``), the
+glass-substitution pool (:mod:`.glasses`) and the global search (:mod:`.global_search`). Imports
+scipy; nothing else in the engine needs it."""
 
 from .glasses import GlassPool, availability, glass_pool
 from .global_search import GlassChoice, GlobalResult, SearchProgress, global_optimize
 from .operands import OperandValue, evaluate, merit
 from .solver import OptimizationResult, apply, check_spec, optimize
 from .spec import (
+    METHODS,
     DesignSpec,
     GlassSettings,
     Operand,
@@ -21,6 +23,7 @@ from .spec import (
 )
 
 __all__ = [
+    "METHODS",
     "DesignSpec",
     "GlassChoice",
     "GlassPool",

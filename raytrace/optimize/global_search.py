@@ -471,6 +471,11 @@ def global_optimize(
     )
     spec = replace(spec, search=s)
     check_spec(lens, spec, need_continuous=False)
+    if spec.method != "least_squares":
+        raise SpecError(
+            f"method {spec.method!r} runs as a local optimization only: the global search ranks "
+            'its starts by the least-squares merit (use method = "least_squares" with --global)'
+        )
     pools = _pools(spec)  # raises SpecError for an unknown glass / empty pool, before any work
     t0 = time.perf_counter()
     deadline = time.time() + s.time_budget_s if s.time_budget_s is not None else math.inf

@@ -22,10 +22,13 @@ docs/design.md, "Conventions"; the spec language is documented in ``docs/spec.md
                       of least RMS spot of that bundle).
 ``axial_color``       paraxial axial colour: the Gaussian image plane at ``wavelengths[0]`` minus
                       the one at ``wavelengths[1]`` (default F 486.1327 − C 656.2725 nm), mm.
-``center_thickness``  one-sided: thickness of ``surface`` ≥ ``min`` (and/or ≤ ``max``).
-``edge_thickness``    one-sided: axial gap at height ``height`` between ``surface`` and the
-                      next surface ≥ ``min`` (and/or ≤ ``max``).
+``center_thickness``  axial thickness after ``surface``.
+``edge_thickness``    axial gap at height ``height`` between ``surface`` and the next surface.
 ====================  ========================================================================
+
+Every operand has a ``target`` or is one-sided with ``min`` and/or ``max`` (in its unit;
+:attr:`Operand.bounded`): its residual is then the weighted violation of the bounds
+(:meth:`Operand.residual`).
 
 ``plane`` is ``"gaussian"`` (default), ``"file"`` (the lens file's image plane), or a table with
 one of ``s_prime`` (from H'), ``from_last_vertex`` (from the last vertex; ``from_vertex`` is
@@ -59,7 +62,7 @@ from ..paraxial import (
     paraxial,
     resolve_object_distance,
 )
-from .spec import BOUND_OPERANDS, Operand, SpecError
+from .spec import Operand, SpecError
 
 
 @dataclass(frozen=True)
@@ -291,13 +294,7 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
                 raise TraceError(f"{op.label()}: height {h} is beyond the surface's sphere")
         else:  # pragma: no cover - validated in read_spec / check_spec
             raise SpecError(f"unknown operand type {t!r}")
-        if t in BOUND_OPERANDS:
-            lo, hi = p.get("min", -math.inf), p.get("max", math.inf)
-            viol = (lo - v) if v < lo else ((v - hi) if v > hi else 0.0)
-            res = op.weight * viol
-        else:
-            res = op.weight * (v - op.target)
-        out.append(OperandValue(op, float(v), float(res)))
+        out.append(OperandValue(op, float(v), float(op.residual(float(v)))))
     return tuple(out)
 
 

@@ -1,7 +1,8 @@
 """Damped least squares on ``scipy.optimize.least_squares`` (trust-region reflective with the
 variable bounds): the spec's continuous variables applied to the start lens, the operands
 evaluated, the weighted residuals minimised. ``glass`` variables are held (the global search,
-:mod:`.global_search`, substitutes them)."""
+:mod:`.global_search`, substitutes them). :func:`optimize` runs the spec's ``method``: this one,
+or minimax (:mod:`.minimax`)."""
 
 from __future__ import annotations
 
@@ -21,9 +22,10 @@ from .operands import OperandValue, evaluate, merit
 from .spec import (
     ABBE_BOUNDS,
     ASPHERIC_KINDS,
-    BOUND_OPERANDS,
     INDEX_BOUNDS,
+    METHODS,
     PICKUP_KINDS,
+    THICKNESS_OPERANDS,
     VARIABLE_KINDS,
     DesignSpec,
     SpecError,
@@ -35,14 +37,18 @@ from .spec import (
 
 @dataclass(frozen=True, eq=False)
 class OptimizationResult:
-    """The outcome of one damped-least-squares run.
+    """The outcome of one local optimization run (damped least squares or minimax).
 
     lens: the optimized lens; x: the continuous variables' values (spec order, glass variables
-    left out); merit_start / merit: sum of squared weighted residuals before / after; operands:
-    every operand's value and residual; evaluations: merit evaluations used; converged: whether
-    the run met its stopping test (and the spec's merit goal); message: why it stopped;
-    seconds: wall time; stopped: ``""``, or why it was cut short from outside (``"time"``,
-    ``"interrupted"``) — the result is then the best design evaluated so far.
+    left out); merit_start / merit: before / after — for ``method == "least_squares"`` the sum
+    of squared weighted residuals (bound operands: their weighted violations), for
+    ``"minimax"`` the largest |weighted residual| of the target operands (the bound operands
+    are constraints, reported in ``violation``); operands: every operand's value and residual;
+    evaluations: merit evaluations used; converged: whether the run met its stopping test (and
+    the spec's merit goal; minimax: and its constraints); message: why it stopped; seconds:
+    wall time; stopped: ``""``, or why it was cut short from outside (``"time"``,
+    ``"interrupted"``) — the result is then the best design evaluated so far; method: the
+    method that ran; violation: the largest weighted violation of a bound operand (0: all met).
     """
 
     lens: Lens
@@ -55,6 +61,8 @@ class OptimizationResult:
     message: str
     seconds: float
     stopped: str = ""
+    method: str = "least_squares"
+    violation: float = 0.0
 
     @property
     def worst(self) -> OperandValue:
@@ -238,10 +246,14 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
         )
     if not spec.operands:
         probs.append("the spec has no operands")
+    if spec.method not in METHODS:
+        probs.append(f"unknown method {spec.method!r}{suggest(spec.method, METHODS)}")
+    if not (isinstance(spec.penalty, (int, float)) and spec.penalty > 0):
+        probs.append(f"penalty must be a positive number, got {spec.penalty!r}")
     for op in spec.operands:
         bad = operand_problems(op.type, op.params, op.target, op.weight)
         probs += [f"operand {op.type}: {b}" for b in bad]
-        if bad or op.type not in BOUND_OPERANDS:
+        if bad or op.type not in THICKNESS_OPERANDS:
             continue
         s = op.params["surface"]
         last = n - 1 if op.type == "edge_thickness" else n
@@ -256,7 +268,29 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
 
 
 # ----------------------------------------------------------------------------- solver
-def _scales(lens: Lens, spec: DesignSpec) -> np.ndarray:
+#: what an impossible trial lens raises in an evaluation (a ray misses a surface, ...)
+EVAL_FAILURES = (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError)
+
+
+def checked_evaluate(
+    lens: Lens,
+    spec: DesignSpec,
+    x: np.ndarray,
+    stop: Callable[[], str | None] | None,
+    count: list[int],
+) -> tuple[OperandValue, ...]:
+    """One merit evaluation of an optimizer: ask ``stop()`` first (raise :class:`Stopped` with
+    its reason), count it in ``count[0]``, evaluate the operands of ``spec`` applied to ``lens``
+    at ``x``. An impossible trial lens raises one of :data:`EVAL_FAILURES`."""
+    if stop is not None:
+        why = stop()
+        if why:
+            raise Stopped(why)
+    count[0] += 1
+    return evaluate(apply(lens, spec, x), spec.operands)
+
+
+def variable_scales(lens: Lens, spec: DesignSpec) -> np.ndarray:
     """The solver works on x / scale: aspheric coefficients are tiny numbers (mm^(1-k)), scaled
     so that a unit change is a sag change of the order of a tenth of the EFL at a tenth of the
     EFL; every other kind is left unscaled."""
@@ -278,10 +312,15 @@ def optimize(
     *,
     stop: Callable[[], str | None] | None = None,
     max_evaluations: int | None = None,
+    method: str | None = None,
 ) -> OptimizationResult:
     """Run damped least squares (``least_squares``, trust-region reflective with the variable
     bounds) over the spec's continuous variables; ``glass`` variables keep the start lens's
     glass. ``progress(evaluation, merit, worst_operand)`` is called after each evaluation.
+
+    ``method`` (default the spec's ``method``): ``"least_squares"``, or ``"minimax"`` to run
+    :func:`raytrace.optimize.minimax.minimax` with the same arguments (its merit is the largest
+    |weighted residual|; the bound operands are constraints).
 
     ``stop()`` is asked before each evaluation; when it returns a reason (a non-empty string)
     the run ends at once and returns the best design evaluated so far with ``stopped`` set.
@@ -290,11 +329,17 @@ def optimize(
     A run that stops on the evaluation limit, or ends above ``spec.merit_goal``, is returned with
     ``converged=False`` and a message saying why; the caller must not present it as a success.
     """
+    if method is not None:
+        spec = replace(spec, method=method)
     check_spec(lens, spec)
+    if spec.method == "minimax":
+        from .minimax import minimax
+
+        return minimax(lens, spec, progress, stop=stop, max_evaluations=max_evaluations)
     limit = spec.max_evaluations if max_evaluations is None else int(max_evaluations)
     lo, hi = bounds(spec)
     x0 = start_values(lens, spec)  # a start value outside its bounds starts on the nearest bound
-    sc = _scales(lens, spec)
+    sc = variable_scales(lens, spec)
     start_vals = evaluate(apply(lens, spec, x0), spec.operands)
     m0 = merit(start_vals)
     n_ev = [0]
@@ -303,14 +348,9 @@ def optimize(
     t0 = time.perf_counter()
 
     def fun(xs):
-        if stop is not None:
-            why = stop()
-            if why:
-                raise Stopped(why)
-        n_ev[0] += 1
         try:
-            vals = evaluate(apply(lens, spec, xs * sc), spec.operands)
-        except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
+            vals = checked_evaluate(lens, spec, xs * sc, stop, n_ev)
+        except EVAL_FAILURES:
             # an impossible lens in the middle of a step: a large, smooth-ish penalty
             return np.full(len(spec.operands), big)
         r = np.array([o.residual for o in vals])
@@ -362,4 +402,10 @@ def optimize(
         message=msg,
         seconds=time.perf_counter() - t0,
         stopped=stopped,
+        violation=max_violation(vals),
     )
+
+
+def max_violation(values: tuple[OperandValue, ...]) -> float:
+    """The largest weighted violation of a bound operand (0 when every bound is met)."""
+    return max((abs(o.residual) for o in values if o.operand.bounded), default=0.0)

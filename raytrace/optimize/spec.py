@@ -55,8 +55,8 @@ OPERAND_PARAMS: dict[str, tuple[str, ...]] = {
     "best_focus": ("field", "field_kind", "aperture", "wavelength", *_OBJECT),
     "rms_spot": ("field", "field_kind", "aperture", "plane", "wavelength", *_OBJECT),
     "axial_color": ("wavelengths", *_OBJECT),
-    "center_thickness": ("surface", "min", "max"),
-    "edge_thickness": ("surface", "height", "min", "max"),
+    "center_thickness": ("surface",),
+    "edge_thickness": ("surface", "height"),
 }
 OPERAND_TYPES = tuple(OPERAND_PARAMS)
 #: parameters an operand type cannot do without
@@ -69,8 +69,14 @@ OPERAND_REQUIRED: dict[str, tuple[str, ...]] = {
     "center_thickness": ("surface",),
     "edge_thickness": ("surface", "height"),
 }
-#: one-sided (bound) operands: their residual is the violation of ``min`` / ``max``
-BOUND_OPERANDS = ("center_thickness", "edge_thickness")
+#: every operand type may carry these instead of a target: it is then one-sided (a bound
+#: operand, :attr:`Operand.bounded`), its residual the violation of ``min`` / ``max``
+BOUND_KEYS = ("min", "max")
+#: operands on the thickness after a ``surface``: they need a ``target`` or ``min`` / ``max``
+THICKNESS_OPERANDS = ("center_thickness", "edge_thickness")
+#: optimization methods (:func:`raytrace.optimize.optimize`): damped least squares, or
+#: minimax by sequential linear programming (:mod:`raytrace.optimize.minimax`)
+METHODS = ("least_squares", "minimax")
 PLANE_KEYS = ("s_prime", "from_last_vertex", "from_vertex", "defocus")
 
 #: glass catalogs the substitution searches by default (``Misc``, crystals and plastics, only
@@ -182,12 +188,40 @@ class Pickup:
 
 @dataclass(frozen=True)
 class Operand:
-    """A target: ``type`` (see :mod:`.operands`), ``target``, ``weight`` and its parameters."""
+    """A target: ``type`` (see :mod:`.operands`), ``target``, ``weight`` and its parameters.
+
+    An operand whose ``params`` hold ``min`` and/or ``max`` (in the operand's unit) is a
+    *bound* operand (:attr:`bounded`): it has no target and contributes only when its value is
+    outside [min, max]. Damped least squares squares its weighted violation with the other
+    residuals; minimax (:mod:`.minimax`) makes it a constraint.
+    """
 
     type: str
     target: float = 0.0
     weight: float = 1.0
     params: dict = field(default_factory=dict)
+
+    @property
+    def bounded(self) -> bool:
+        """Whether the operand is one-sided (has ``min`` and/or ``max``), not a target."""
+        return any(k in self.params for k in BOUND_KEYS)
+
+    @property
+    def limits(self) -> tuple[float, float]:
+        """(min, max) of a bound operand (±inf where not given; (-inf, inf) for a target)."""
+        return (
+            float(self.params.get("min", -math.inf)),
+            float(self.params.get("max", math.inf)),
+        )
+
+    def residual(self, value: float) -> float:
+        """The weighted residual of ``value``: weight × (value − target), or for a bound
+        operand weight × its violation (distance outside [min, max], 0 inside)."""
+        if not self.bounded:
+            return self.weight * (value - self.target)
+        lo, hi = self.limits
+        viol = (lo - value) if value < lo else ((value - hi) if value > hi else 0.0)
+        return self.weight * viol
 
     def label(self) -> str:
         extra = ", ".join(f"{k}={v}" for k, v in self.params.items())
@@ -197,7 +231,13 @@ class Operand:
 @dataclass(frozen=True)
 class DesignSpec:
     """A reproducible design: start lens, variables, pick-ups, operands, solver settings, the
-    glass pool and the global-search settings."""
+    glass pool and the global-search settings.
+
+    ``method``: ``"least_squares"`` (damped least squares, the merit the sum of squared weighted
+    residuals) or ``"minimax"`` (the merit the largest |weighted residual| of the target
+    operands, the bound operands constraints; :mod:`.minimax`); ``penalty``: minimax's weight P
+    of the constraint violations in its exact penalty max|r| + P × Σ violation.
+    """
 
     start: str
     variables: tuple[Variable, ...]
@@ -210,6 +250,8 @@ class DesignSpec:
     path: str | None = None
     glass: GlassSettings = GlassSettings()
     search: SearchSettings = SearchSettings()
+    method: str = "least_squares"
+    penalty: float = 100.0
 
     def glass_settings(self, v: Variable) -> GlassSettings:
         """The pool settings of glass variable ``v`` (its own, else the spec's)."""
@@ -330,12 +372,16 @@ def _range(v) -> bool:
     )
 
 
-def operand_problems(type_: str, params: dict, target, weight) -> list[str]:
-    """Problems of one operand (unknown type or keys, wrong types); empty when it is valid."""
+def operand_problems(
+    type_: str, params: dict, target, weight, *, target_given: bool | None = None
+) -> list[str]:
+    """Problems of one operand (unknown type or keys, wrong types, a target mixed with bounds);
+    empty when it is valid. ``target_given``: whether the spec wrote a ``target`` (None: read
+    from the API, where a target other than 0 counts as given)."""
     out: list[str] = []
     if type_ not in OPERAND_PARAMS:
         return [f"unknown operand type {type_!r}{suggest(type_, OPERAND_TYPES)}"]
-    allowed = OPERAND_PARAMS[type_]
+    allowed = OPERAND_PARAMS[type_] + BOUND_KEYS
     for k in params:
         if k not in allowed:
             out.append(
@@ -356,11 +402,7 @@ def operand_problems(type_: str, params: dict, target, weight) -> list[str]:
         out.append(f'\'field_kind\' must be "angle" or "height", got {p["field_kind"]!r}')
     if "surface" in p and not _is_int(p["surface"]):
         out.append(f"'surface' must be an integer (1-based), got {p['surface']!r}")
-    for k in ("min", "max"):
-        if k in p and not _is_num(p[k]):
-            out.append(f"{k!r} must be a number (mm), got {p[k]!r}")
-    if type_ in BOUND_OPERANDS and "min" not in p and "max" not in p:
-        out.append(f"operand {type_} needs 'min' and/or 'max'")
+    out += _bound_problems(type_, p, target, target_given)
     if "height" in p and not (_is_num(p["height"]) and p["height"] >= 0):
         out.append(f"'height' must be a non-negative number (mm), got {p['height']!r}")
     if "aperture" in p and not (_is_num(p["aperture"]) and 0 < p["aperture"] <= 1):
@@ -392,6 +434,32 @@ def operand_problems(type_: str, params: dict, target, weight) -> list[str]:
         out.append(f"'object_scale' must be a positive number, got {p['object_scale']!r}")
     if "plane" in p:
         out += plane_problems(p["plane"], allow_best=type_ == "rms_spot")
+    return out
+
+
+def _bound_problems(type_: str, p: dict, target, target_given: bool | None) -> list[str]:
+    """Problems of an operand's ``min`` / ``max`` (numbers in the operand's unit, min ≤ max, no
+    target beside them; a thickness operand needs a target or a bound)."""
+    out: list[str] = []
+    given = [k for k in BOUND_KEYS if k in p]
+    for k in given:
+        v = p[k]
+        if not (_num_or_inf(v) and not math.isnan(_as_float(v))):
+            out.append(f'{k!r} must be a number (in the operand\'s unit) or "inf", got {v!r}')
+            return out
+    if _as_float(p.get("min", 0.0)) == math.inf or _as_float(p.get("max", 0.0)) == -math.inf:
+        out.append("'min' cannot be +inf nor 'max' -inf: leave the bound out instead")
+    elif "min" in p and "max" in p and _as_float(p["min"]) > _as_float(p["max"]):
+        out.append(f"'min' ({p['min']!r}) is above 'max' ({p['max']!r}): swap them")
+    if target_given is None:
+        target_given = _is_num(target) and target != 0
+    if given and target_given:
+        out.append(
+            "give a 'target' (two-sided) or 'min' / 'max' (one-sided bound), not both: "
+            "write the bound as its own operand"
+        )
+    if type_ in THICKNESS_OPERANDS and not given and target_given is False:
+        out.append(f"operand {type_} needs a 'target' or 'min' and/or 'max'")
     return out
 
 
@@ -485,6 +553,8 @@ TOP_KEYS = (
     "max_evaluations",
     "tolerance",
     "merit_goal",
+    "method",
+    "penalty",
     "glass",
     "global",
 )
@@ -557,8 +627,22 @@ def read_spec(path: str | Path) -> DesignSpec:
         if k in d and not isinstance(d[k], str):
             probs.add(f"{k!r} must be a string, got {d[k]!r}")
     top: dict = {}
-    kinds = {"max_evaluations": _POSITIVE_INT, "tolerance": _POSITIVE, "merit_goal": _NON_NEGATIVE}
+    kinds = {
+        "max_evaluations": _POSITIVE_INT,
+        "tolerance": _POSITIVE,
+        "merit_goal": _NON_NEGATIVE,
+        "penalty": _POSITIVE,
+    }
     _take(d, kinds, top, probs)
+    if "method" in d:
+        m = d["method"]
+        if isinstance(m, str) and m in METHODS:
+            top["method"] = m
+        else:
+            probs.add(
+                f"'method' must be one of {', '.join(map(repr, METHODS))}, got {m!r}"
+                + (suggest(m, METHODS) if isinstance(m, str) else "")
+            )
 
     glass = GlassSettings()
     if "glass" in d:
@@ -631,7 +715,7 @@ def read_spec(path: str | Path) -> DesignSpec:
         t = o["type"]
         params = {k: v for k, v in o.items() if k not in ("type", "target", "weight")}
         target, weight = o.get("target", 0.0), o.get("weight", 1.0)
-        bad = operand_problems(t, params, target, weight)
+        bad = operand_problems(t, params, target, weight, target_given="target" in o)
         for b in bad:
             probs.add(f"{at} ({t}): {b}")
         if not bad:
