@@ -193,10 +193,13 @@ def test_glass_substitution_recovers_the_vendor_achromat_pair():
 # --------------------------------------------------------------------------- seeds, workers
 def cooke_multimodal(starts: int = 3) -> DesignSpec:
     """Cooke triplet, six curvatures free, EFL 50 and RMS spot at 0, 14, 20 deg in the lens
-    file's (Gaussian) plane: several local minima (damped least squares from the file's lens
-    stops at merit 11.35; the global search finds ~9)."""
+    file's (Gaussian) plane: several local minima. At 20 deg the bundle is 0.8 of the pupil: the
+    file's lens has no semi-diameters, and its full f/4 beam there meets surface 6 beyond the
+    edge where it crosses surface 5 (32 of 240 rays travel backwards), which the real lens
+    vignettes."""
     ops = (Operand("efl", 50.0, 10.0),) + tuple(
-        Operand("rms_spot", 0.0, 100.0, {"field": f, "plane": "file"}) for f in (0.0, 14.0, 20.0)
+        Operand("rms_spot", 0.0, 100.0, {"field": f, "plane": "file", "aperture": a})
+        for f, a in ((0.0, 1.0), (14.0, 1.0), (20.0, 0.8))
     )
     return DesignSpec(
         start="cooke-triplet-f4",
@@ -215,10 +218,12 @@ def test_two_seeds_reach_merits_within_five_percent():
     local = optimize(lens, spec)
     a = global_optimize(lens, spec, seed=1)
     b = global_optimize(lens, spec, seed=2)
-    # our own runs (2026-11), for orientation: local 11.35; seeds 1..6 reach 8.86, 8.99, 9.25,
-    # 9.13, 9.09, 9.60 (3 starts, 1 hop each)
+    # our own runs (2026-11-27), for orientation: local 8.692; seeds 1..6 reach 8.033, 7.988,
+    # 7.990, 8.478, 7.985, 8.220 (3 starts, 1 hop each). (Before a spot bundle with failing rays
+    # became an error the 20 deg spot dropped them and the local run stuck at 11.35 in a valley
+    # of that artefact; the global search then won by 20 %, now by 3-8 %.)
     assert abs(a.merit - b.merit) <= 0.05 * min(a.merit, b.merit)
-    assert max(a.merit, b.merit) < 0.9 * local.merit  # the global search beats the local one
+    assert max(a.merit, b.merit) < 0.95 * local.merit  # the global search beats the local one
     assert not np.array_equal(a.start_merits, b.start_merits)  # the seeds do differ
 
 
@@ -287,8 +292,9 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
         + "]\noperands = [\n"
         '  { type = "efl", target = 50.0, weight = 10 },\n'
         + "".join(
-            f'  {{ type = "rms_spot", field = {f}, plane = "file", weight = 100 }},\n'
-            for f in (0, 14, 20)
+            f'  {{ type = "rms_spot", field = {f}, plane = "file", aperture = {a}, '
+            "weight = 100 },\n"
+            for f, a in ((0, 1.0), (14, 1.0), (20, 0.8))
         )
         + "]\n[global]\nstarts = 40\nhops = 3\nlocal_evaluations = 20\n"
     )

@@ -159,3 +159,32 @@ def test_rms_spot_wavelength_changes_the_spot():
     # radius r/sqrt 2 (the real rays and the F-line focal length change it by about 1 %)
     r = 0.5 * paraxial(lens).epd * abs(zF - zd) / fd
     assert f_at_d == pytest.approx(r / math.sqrt(2), rel=0.03)
+
+
+def test_a_spot_bundle_with_failing_rays_is_an_error_not_a_smaller_spot():
+    # a back surface of radius 20 mm behind a 50 mm pupil: the outer rays meet it too steeply
+    # (total internal reflection) or miss its sphere. The spot of the rays that pass would be
+    # smaller than the lens's, and an optimizer would learn to make rays fail. The inner 40 % of
+    # the bundle all pass.
+    from dataclasses import replace
+
+    from support import singlet
+
+    from raytrace.errors import TraceError
+
+    lens = singlet(n=1.5, f=100.0, t=25.0, fnum=2.0)
+    back = replace(lens.surfaces[1], curvature=-0.05)
+    lens = replace(lens, surfaces=(lens.surfaces[0], back), aperture=Aperture("epd", 50.0))
+    for t in ("rms_spot", "best_focus"):
+        with pytest.raises(TraceError, match=r"of 240 rays of the bundle fail .* surface 2\)"):
+            evaluate(lens, (Operand(t, params={"aperture": 1.0}),))
+        (v,) = evaluate(lens, (Operand(t, params={"aperture": 0.4}),))
+        assert math.isfinite(v.value)
+        # said explicitly, the failed rays are left out as vignetted
+        (v,) = evaluate(lens, (Operand(t, params={"aperture": 1.0, "drop_failed": True}),))
+        assert math.isfinite(v.value)
+    from raytrace.optimize.spec import operand_problems
+
+    assert operand_problems("rms_spot", {"drop_failed": "yes"}, 0.0, 1.0) == [
+        "'drop_failed' must be true or false, got 'yes'"
+    ]

@@ -19,7 +19,9 @@ docs/design.md, "Conventions"; the spec language is documented in ``docs/spec.md
 ``best_focus``        the plane of least RMS spot for a ``field`` bundle (default on axis) at
                       ``aperture`` (fraction of the pupil radius), given as s' from H'.
 ``rms_spot``          RMS spot radius at ``field`` in ``plane`` (``plane = "best"``: at the plane
-                      of least RMS spot of that bundle).
+                      of least RMS spot of that bundle). Every ray of a ``best_focus`` or
+                      ``rms_spot`` bundle must pass: a failing ray is an evaluation error,
+                      unless the operand says ``drop_failed = true`` (left out, as vignetted).
 ``axial_color``       paraxial axial colour: the Gaussian image plane at ``wavelengths[0]`` minus
                       the one at ``wavelengths[1]`` (default F 486.1327 − C 656.2725 nm), mm.
 ``center_thickness``  axial thickness after ``surface``.
@@ -51,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import TraceError
+from ..kernels.codes import status_message
 from ..lens import Lens
 from ..packing import pack
 from ..paraxial import (
@@ -153,11 +156,26 @@ def _bundle(
     return x0 + s * L, y0 + s * M, np.full_like(px, z_start), L, M, N
 
 
-def _spot_stats(batch):
-    """Linear model of x, y versus z for the OK rays: (a_x, b_x, a_y, b_y), x = a + b z."""
+def _spot_stats(batch, label: str, drop_failed: bool = False):
+    """Linear model of x, y versus z of a bundle's rays: (a_x, b_x, a_y, b_y), x = a + b z.
+
+    Every ray must pass (the bundle is traced without clipping): a ray that misses a surface,
+    is totally reflected or travels backwards raises :class:`TraceError` naming the first such
+    ray's fate. A spot of the rays that pass would hide them, and an optimizer would learn to
+    lower an RMS by making rays fail. ``drop_failed`` (the operand's ``drop_failed = true``)
+    leaves failed rays out instead, as vignetted (at least 3 rays must pass).
+    """
     ok = batch.status == 0
-    if ok.sum() < 3:
-        raise TraceError("too few rays pass the lens to evaluate a spot")
+    if drop_failed:
+        if ok.sum() < 3:
+            raise TraceError(f"{label}: too few rays pass the lens to evaluate a spot")
+    elif not ok.all():
+        j = int(np.flatnonzero(~ok)[0])
+        raise TraceError(
+            f"{label}: {int((~ok).sum())} of {ok.size} rays of the bundle fail (first: "
+            f"{status_message(int(batch.status[j]), int(batch.surface[j]))}); reduce "
+            "'aperture' or change the lens"
+        )
     bx = batch.L[ok] / batch.N[ok]
     by = batch.M[ok] / batch.N[ok]
     ax = batch.x[ok] - bx * batch.z[ok]
@@ -275,7 +293,7 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
             if wl not in packs:  # once per evaluation and wavelength, for every spot operand
                 packs[wl] = pack(lens, wl)
             batch = trace_rays(packs[wl], rays[:3], rays[3:], clip=False)
-            stats = _spot_stats(batch)
+            stats = _spot_stats(batch, op.label(), bool(p.get("drop_failed", False)))
             if t == "best_focus":
                 v = _best_focus_z(stats) - par.z_Hp
             else:

@@ -52,8 +52,8 @@ OPERAND_PARAMS: dict[str, tuple[str, ...]] = {
     "image_height": (*_CHIEF, "plane"),
     "distortion_slope": _CHIEF,
     "landing_angle": _CHIEF,
-    "best_focus": ("field", "field_kind", "aperture", "wavelength", *_OBJECT),
-    "rms_spot": ("field", "field_kind", "aperture", "plane", "wavelength", *_OBJECT),
+    "best_focus": ("field", "field_kind", "aperture", "wavelength", "drop_failed", *_OBJECT),
+    "rms_spot": ("field", "field_kind", "aperture", "plane", "wavelength", "drop_failed", *_OBJECT),
     "axial_color": ("wavelengths", *_OBJECT),
     "center_thickness": ("surface",),
     "edge_thickness": ("surface", "height"),
@@ -405,6 +405,8 @@ def operand_problems(
     out += _bound_problems(type_, p, target, target_given)
     if "height" in p and not (_is_num(p["height"]) and p["height"] >= 0):
         out.append(f"'height' must be a non-negative number (mm), got {p['height']!r}")
+    if "drop_failed" in p and not isinstance(p["drop_failed"], bool):
+        out.append(f"'drop_failed' must be true or false, got {p['drop_failed']!r}")
     if "aperture" in p and not (_is_num(p["aperture"]) and 0 < p["aperture"] <= 1):
         out.append(
             f"'aperture' must be a fraction of the pupil radius in (0, 1], got {p['aperture']!r}"
