@@ -568,6 +568,16 @@ class Lens:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return n
 
+    def catalog_span(self) -> tuple[float, float]:
+        """The wavelengths (nm) inside the data range of every catalog glass of the lens (object
+        space included): (lo, hi); (0, inf) when it has no catalog glass. Indices outside it are
+        extrapolations of a vendor formula (:meth:`indices` warns)."""
+        lo, hi = 0.0, math.inf
+        for m in (self.object_material, *(s.material for s in self.surfaces)):
+            if m.kind == "catalog":
+                lo, hi = max(lo, m.wavelength_range_nm[0]), min(hi, m.wavelength_range_nm[1])
+        return lo, hi
+
     def indices(self, wavelengths=None) -> np.ndarray:
         """Refractive indices at ``wavelengths`` (nm; a number or a sequence; default the
         reference wavelength): array (n_wavelengths, n_surfaces + 1) — column 0 the object space,
@@ -580,7 +590,7 @@ class Lens:
             key = (float(wavelengths),)
         else:
             key = tuple(float(w) for w in np.atleast_1d(np.asarray(wavelengths, dtype=float)))
-        lo, hi = _catalog_span(self)
+        lo, hi = self.catalog_span()
         if all(lo <= w <= hi for w in key):
             return _indices(self, key)
         return _indices.__wrapped__(self, key)  # out of a glass's range: warn every time
@@ -650,15 +660,6 @@ def _scaled_placement(p, factor: float):
 
 
 @functools.lru_cache(maxsize=512)
-def _catalog_span(lens: Lens) -> tuple[float, float]:
-    """The wavelength span (nm) inside every catalog glass's data range (cached per lens)."""
-    lo, hi = 0.0, math.inf
-    for m in (lens.object_material, *(s.material for s in lens.surfaces)):
-        if m.kind == "catalog":
-            lo, hi = max(lo, m.wavelength_range_nm[0]), min(hi, m.wavelength_range_nm[1])
-    return lo, hi
-
-
 @functools.lru_cache(maxsize=512)
 def _indices(lens: Lens, wavelengths: tuple[float, ...]) -> np.ndarray:
     """:meth:`Lens.indices` for a tuple of wavelengths (nm), cached per lens (read-only)."""

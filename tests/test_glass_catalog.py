@@ -272,3 +272,21 @@ def test_first_lookup_is_fast():
     t = time.perf_counter()
     lookup_glass("S-LAH79")
     assert time.perf_counter() - t < 0.1
+
+
+def test_lens_catalog_span_is_where_every_glass_has_data():
+    # the Twinplex-like: Hoya E-FDS3 / FCD100, Schott LASF35 / N-LAK34. Its span is the
+    # intersection of the glasses' data ranges: indices inside are silent, just outside warn.
+    from raytrace.files.library import load_lens
+
+    lens = load_lens("twinplex-like-55-525")
+    glasses = [s.material for s in lens.surfaces if s.material.kind == "catalog"]
+    lo, hi = lens.catalog_span()
+    assert lo == max(m.wavelength_range_nm[0] for m in glasses)
+    assert hi == min(m.wavelength_range_nm[1] for m in glasses)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lens.indices([lo, hi])
+    with pytest.warns(OutOfRangeWarning, match="outside its data range"):
+        lens.indices(lo - 1.0)
+    assert load_lens("topogon-like-pestrecov").catalog_span() == (0.0, math.inf)  # model glasses

@@ -331,11 +331,11 @@ def optimize(
     """
     if method is not None:
         spec = replace(spec, method=method)
-    check_spec(lens, spec)
-    if spec.method == "minimax":
+    if spec.method == "minimax":  # it checks the spec itself
         from .minimax import minimax
 
         return minimax(lens, spec, progress, stop=stop, max_evaluations=max_evaluations)
+    check_spec(lens, spec)
     limit = spec.max_evaluations if max_evaluations is None else int(max_evaluations)
     lo, hi = bounds(spec)
     x0 = start_values(lens, spec)  # a start value outside its bounds starts on the nearest bound
