@@ -59,10 +59,12 @@ from __future__ import annotations
 import difflib
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from raytrace.trace.results import object_words
+from raytrace.units import UnitError, image_scale, length_mm, wavelength_nm
 
 from ..errors import DataError
 from .sensor import Sensor
@@ -253,32 +255,41 @@ def _object_value(value, what: str):
     t = value.strip().lower()
     if t in ("inf", "infinity") or t.endswith(("x", "×")):
         return t
-    from raytrace.units import UnitError, length_mm
-
-    try:
-        return length_mm(t, what, allow_inf=True)
-    except UnitError as e:
-        raise DataError(str(e)) from None
+    return _in_units(length_mm, t, what, allow_inf=True)
 
 
-def _length(value, what: str) -> float | None:
+def _in_units(
+    convert: Callable[..., float], value: float | str | None, what: str, **options: bool
+) -> float | None:
+    """A setup value through one of :mod:`raytrace.units`' parsers, its refusal a DataError.
+
+    Parameters
+    ----------
+    convert : callable
+        :func:`~raytrace.units.length_mm` (→ mm), :func:`~raytrace.units.image_scale` (→ N,
+        dimensionless) or :func:`~raytrace.units.wavelength_nm` (→ nm).
+    value : float, str or None
+        The value as given: a number in the parser's default unit, or a string with a unit
+        (``"2m"``, ``"12x"``, ``"0.5876um"``). None: not given.
+    what : str
+        The keyword's name, for the message.
+    **options : bool
+        Passed on to ``convert`` (``allow_inf=True`` for a distance that may be infinite).
+
+    Returns
+    -------
+    float or None
+        The value in the parser's unit (mm, N or nm); None when ``value`` is None.
+
+    Raises
+    ------
+    DataError
+        The parser's UnitError, with its message.
+    """
     if value is None:
         return None
-    from raytrace.units import UnitError, length_mm
-
     try:
-        return length_mm(value, what)
-    except UnitError as e:
-        raise DataError(str(e)) from None
-
-
-def _scale(value, what: str) -> float | None:
-    if value is None:
-        return None
-    from raytrace.units import UnitError, image_scale
-
-    try:
-        return image_scale(value, what)
+        return convert(value, what, **options)
     except UnitError as e:
         raise DataError(str(e)) from None
 
@@ -291,8 +302,8 @@ def _resolve_object(lens, distance, s, scale, wavelength, prefix: str) -> float:
         return resolve_object_distance(
             lens,
             object_distance=_object_value(distance, prefix),
-            object_s=_length(s, f"{prefix}_s"),
-            object_scale=_scale(scale, f"{prefix}_scale"),
+            object_s=_in_units(length_mm, s, f"{prefix}_s"),
+            object_scale=_in_units(image_scale, scale, f"{prefix}_scale"),
             wavelength=wavelength,
         )
     except TraceError as e:
@@ -317,15 +328,15 @@ def resolve_setup(lens, setup: CameraSetup) -> CameraGeometry:
     Raises DataError for a focus or object the lens cannot image. A decentered or tilted lens
     takes these first-order quantities from its centred design (:func:`nominal_lens`)."""
     from raytrace.paraxial import paraxial, pestrecov_constants
-    from raytrace.units import UnitError, wavelength_nm
 
     lens = nominal_lens(lens)
 
     wl_ref = float(lens.wavelength)
-    try:
-        wl = wl_ref if setup.wavelength is None else wavelength_nm(setup.wavelength)
-    except UnitError as e:
-        raise DataError(str(e)) from None
+    wl = (
+        wl_ref
+        if setup.wavelength is None
+        else _in_units(wavelength_nm, setup.wavelength, "wavelength")
+    )
     od = _resolve_object(
         lens, setup.object_distance, setup.object_s, setup.object_scale, wl_ref, "object_distance"
     )
@@ -339,7 +350,7 @@ def resolve_setup(lens, setup: CameraSetup) -> CameraGeometry:
         what = f"focused at {setup.describe_focus()}"
     elif any(getattr(setup, k) is not None for k in _PLANE_KEYS):
         kind = next(k for k in _PLANE_KEYS if getattr(setup, k) is not None)
-        v = _length(getattr(setup, kind), kind)
+        v = _in_units(length_mm, getattr(setup, kind), kind)
         z = {
             "s_prime": par_ref.z_from_s_prime,
             "from_last_vertex": par_ref.z_from_last_vertex,

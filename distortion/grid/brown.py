@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError
+from .decompose import point_pairs
 
 #: |b|·r_max (mm) above which b1 / b2 are reported as a warning
 AFFINITY_WARNING_MM = 1e-6
@@ -144,11 +145,7 @@ def fit_brown_conrady_points(
     """
     from ..camera import CameraModel, convert_camera_model, fit_camera_model
 
-    t = np.asarray(t, dtype=float)
-    img = np.asarray(image_mm, dtype=float)
-    if t.shape != img.shape or t.ndim != 2 or t.shape[1] != 2:
-        raise DataError("t and image_mm must be (N, 2) arrays of the same shape")
-    good = np.all(np.isfinite(t), axis=1) & np.all(np.isfinite(img), axis=1)
+    t, img, good = point_pairs(t, image_mm, "image_mm")
     t, img = t[good], img[good]
     n_free = 10 if affinity else 8
     if t.shape[0] * 2 <= n_free:

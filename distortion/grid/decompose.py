@@ -67,12 +67,47 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from ..errors import DataError
 
 #: the principal-point choices: fitted, or held at a named reference point
 PRINCIPAL_POINTS = ("fit", "axial", "ppa", "ppbs")
 CAMERA_CONSTANTS = ("fit", "characteristic")
+
+
+def point_pairs(
+    t: npt.ArrayLike, image: npt.ArrayLike, image_name: str = "image"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Correspondences checked for a fit: ideal points ``t`` and image points of the same shape.
+
+    Parameters
+    ----------
+    t : array_like
+        (N, 2) normalised ideal coordinates (tx, ty): direction tangents (dimensionless).
+    image : array_like
+        (N, 2) image points (mm).
+    image_name : str
+        What ``image`` is called in the message (the caller's keyword).
+
+    Returns
+    -------
+    t, image : ndarray
+        Both as (N, 2) float arrays, every row kept (dimensionless; mm).
+    good : ndarray of bool
+        (N,) the rows where both points are finite: the ones a fit uses.
+
+    Raises
+    ------
+    DataError
+        ``t`` and ``image`` are not (N, 2) arrays of the same shape.
+    """
+    t = np.asarray(t, dtype=float)
+    img = np.asarray(image, dtype=float)
+    if t.shape != img.shape or t.ndim != 2 or t.shape[1] != 2:
+        raise DataError(f"t and {image_name} must be (N, 2) arrays of the same shape")
+    good = np.all(np.isfinite(t), axis=1) & np.all(np.isfinite(img), axis=1)
+    return t, img, good
 
 
 def basis_columns(tx: np.ndarray, ty: np.ndarray, radial_terms: int, asymmetric: bool) -> list:
@@ -133,13 +168,9 @@ def solve_linear(
     coordinates) and ``image`` (N, 2) (mm). ``principal_point`` / ``camera_constant`` given:
     held at those values; None: fitted. ``asymmetric=False``: radial terms only (no P, S).
     Non-finite points are left out."""
-    t = np.asarray(t, dtype=float)
-    img = np.asarray(image, dtype=float)
-    if t.shape != img.shape or t.ndim != 2 or t.shape[1] != 2:
-        raise DataError("t and image must be (N, 2) arrays of the same shape")
+    t, img, good = point_pairs(t, image)
     if radial_terms < 0:
         raise DataError("radial_terms must be 0 or more")
-    good = np.all(np.isfinite(t), axis=1) & np.all(np.isfinite(img), axis=1)
     tx, ty = t[good, 0], t[good, 1]
     bx, by = img[good, 0].copy(), img[good, 1].copy()
     cols = basis_columns(tx, ty, radial_terms, asymmetric)

@@ -291,6 +291,7 @@ def distortion_grid(
     DistortionGrid
     """
     from raytrace.paraxial import resolve_paraxial
+    from raytrace.trace.chief2d import requested_fields_2d
 
     if reference_point not in REFERENCE_POINTS:
         raise TraceError(
@@ -299,19 +300,13 @@ def distortion_grid(
     # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
     # centred lens (raytrace.paraxial refuses a lens that is not centred)
     par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength, nominal=True)
-    angles = fields_x_deg is not None or fields_y_deg is not None
-    heights = object_x_mm is not None or object_y_mm is not None
-    if angles and heights:
-        raise TraceError("give field angles or object coordinates, not both")
-    if (angles or heights) and sensor is not None:
+    given = requested_fields_2d(fields_x_deg, fields_y_deg, object_x_mm, object_y_mm)
+    if given is not None and sensor is not None:
         raise TraceError("give fields or a sensor, not both")
     nx, ny = _grid_size(grid)
-    if angles or heights:
-        a, b = (fields_x_deg, fields_y_deg) if angles else (object_x_mm, object_y_mm)
-        ax = np.atleast_1d(np.asarray(0.0 if a is None else a, dtype=float)).ravel()
-        ay = np.atleast_1d(np.asarray(0.0 if b is None else b, dtype=float)).ravel()
-        kind = "angle" if angles else "height"
-        FX, FY = np.meshgrid(ax, ay)
+    if given is not None:
+        kind, ax, ay = given
+        FX, FY = np.meshgrid(np.atleast_1d(ax).ravel(), np.atleast_1d(ay).ravel())
     else:
         FX, FY, kind = _default_fields(lens, par, nx, ny, sensor)
     return grid_from_fields(

@@ -27,6 +27,7 @@ from .common import (
     add_output_args,
     add_strict_arg,
     add_wavelength_arg,
+    check_output_path,
     check_plot_path,
     length,
     load,
@@ -60,14 +61,6 @@ PATTERNS = ("grid", "checkerboard")
 
 
 # ---------------------------------------------------------------------------------- helpers
-def _check_out(path, args, flag: str) -> None:
-    if path is None:
-        return
-    from raytrace.files.output import check_output
-
-    check_output(path, inputs=args._inputs, overwrite=args.force, flag="--force")
-
-
 def _write(path, data, args) -> None:
     from raytrace.files.output import write_atomic
 
@@ -237,8 +230,8 @@ def _cmd_lens(args, lens_name: str) -> int:
     lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
-    for flag, path in (("-o", args.output), ("--picture", args.picture), ("--maps", args.maps)):
-        _check_out(path, args, flag)
+    for path in (args.output, args.picture, args.maps):
+        check_output_path(path, args)
     if args.picture and not str(args.picture).lower().endswith(".png"):
         raise CliError(f"--picture {args.picture}: the picture is a .png image")
     if args.maps and not str(args.maps).lower().endswith(".npz"):
@@ -310,7 +303,7 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
     lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
-    _check_out(args.output, args, "-o")
+    check_output_path(args.output, args)
     cal = read_calibration(cal_path)
     sensor = _sensor(args, cal)
     setup = _setup(args, sensor)
@@ -342,7 +335,7 @@ def _cmd_convert(args, cal_path: str) -> int:
     from ..report.camera import conversion_to_dict, format_conversion
 
     args._inputs = [p for p in (cal_path, args.camera) if p]
-    _check_out(args.output, args, "-o")
+    check_output_path(args.output, args)
     cal = read_calibration(cal_path)
     target = {"fisheye": "opencv_fisheye", "colmap": "colmap:FULL_OPENCV",
               "colmap-fisheye": "colmap:OPENCV_FISHEYE"}.get(args.model, args.model)  # fmt: skip
@@ -372,7 +365,7 @@ def _cmd_variation(args, cal1: str, cal2: str) -> int:
     from distortion.camera import calibrated_models_by_distance, read_calibration
 
     args._inputs = [cal1, cal2]
-    _check_out(args.output, args, "-o")
+    check_output_path(args.output, args)
     if args.calibrated_at is None or args.focal_length is None or args.focus is None:
         raise CliError("variation needs --calibrated-at S1,S2, --focal-length F and --focus S")
     at = [s.strip() for s in str(args.calibrated_at).split(",") if s.strip()]

@@ -13,13 +13,11 @@ from .common import (
     add_object_args,
     add_output_args,
     add_plane_args,
-    check_finite_object,
     check_plot_path,
     field_keyword,
     load_input,
     print_result,
-    resolve_fields,
-    resolve_object,
+    resolve_object_fields,
     resolve_planes,
     save_plot,
 )
@@ -86,9 +84,7 @@ def cmd_colour(args) -> int:
     lens = load_input(args)
     if args.plot:
         check_plot_path(args.plot, "--plot", args)
-    od = resolve_object(lens, args)
-    fields, kind = resolve_fields(lens, args)
-    check_finite_object(kind, od)
+    od, fields, kind = resolve_object_fields(lens, args)
     planes = resolve_planes(lens, args)
     wls = args.wavelengths
     if wls is None:

@@ -366,6 +366,16 @@ def check_finite_object(kind: str, object_distance: float) -> None:
         raise CliError("object-height fields need a finite object (--object-distance)")
 
 
+def resolve_object_fields(lens, args) -> tuple[float, np.ndarray, str]:
+    """(object distance, fields, field kind) of the object and field flags
+    (:func:`resolve_object`, :func:`resolve_fields`); object-height fields with the object at
+    infinity are refused (:func:`check_finite_object`)."""
+    od = resolve_object(lens, args)
+    fields, kind = resolve_fields(lens, args)
+    check_finite_object(kind, od)
+    return od, fields, kind
+
+
 def refuse_flags(message: str, flags) -> None:
     """CliError ``message`` (``{}`` = the flag names) when a flag of the ``(flag, value)`` pairs
     ``flags`` is given (its value true): flags that do not apply to this run."""
@@ -419,13 +429,22 @@ def add_table_layout_arg(p) -> None:
     )
 
 
-def check_plot_path(path: str | None, flag: str, args) -> None:
-    """Refuse a plot file name before any work: suffix, folder, no overwrite without --force."""
+def check_output_path(path, args) -> None:
+    """Refuse an output file before any work: one of the command's inputs (``args._inputs``),
+    a missing folder, an existing file without --force (``args.force``). None: nothing to
+    check."""
     if path is None:
         return
     from raytrace.files.output import check_output
 
     check_output(path, inputs=getattr(args, "_inputs", ()), overwrite=args.force, flag="--force")
+
+
+def check_plot_path(path: str | None, flag: str, args) -> None:
+    """Refuse a plot file name before any work: suffix, folder, no overwrite without --force."""
+    if path is None:
+        return
+    check_output_path(path, args)
     check_plot_suffix(path, flag)
 
 

@@ -16,13 +16,11 @@ from .common import (
     add_strict_arg,
     add_table_layout_arg,
     add_wavelength_arg,
-    check_finite_object,
     check_plot_path,
     field_keyword,
     load_input,
     print_result,
-    resolve_fields,
-    resolve_object,
+    resolve_object_fields,
     save_plot,
     strict_check,
 )
@@ -46,9 +44,7 @@ def cmd_pupils(args) -> int:
 
     lens = load_input(args)
     check_plot_path(args.plot, "--plot", args)
-    od = resolve_object(lens, args)
-    fields, kind = resolve_fields(lens, args)
-    check_finite_object(kind, od)
+    od, fields, kind = resolve_object_fields(lens, args)
     pa = pupil_analysis(
         lens, **field_keyword(fields, kind), object_distance=od, wavelength=args.wavelength
     )

@@ -13,6 +13,7 @@ from .common import (
     CliError,
     add_force_arg,
     add_output_args,
+    check_output_path,
     check_plot_suffix,
     load_scaled,
     print_result,
@@ -169,13 +170,11 @@ def _analysis_options(args) -> dict:
 def _check_outputs(args) -> None:
     """Refuse bad output files before any work (same file as an input, existing without
     --force, unknown plot suffix)."""
-    from raytrace.files.output import check_output
-
     if not hasattr(args, "_inputs"):
         args._inputs = [args.profiles] if args.profiles else []
     for path in (args.plot, args.plot_g, getattr(args, "profiles_csv", None)):
         if path:
-            check_output(path, inputs=args._inputs, overwrite=args.force, flag="--force")
+            check_output_path(path, args)
     for flag, path in (("--plot", args.plot), ("--plot-g", args.plot_g)):
         if path:
             check_plot_suffix(path, flag)

@@ -214,17 +214,10 @@ def chief_rays_2d(
         object_scale=object_scale,
         wavelength=wl,
     )
-    angles = fields_x_deg is not None or fields_y_deg is not None
-    heights = object_x_mm is not None or object_y_mm is not None
-    if angles and heights:
-        raise TraceError("give field angles (fields_x_deg, fields_y_deg) or object coordinates "
-                         "(object_x_mm, object_y_mm), not both")  # fmt: skip
-    if not (angles or heights):
+    given = requested_fields_2d(fields_x_deg, fields_y_deg, object_x_mm, object_y_mm)
+    if given is None:
         raise TraceError("give fields_x_deg / fields_y_deg (degrees) or object_x_mm / object_y_mm")
-    kind = "angle" if angles else "height"
-    a, b = (fields_x_deg, fields_y_deg) if angles else (object_x_mm, object_y_mm)
-    fx = np.asarray(0.0 if a is None else a, dtype=np.float64)
-    fy = np.asarray(0.0 if b is None else b, dtype=np.float64)
+    kind, fx, fy = given
     try:
         fx, fy = np.broadcast_arrays(fx, fy)
     except ValueError:
@@ -232,6 +225,45 @@ def chief_rays_2d(
             f"the x and y fields have shapes {fx.shape} and {fy.shape} that do not broadcast"
         ) from None
     return aim_2d(lens, fx, fy, kind, od, wl, clip)
+
+
+def requested_fields_2d(
+    fields_x_deg: npt.ArrayLike | None,
+    fields_y_deg: npt.ArrayLike | None,
+    object_x_mm: npt.ArrayLike | None,
+    object_y_mm: npt.ArrayLike | None,
+) -> tuple[str, np.ndarray, np.ndarray] | None:
+    """The 2-D fields a caller gave, as ``(kind, x, y)``: angles or object coordinates.
+
+    Parameters
+    ----------
+    fields_x_deg, fields_y_deg : array_like or None
+        Field angles αx, αy in degrees (module docstring): kind ``"angle"``.
+    object_x_mm, object_y_mm : array_like or None
+        Object coordinates in mm: kind ``"height"``. Give angles or coordinates, not both.
+
+    Returns
+    -------
+    (kind, x, y) or None
+        ``kind`` ``"angle"`` or ``"height"``; ``x``, ``y`` float arrays as given (degrees or
+        mm; a missing one of the pair is 0.0, not yet broadcast). None when nothing is given.
+
+    Raises
+    ------
+    TraceError
+        Both angles and object coordinates given.
+    """
+    angles = fields_x_deg is not None or fields_y_deg is not None
+    heights = object_x_mm is not None or object_y_mm is not None
+    if angles and heights:
+        raise TraceError("give field angles (fields_x_deg, fields_y_deg) or object coordinates "
+                         "(object_x_mm, object_y_mm), not both")  # fmt: skip
+    if not (angles or heights):
+        return None
+    a, b = (fields_x_deg, fields_y_deg) if angles else (object_x_mm, object_y_mm)
+    x = np.asarray(0.0 if a is None else a, dtype=np.float64)
+    y = np.asarray(0.0 if b is None else b, dtype=np.float64)
+    return ("angle" if angles else "height"), x, y
 
 
 def aim_2d(
