@@ -22,6 +22,11 @@ docs/design.md, "Conventions"; the spec language is documented in ``docs/spec.md
                       of least RMS spot of that bundle). Every ray of a ``best_focus`` or
                       ``rms_spot`` bundle must pass: a failing ray is an evaluation error,
                       unless the operand says ``drop_failed = true`` (left out, as vignetted).
+``ray_height``        distance from the axis (mm, ≥ 0) at which one real ray meets ``surface``: the
+                      ray from ``field`` through ``pupil = [px, py]`` (fractions of the paraxial
+                      entrance-pupil radius, centred on the axis; default [0, 1], the upper rim
+                      of the meridional section), the rays of the spot operands' bundles; as a
+                      ``max`` bound it keeps a footprint inside a clear aperture.
 ``axial_color``       paraxial axial colour: the Gaussian image plane at ``wavelengths[0]`` minus
                       the one at ``wavelengths[1]`` (default F 486.1327 − C 656.2725 nm), mm.
 ``center_thickness``  axial thickness after ``surface``.
@@ -111,8 +116,42 @@ def _object_distance(lens: Lens, op: Operand) -> float:
         raise SpecError(f"operand {op.label()}: {e}") from None
 
 
+def _pupil_rays(
+    par: ParaxialResult, field_value: float, kind: str, px: np.ndarray, py: np.ndarray
+) -> tuple[np.ndarray, ...]:
+    """Rays from one field through points of the paraxial entrance pupil: start arrays for
+    trace_rays / ray_paths, ``(x, y, z, L, M, N)``.
+
+    ``px``, ``py`` are pupil coordinates in units of the paraxial entrance-pupil radius
+    ``par.epd / 2``, centred on the axis (the pupil plane z_E0); +y is the side of the field's
+    image for a positive field. An object at infinity sends parallel rays at the field angle; a
+    finite object sends them from the object point (``kind`` "angle": nominal angle, height
+    p0 tan α; "height": object height in mm). Every ray starts on one plane before the first
+    vertex.
+    """
+    a = par.epd / 2.0
+    px, py = a * np.asarray(px, float), a * np.asarray(py, float)
+    zE = par.z_E0
+    if par.infinite:
+        t = math.tan(math.radians(field_value))
+        L = np.zeros_like(px)
+        M = np.full_like(px, t / math.sqrt(1 + t * t))
+        N = np.full_like(px, 1.0 / math.sqrt(1 + t * t))
+    else:
+        if kind == "angle":
+            yobj = par.p0 * math.tan(math.radians(field_value))
+        else:
+            yobj = field_value
+        dx, dy, dz = px, py - yobj, zE - par.z_object
+        nrm = np.sqrt(dx * dx + dy * dy + dz * dz)
+        L, M, N = dx / nrm, dy / nrm, dz / nrm
+    # start left of every surface: back along each ray to a plane before the first vertex
+    z_start = -(abs(zE) + 2.0 * a + float(np.max(np.abs(py))) + 1.0)
+    s = (z_start - zE) / N
+    return px + s * L, py + s * M, np.full_like(px, z_start), L, M, N
+
+
 def _bundle(
-    lens: Lens,
     par: ParaxialResult,
     field_value: float,
     kind: str,
@@ -120,7 +159,7 @@ def _bundle(
     n_ring: int = 10,
     per_ring: int = 24,
 ):
-    """A pupil grid of rays for one field: start arrays for trace_rays.
+    """A pupil grid of rays for one field (:func:`_pupil_rays`): start arrays for trace_rays.
 
     Equal-area rings (the midpoint rule in ρ²): ring k = 1..n_ring at ρ = aperture·√((k − ½)/n),
     ``per_ring`` rays each (alternate rings rotated by half a step), so every ray stands for the
@@ -132,28 +171,7 @@ def _bundle(
     rho = np.repeat(aperture * np.sqrt((k - 0.5) / n_ring), per_ring)
     step = 2 * np.pi / per_ring
     theta = np.tile(np.arange(per_ring) * step, n_ring) + np.repeat((k % 2) * 0.5 * step, per_ring)
-    a = par.epd / 2.0
-    px, py = a * rho * np.cos(theta), a * rho * np.sin(theta)
-    zE = par.z_E0
-    if par.infinite:
-        t = math.tan(math.radians(field_value))
-        L = np.zeros_like(px)
-        M = np.full_like(px, t / math.sqrt(1 + t * t))
-        N = np.full_like(px, 1.0 / math.sqrt(1 + t * t))
-        x0, y0 = px, py
-    else:
-        if kind == "angle":
-            yobj = par.p0 * math.tan(math.radians(field_value))
-        else:
-            yobj = field_value
-        dx, dy, dz = px, py - yobj, zE - par.z_object
-        nrm = np.sqrt(dx * dx + dy * dy + dz * dz)
-        L, M, N = dx / nrm, dy / nrm, dz / nrm
-        x0, y0 = px, py
-    # start left of every surface: back along each ray to a plane before the first vertex
-    z_start = -(abs(zE) + 2.0 * a + float(np.max(np.abs(y0))) + 1.0)
-    s = (z_start - zE) / N
-    return x0 + s * L, y0 + s * M, np.full_like(px, z_start), L, M, N
+    return _pupil_rays(par, field_value, kind, rho * np.cos(theta), rho * np.sin(theta))
 
 
 def _spot_stats(batch, label: str, drop_failed: bool = False):
@@ -214,6 +232,37 @@ def _field_kind(lens: Lens, op: Operand, od: float) -> str:
     return op.params.get("field_kind", "angle" if math.isinf(od) else lens.field.kind)
 
 
+def _ray_heights(lens: Lens, ops: list[Operand], par_for) -> dict[int, float]:
+    """The ``ray_height`` operands' values, keyed by ``id(operand)``: one ray each
+    (:func:`_pupil_rays`, pupil point ``pupil``), all of one wavelength traced in one
+    :func:`~raytrace.trace.ray_paths` call without clipping. A ray that fails before it reaches
+    its ``surface`` raises :class:`TraceError` naming its fate."""
+    from ..trace import ray_paths
+
+    by_wl: dict[float | None, list[tuple[Operand, tuple[np.ndarray, ...]]]] = {}
+    for op in ops:
+        p = op.params
+        od = _object_distance(lens, op)
+        wl = _wavelength(op)
+        px, py = p.get("pupil", (0.0, 1.0))
+        rays = _pupil_rays(
+            par_for(od, wl), float(p.get("field", 0.0)), _field_kind(lens, op, od), [px], [py]
+        )
+        by_wl.setdefault(wl, []).append((op, rays))
+    out: dict[int, float] = {}
+    for wl, items in by_wl.items():
+        starts = [np.concatenate([r[k] for _, r in items]) for k in range(6)]
+        paths = ray_paths(lens, starts[:3], starts[3:], wavelength=wl)
+        for j, (op, _) in enumerate(items):
+            i = int(op.params["surface"]) - 1
+            x, y = paths.x[j, i], paths.y[j, i]
+            if not (math.isfinite(x) and math.isfinite(y)):
+                why = status_message(int(paths.status[j]), int(paths.surface[j]))
+                raise TraceError(f"{op.label()}: the ray does not reach surface {i + 1} ({why})")
+            out[id(op)] = math.hypot(x, y)
+    return out
+
+
 def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, ...]:
     """Compute every operand for ``lens``.
 
@@ -244,6 +293,8 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
     for (od, kind, wl), fl in groups.items():
         fields = np.array(sorted(fl))
         chief[(od, kind, wl)] = (fields, aim(lens, fields, kind, od, wl))
+
+    heights = _ray_heights(lens, [op for op in operands if op.type == "ray_height"], par_for)
 
     out = []
     for op in operands:
@@ -287,9 +338,7 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
             od = _object_distance(lens, op)
             par = par_for(od, wl)
             kind = _field_kind(lens, op, od)
-            rays = _bundle(
-                lens, par, float(p.get("field", 0.0)), kind, float(p.get("aperture", 1.0))
-            )
+            rays = _bundle(par, float(p.get("field", 0.0)), kind, float(p.get("aperture", 1.0)))
             if wl not in packs:  # once per evaluation and wavelength, for every spot operand
                 packs[wl] = pack(lens, wl)
             batch = trace_rays(packs[wl], rays[:3], rays[3:], clip=False)
@@ -300,6 +349,8 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
                 plane = p.get("plane")
                 z = _best_focus_z(stats) if plane == "best" else _plane_z(par, plane)
                 v = _rms_at(stats, z)
+        elif t == "ray_height":
+            v = heights[id(op)]
         elif t == "center_thickness":
             v = lens.surfaces[int(p["surface"]) - 1].thickness
         elif t == "edge_thickness":

@@ -25,7 +25,7 @@ from .spec import (
     INDEX_BOUNDS,
     METHODS,
     PICKUP_KINDS,
-    THICKNESS_OPERANDS,
+    SURFACE_OPERANDS,
     VARIABLE_KINDS,
     DesignSpec,
     SpecError,
@@ -253,13 +253,18 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
     for op in spec.operands:
         bad = operand_problems(op.type, op.params, op.target, op.weight)
         probs += [f"operand {op.type}: {b}" for b in bad]
-        if bad or op.type not in THICKNESS_OPERANDS:
+        if bad or op.type not in SURFACE_OPERANDS:
             continue
         s = op.params["surface"]
         last = n - 1 if op.type == "edge_thickness" else n
         if not 1 <= s <= last:
             probs.append(
                 f"operand {op.type}: surface {s!r} does not exist (1..{last} for this lens)"
+            )
+        elif op.type == "ray_height" and lens.surfaces[s - 1].coordinate_break:
+            probs.append(
+                f"operand ray_height: surface {s} is a coordinate break (not traced); name a "
+                "surface that rays meet"
             )
     if len(probs) == 1:
         raise SpecError(probs[0])

@@ -54,6 +54,7 @@ OPERAND_PARAMS: dict[str, tuple[str, ...]] = {
     "landing_angle": _CHIEF,
     "best_focus": ("field", "field_kind", "aperture", "wavelength", "drop_failed", *_OBJECT),
     "rms_spot": ("field", "field_kind", "aperture", "plane", "wavelength", "drop_failed", *_OBJECT),
+    "ray_height": ("field", "field_kind", "pupil", "surface", "wavelength", *_OBJECT),
     "axial_color": ("wavelengths", *_OBJECT),
     "center_thickness": ("surface",),
     "edge_thickness": ("surface", "height"),
@@ -66,6 +67,7 @@ OPERAND_REQUIRED: dict[str, tuple[str, ...]] = {
     "image_height": ("field",),
     "distortion_slope": ("field",),
     "landing_angle": ("field",),
+    "ray_height": ("surface",),
     "center_thickness": ("surface",),
     "edge_thickness": ("surface", "height"),
 }
@@ -74,6 +76,8 @@ OPERAND_REQUIRED: dict[str, tuple[str, ...]] = {
 BOUND_KEYS = ("min", "max")
 #: operands on the thickness after a ``surface``: they need a ``target`` or ``min`` / ``max``
 THICKNESS_OPERANDS = ("center_thickness", "edge_thickness")
+#: operands that name a lens ``surface`` (checked against the lens by ``check_spec``)
+SURFACE_OPERANDS = (*THICKNESS_OPERANDS, "ray_height")
 #: optimization methods (:func:`raytrace.optimize.optimize`): damped least squares, or
 #: minimax by sequential linear programming (:mod:`raytrace.optimize.minimax`)
 METHODS = ("least_squares", "minimax")
@@ -411,6 +415,18 @@ def operand_problems(
         out.append(
             f"'aperture' must be a fraction of the pupil radius in (0, 1], got {p['aperture']!r}"
         )
+    if "pupil" in p:
+        pp = p["pupil"]
+        if not (
+            isinstance(pp, (list, tuple))
+            and len(pp) == 2
+            and all(_is_num(c) and math.isfinite(c) for c in pp)
+            and math.hypot(*pp) <= 1.0 + 1e-12
+        ):
+            out.append(
+                "'pupil' must be two numbers [px, py] inside the unit circle (fractions of the "
+                f"entrance-pupil radius), got {pp!r}"
+            )
     if "wavelength" in p and not (_is_num(p["wavelength"]) and p["wavelength"] > 0):
         out.append(f"'wavelength' must be a positive number (nm), got {p['wavelength']!r}")
     if "wavelengths" in p:
