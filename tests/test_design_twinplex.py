@@ -393,7 +393,7 @@ def test_table_v_spec_targets_are_the_shipped_lens_errors(lens, par, table_v_tra
 
 
 def test_table_v_design_is_reproducible_from_its_spec(lens):
-    """The design run itself (about 4 s on one core, 344 evaluations): the spec's minimax from its
+    """The design run itself (3-6 s on one core, 401 evaluations): the spec's minimax from its
     start lens (the 2026-11-24 design) converges to the shipped lens, with every bound met, to
     0.01 µm in its max error and 1e-6 (relative) in every curvature and thickness."""
     spec = read_spec(TABLEV_SPEC)

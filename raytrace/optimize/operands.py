@@ -122,15 +122,15 @@ def _pupil_rays(
     """Rays from one field through points of the paraxial entrance pupil: start arrays for
     trace_rays / ray_paths, ``(x, y, z, L, M, N)``.
 
-    ``px``, ``py`` are pupil coordinates in units of the paraxial entrance-pupil radius
-    ``par.epd / 2``, centred on the axis (the pupil plane z_E0); +y is the side of the field's
+    ``px``, ``py`` are the points in mm in the pupil plane z_E0, centred on the axis (a point at
+    fraction ρ of the pupil radius lies at ρ ``par.epd / 2``); +y is the side of the field's
     image for a positive field. An object at infinity sends parallel rays at the field angle; a
     finite object sends them from the object point (``kind`` "angle": nominal angle, height
     p0 tan α; "height": object height in mm). Every ray starts on one plane before the first
     vertex.
     """
     a = par.epd / 2.0
-    px, py = a * np.asarray(px, float), a * np.asarray(py, float)
+    px, py = np.asarray(px, float), np.asarray(py, float)
     zE = par.z_E0
     if par.infinite:
         t = math.tan(math.radians(field_value))
@@ -171,7 +171,8 @@ def _bundle(
     rho = np.repeat(aperture * np.sqrt((k - 0.5) / n_ring), per_ring)
     step = 2 * np.pi / per_ring
     theta = np.tile(np.arange(per_ring) * step, n_ring) + np.repeat((k % 2) * 0.5 * step, per_ring)
-    return _pupil_rays(par, field_value, kind, rho * np.cos(theta), rho * np.sin(theta))
+    a = par.epd / 2.0
+    return _pupil_rays(par, field_value, kind, a * rho * np.cos(theta), a * rho * np.sin(theta))
 
 
 def _spot_stats(batch, label: str, drop_failed: bool = False):
@@ -245,8 +246,10 @@ def _ray_heights(lens: Lens, ops: list[Operand], par_for) -> dict[int, float]:
         od = _object_distance(lens, op)
         wl = _wavelength(op)
         px, py = p.get("pupil", (0.0, 1.0))
+        par = par_for(od, wl)
+        a = par.epd / 2.0
         rays = _pupil_rays(
-            par_for(od, wl), float(p.get("field", 0.0)), _field_kind(lens, op, od), [px], [py]
+            par, float(p.get("field", 0.0)), _field_kind(lens, op, od), [a * px], [a * py]
         )
         by_wl.setdefault(wl, []).append((op, rays))
     out: dict[int, float] = {}
