@@ -27,6 +27,8 @@ docs/design.md, "Conventions"; the spec language is documented in ``docs/spec.md
                       entrance-pupil radius, centred on the axis; default [0, 1], the upper rim
                       of the meridional section), the rays of the spot operands' bundles; as a
                       ``max`` bound it keeps a footprint inside a clear aperture.
+``element_power``     paraxial power (1/mm) of the surfaces ``surface`` .. ``last`` (default
+                      ``surface + 1``: an element), :func:`raytrace.paraxial.element_power`.
 ``axial_color``       paraxial axial colour: the Gaussian image plane at ``wavelengths[0]`` minus
                       the one at ``wavelengths[1]`` (default F 486.1327 − C 656.2725 nm), mm.
 ``center_thickness``  axial thickness after ``surface``.
@@ -65,6 +67,7 @@ from ..paraxial import (
     ImagePlane,
     ParaxialResult,
     distortion_slope,
+    element_power,
     ideal_heights,
     orthoscopy_abscissa,
     paraxial,
@@ -354,6 +357,9 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
                 v = _rms_at(stats, z)
         elif t == "ray_height":
             v = heights[id(op)]
+        elif t == "element_power":
+            first = int(p["surface"])
+            v = element_power(lens, first, int(p.get("last", first + 1)), wl)
         elif t == "center_thickness":
             v = lens.surfaces[int(p["surface"]) - 1].thickness
         elif t == "edge_thickness":

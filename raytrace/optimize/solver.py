@@ -256,10 +256,18 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
         if bad or op.type not in SURFACE_OPERANDS:
             continue
         s = op.params["surface"]
-        last = n - 1 if op.type == "edge_thickness" else n
+        pair = op.type == "edge_thickness" or (
+            op.type == "element_power" and "last" not in op.params
+        )
+        last = n - 1 if pair else n  # the surface and the next one
         if not 1 <= s <= last:
             probs.append(
                 f"operand {op.type}: surface {s!r} does not exist (1..{last} for this lens)"
+            )
+        elif not op.params.get("last", s) <= n:
+            probs.append(
+                f"operand {op.type}: last surface {op.params['last']!r} does not exist (the "
+                f"lens has {n})"
             )
         elif op.type == "ray_height" and lens.surfaces[s - 1].coordinate_break:
             probs.append(

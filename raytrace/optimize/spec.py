@@ -56,6 +56,7 @@ OPERAND_PARAMS: dict[str, tuple[str, ...]] = {
     "rms_spot": ("field", "field_kind", "aperture", "plane", "wavelength", "drop_failed", *_OBJECT),
     "ray_height": ("field", "field_kind", "pupil", "surface", "wavelength", *_OBJECT),
     "axial_color": ("wavelengths", *_OBJECT),
+    "element_power": ("surface", "last", "wavelength"),
     "center_thickness": ("surface",),
     "edge_thickness": ("surface", "height"),
 }
@@ -68,6 +69,7 @@ OPERAND_REQUIRED: dict[str, tuple[str, ...]] = {
     "distortion_slope": ("field",),
     "landing_angle": ("field",),
     "ray_height": ("surface",),
+    "element_power": ("surface",),
     "center_thickness": ("surface",),
     "edge_thickness": ("surface", "height"),
 }
@@ -77,7 +79,7 @@ BOUND_KEYS = ("min", "max")
 #: operands on the thickness after a ``surface``: they need a ``target`` or ``min`` / ``max``
 THICKNESS_OPERANDS = ("center_thickness", "edge_thickness")
 #: operands that name a lens ``surface`` (checked against the lens by ``check_spec``)
-SURFACE_OPERANDS = (*THICKNESS_OPERANDS, "ray_height")
+SURFACE_OPERANDS = (*THICKNESS_OPERANDS, "ray_height", "element_power")
 #: optimization methods (:func:`raytrace.optimize.optimize`): damped least squares, or
 #: minimax by sequential linear programming (:mod:`raytrace.optimize.minimax`)
 METHODS = ("least_squares", "minimax")
@@ -406,6 +408,13 @@ def operand_problems(
         out.append(f'\'field_kind\' must be "angle" or "height", got {p["field_kind"]!r}')
     if "surface" in p and not _is_int(p["surface"]):
         out.append(f"'surface' must be an integer (1-based), got {p['surface']!r}")
+    if "last" in p and not (
+        _is_int(p["last"]) and (not _is_int(p.get("surface")) or p["last"] >= p["surface"])
+    ):
+        out.append(
+            f"'last' must be an integer surface number (1-based) not before 'surface', got "
+            f"{p['last']!r}"
+        )
     out += _bound_problems(type_, p, target, target_given)
     if "height" in p and not (_is_num(p["height"]) and p["height"] >= 0):
         out.append(f"'height' must be a non-negative number (mm), got {p['height']!r}")

@@ -12,7 +12,7 @@ from .conjugates import (
     resolve_object_distance,
     resolve_paraxial,
 )
-from .firstorder import ParaxialResult, paraxial, ynu_matrix, ynu_trace
+from .firstorder import ParaxialResult, element_power, paraxial, ynu_matrix, ynu_trace
 from .orthoscopy import (
     PestrecovConstants,
     distortion_slope,
@@ -30,6 +30,7 @@ __all__ = [
     "PestrecovConstants",
     "checked_wavelength",
     "distortion_slope",
+    "element_power",
     "ideal_heights",
     "image_planes",
     "object_distance_for_s",

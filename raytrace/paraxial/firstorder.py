@@ -308,6 +308,34 @@ def aim_geometry(
     return z_E0, abs(a * ym1 + b * num1)
 
 
+def element_power(lens: Lens, first: int, last: int, wavelength: float | None = None) -> float:
+    """Paraxial power of the surfaces ``first`` .. ``last`` (1-based, inclusive): an element, a
+    cemented group or any run of surfaces, in the media around it.
+
+    Parameters
+    ----------
+    lens : Lens
+    first, last : int
+        1-based surface numbers, ``first <= last`` (an element in air: its two surfaces).
+    wavelength : float, optional
+        nm; default the lens's.
+
+    Returns
+    -------
+    float
+        Power φ in 1/mm: −n′u′ after surface ``last`` of a ray entering surface ``first`` at
+        height 1 mm parallel to the axis (:func:`ynu_trace`); + converging. For a lens in air,
+        φ = (n − 1)(c1 − c2) + (n − 1)² t c1 c2 / n (the thick-lens formula); 1/φ is its
+        focal length.
+    """
+    n = lens.n_surfaces
+    if not 1 <= first <= last <= n:
+        raise LensError(f"{lens.name}: surfaces {first}..{last}: need 1 <= first <= last <= {n}")
+    c, t, n_in, n_out = _system(lens, lens.wavelength if wavelength is None else wavelength)
+    _, nu = ynu_trace(c, t, n_in, n_out, 1.0, 0.0, last, start=first - 1)
+    return float(-nu)
+
+
 def paraxial(
     lens: Lens, object_distance: float | None = None, wavelength: float | None = None
 ) -> ParaxialResult:

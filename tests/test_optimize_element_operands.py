@@ -1,10 +1,12 @@
-"""The ``ray_height`` operand (raytrace.optimize.operands): where one real ray of a field meets a
-surface, the footprint bound a shop rule at a clear aperture needs.
+"""The operands of single elements and surfaces (raytrace.optimize.operands): ``ray_height``, where
+one real ray of a field meets a surface (the footprint bound a shop rule at a clear aperture
+needs), and ``element_power``, the paraxial power of an element or a run of surfaces.
 
 Reference values are computed here, independently of the tracer, from closed forms: the
 intersection of a straight line with a sphere (vertex at z_v, curvature c: the centre on the axis
 at z_v + 1/c) and the vector form of Snell's law, n' (d' × m) = n (d × m) for the unit normal m
-(e.g. Welford, *Aberrations of Optical Systems*, §4.2). The rays' definition (the spot operands'
+(e.g. Welford, *Aberrations of Optical Systems*, §4.2), and the thick-lens power (Hecht,
+*Optics*, 4th ed., Eq. 6.2). The rays' definition (the spot operands'
 bundles: through the paraxial entrance pupil, centred on the axis, from the object point or
 parallel at the field angle) is the one docs/spec.md states.
 """
@@ -174,3 +176,44 @@ def test_ray_height_parameters_are_checked():
     )
     with pytest.raises(SpecError, match=r"ray_height: surface 4 does not exist \(1\.\.3"):
         check_spec(_stop_and_lens(10.0), spec)
+
+
+# --------------------------------------------------------------------------- element_power
+def test_element_power_is_the_thick_lens_formula():
+    # each element of the Cooke triplet in air: phi = (n - 1)(c1 - c2) + (n - 1)^2 t c1 c2 / n
+    # (Hecht, Optics, 4th ed., Eq. 6.2), n the element's glass index at the lens's wavelength
+    lens = load_lens("cooke-triplet-f4")
+    n_after = lens.indices(lens.wavelength)[0][1:]
+    glass = [i for i, s in enumerate(lens.surfaces[:-1]) if not s.material.is_air]
+    assert len(glass) == 3
+    ops = tuple(Operand("element_power", 0.0, 1.0, {"surface": i + 1}) for i in glass)
+    got = [v.value for v in evaluate(lens, ops)]
+    for i, g in zip(glass, got, strict=True):
+        s1, s2 = lens.surfaces[i], lens.surfaces[i + 1]
+        n, c1, c2, t = n_after[i], s1.curvature, s2.curvature, s1.thickness
+        want = (n - 1) * (c1 - c2) + (n - 1) ** 2 * t * c1 * c2 / n
+        assert g == pytest.approx(want, rel=1e-12)
+    assert [math.copysign(1, g) for g in got] == [1, -1, 1]  # the triplet's + - +
+    # the whole lens as one run of surfaces: 1 / EFL
+    (whole,) = evaluate(lens, (Operand("element_power", 0.0, 1.0, {"surface": 1, "last": 6}),))
+    assert whole.value == pytest.approx(1.0 / paraxial(lens).efl, rel=1e-12)
+
+
+def test_element_power_parameters_are_checked():
+    from raytrace.optimize.solver import check_spec
+
+    assert operand_problems("element_power", {"surface": 3, "last": 2}, 0.0, 1.0) == [
+        "'last' must be an integer surface number (1-based) not before 'surface', got 2"
+    ]
+    lens = _stop_and_lens(10.0)  # 3 surfaces
+    for params, msg in (
+        ({"surface": 3}, r"surface 3 does not exist \(1\.\.2"),
+        ({"surface": 1, "last": 4}, r"last surface 4 does not exist \(the lens has 3\)"),
+    ):
+        spec = DesignSpec(
+            start="(built in test)",
+            variables=(Variable("thickness", 1, 1.0, 60.0),),
+            operands=(Operand("element_power", 0.0, 1.0, {**params, "min": 0.0}),),
+        )
+        with pytest.raises(SpecError, match=msg):
+            check_spec(lens, spec)
