@@ -236,11 +236,12 @@ def _field_kind(lens: Lens, op: Operand, od: float) -> str:
     return op.params.get("field_kind", "angle" if math.isinf(od) else lens.field.kind)
 
 
-def _ray_heights(lens: Lens, ops: list[Operand], par_for) -> dict[int, float]:
+def _ray_heights(lens: Lens, ops: list[Operand], par_for, pack_for) -> dict[int, float]:
     """The ``ray_height`` operands' values, keyed by ``id(operand)``: one ray each
     (:func:`_pupil_rays`, pupil point ``pupil``), all of one wavelength traced in one
-    :func:`~raytrace.trace.ray_paths` call without clipping. A ray that fails before it reaches
-    its ``surface`` raises :class:`TraceError` naming its fate."""
+    :func:`~raytrace.trace.ray_paths` call without clipping (``par_for(od, wl)``,
+    ``pack_for(wl)``: the evaluation's paraxial data and packed lenses). A ray that fails
+    before it reaches its ``surface`` raises :class:`TraceError` naming its fate."""
     from ..trace import ray_paths
 
     by_wl: dict[float | None, list[tuple[Operand, tuple[np.ndarray, ...]]]] = {}
@@ -258,7 +259,7 @@ def _ray_heights(lens: Lens, ops: list[Operand], par_for) -> dict[int, float]:
     out: dict[int, float] = {}
     for wl, items in by_wl.items():
         starts = [np.concatenate([r[k] for _, r in items]) for k in range(6)]
-        paths = ray_paths(lens, starts[:3], starts[3:], wavelength=wl)
+        paths = ray_paths(pack_for(wl), starts[:3], starts[3:])
         for j, (op, _) in enumerate(items):
             i = int(op.params["surface"]) - 1
             x, y = paths.x[j, i], paths.y[j, i]
@@ -300,7 +301,14 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
         fields = np.array(sorted(fl))
         chief[(od, kind, wl)] = (fields, aim(lens, fields, kind, od, wl))
 
-    heights = _ray_heights(lens, [op for op in operands if op.type == "ray_height"], par_for)
+    def pack_for(wl: float | None):  # once per evaluation and wavelength, for every ray operand
+        if wl not in packs:
+            packs[wl] = pack(lens, wl)
+        return packs[wl]
+
+    heights = _ray_heights(
+        lens, [op for op in operands if op.type == "ray_height"], par_for, pack_for
+    )
 
     out = []
     for op in operands:
@@ -345,9 +353,7 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
             par = par_for(od, wl)
             kind = _field_kind(lens, op, od)
             rays = _bundle(par, float(p.get("field", 0.0)), kind, float(p.get("aperture", 1.0)))
-            if wl not in packs:  # once per evaluation and wavelength, for every spot operand
-                packs[wl] = pack(lens, wl)
-            batch = trace_rays(packs[wl], rays[:3], rays[3:], clip=False)
+            batch = trace_rays(pack_for(wl), rays[:3], rays[3:], clip=False)
             stats = _spot_stats(batch, op.label(), bool(p.get("drop_failed", False)))
             if t == "best_focus":
                 v = _best_focus_z(stats) - par.z_Hp

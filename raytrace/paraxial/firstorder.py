@@ -328,6 +328,7 @@ def element_power(lens: Lens, first: int, last: int, wavelength: float | None = 
         φ = (n − 1)(c1 − c2) + (n − 1)² t c1 c2 / n (the thick-lens formula); 1/φ is its
         focal length.
     """
+    require_centred(lens)
     n = lens.n_surfaces
     if not 1 <= first <= last <= n:
         raise LensError(f"{lens.name}: surfaces {first}..{last}: need 1 <= first <= last <= {n}")
