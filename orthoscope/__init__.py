@@ -141,6 +141,11 @@ _API: dict[str, str] = {
     "read_spec": "raytrace.optimize",
     "optimize": "raytrace.optimize",
     "global_optimize": "raytrace.optimize",
+    "split_element": "raytrace.elements",
+    "insert_element": "raytrace.elements",
+    "split_design": "raytrace.optimize",
+    "insert_design": "raytrace.optimize",
+    "element_power": "raytrace.paraxial",
     # tolerancing (docs/tolerance.md)
     "read_tolerance_spec": "raytrace.tolerance",
     "ToleranceSpec": "raytrace.tolerance",

@@ -242,6 +242,7 @@ def cmd_optimize(args) -> int:
     over = _search_overrides(args) if args.global_search else {}
     lens = start_lens(spec)
     inputs = [spec.path] + ([lens.path] if lens.path else [])
+    lens, spec = _edit_elements(args, lens, spec)
     # every output is checked before the run
     check_output(out, inputs=inputs, overwrite=args.force, flag="--force")
     if args.glass_map is not None:
@@ -256,6 +257,31 @@ def cmd_optimize(args) -> int:
     if args.global_search:
         return _run_global(args, spec, lens, out, inputs, over)
     return _run_local(args, spec, lens, out, inputs)
+
+
+def _edit_elements(args, lens, spec):
+    """Apply --split K and --insert K:GLASS to the start lens and renumber the spec (surface
+    numbers of the start lens; applied from the last surface back so each keeps its meaning)."""
+    edits = [(k, "split", None) for k in args.split or ()]
+    for text in args.insert or ():
+        after, sep, glass = str(text).partition(":")
+        if not (sep and after.strip().isdigit() and glass.strip()):
+            raise CliError(f"--insert {text}: use AFTER:GLASS, e.g. --insert 4:N-BK7")
+        edits.append((int(after), "insert", glass.strip()))
+    if not edits:
+        return lens, spec
+    from raytrace.glass import lookup_glass
+    from raytrace.optimize import insert_design, split_design
+
+    flags = [f"--split {k}" for k in args.split or ()] + [
+        f"--insert {t}" for t in args.insert or ()
+    ]
+    for k, what, glass in sorted(edits, key=lambda e: e[0], reverse=True):
+        if what == "split":
+            lens, spec = split_design(lens, spec, k)
+        else:
+            lens, spec = insert_design(lens, spec, k, lookup_glass(glass).material)
+    return lens, replace(spec, start=f"{spec.start} edited by {' '.join(flags)}")
 
 
 def _write_design(args, res, spec, out, inputs, notes, source: str) -> bool:
@@ -427,7 +453,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             "surfaces, with bounds; glass = substitution among real catalog glasses, --global "
             "only), pick-ups, and operands with targets and weights (efl, m_e, HE0, HpE0p, "
             "distortion, distortion_rel, distortion_slope, image_height, landing_angle, "
-            "best_focus, rms_spot, axial_color, center_thickness, edge_thickness; any operand "
+            "best_focus, rms_spot, ray_height, axial_color, element_power, center_thickness, "
+            "edge_thickness; any operand "
             "may give min / max instead of a target: a one-sided bound). Without --global: "
             "damped least squares from the start lens, or minimax (--method minimax, or the "
             'spec\'s method = "minimax": the largest weighted residual is minimised, the '
@@ -496,6 +523,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--write-anyway",
         action="store_true",
         help="Write the lens even when the run did not converge (marked in its notes).",
+    )
+    e = q.add_argument_group("elements (surface numbers of the start lens; the spec follows)")
+    e.add_argument(
+        "--split",
+        type=int,
+        action="append",
+        metavar="K",
+        help="Split the element whose first surface is K in two (cut at the mean curvature, "
+        "0.1 mm apart), with variables and rules for the new half; repeatable.",
+    )
+    e.add_argument(
+        "--insert",
+        action="append",
+        metavar="K:GLASS",
+        help="Insert a 2 mm plate of catalog GLASS into the air space after surface K (free "
+        "curvatures, thickness variable); repeatable.",
     )
     q.add_argument("--quiet", action="store_true", help="No progress display.")
     add_force_arg(q)

@@ -1,9 +1,11 @@
 """Lens design optimization: specs (:mod:`.spec`; the language in ``docs/spec.md``), operands
 (:mod:`.operands`), damped least squares (:mod:`.solver`), minimax by sequential linear
 programming (:mod:`.minimax`; run it as ``optimize(lens, spec, method="minimax")``), the
-glass-substitution pool (:mod:`.glasses`) and the global search (:mod:`.global_search`). Imports
+glass-substitution pool (:mod:`.glasses`), the global search (:mod:`.global_search`) and element
+splitting / adding with the spec renumbered (:mod:`.elements`). Imports
 scipy; nothing else in the engine needs it."""
 
+from .elements import insert_design, split_design
 from .glasses import GlassPool, availability, glass_pool
 from .global_search import GlassChoice, GlobalResult, SearchProgress, global_optimize
 from .operands import OperandValue, evaluate, merit
@@ -43,9 +45,11 @@ __all__ = [
     "evaluate",
     "global_optimize",
     "glass_pool",
+    "insert_design",
     "merit",
     "optimize",
     "parse_duration",
     "read_spec",
+    "split_design",
     "start_lens",
 ]

@@ -1,0 +1,190 @@
+"""Splitting and adding elements (raytrace.elements; raytrace.optimize.elements; ``orthoscope
+optimize --split / --insert``).
+
+References, none of them our own output: the thin-lens limit (a thin element cut in two thin
+halves of the mean curvature has the same power: (n - 1)(c1 - c_m) + (n - 1)(c_m - c2) =
+(n - 1)(c1 - c2)); the focal shift of a plane-parallel plate in a converging beam, t (1 - 1/n)
+(paraxial; e.g. Smith, Modern Optical Engineering, §2.6); and the designer's rule that splitting
+a lens into two reduces its least spherical aberration several times (two thin lenses of half
+the power each contribute (1/2)³ of the single lens's at best form, and the second works at a
+better conjugate: Kingslake & Johnson, Lens Design Fundamentals, 2nd ed., §6.4 "lens
+splitting").
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from dataclasses import replace
+
+import pytest
+from support import singlet, singlet_spec
+
+from raytrace.elements import insert_element, split_element, surface_map
+from raytrace.errors import LensError
+from raytrace.files.library import load_lens
+from raytrace.materials import fixed_index
+from raytrace.optimize import Operand, Variable, check_spec, evaluate, optimize, split_design
+from raytrace.optimize.elements import insert_design
+from raytrace.paraxial import element_power, paraxial
+
+
+def test_a_thin_element_split_keeps_its_power():
+    lens = singlet(n=1.5, f=100.0, t=1e-4)
+    c1, c2 = lens.surfaces[0].curvature, lens.surfaces[1].curvature
+    split = split_element(lens, 1, gap=1e-4)
+    assert split.n_surfaces == 4
+    s = split.surfaces
+    assert [x.material.is_air for x in s] == [False, True, False, True]
+    assert s[1].curvature == s[2].curvature == pytest.approx(0.5 * (c1 + c2), rel=1e-15)
+    assert s[0].thickness == s[2].thickness == pytest.approx(0.5e-4)
+    assert s[0].stop and not any(x.stop for x in s[1:])
+    # each half has half the power, the whole the same (thin-lens limit)
+    half = 0.5 * (1.5 - 1) * (c1 - c2)
+    assert element_power(split, 1, 2) == pytest.approx(half, rel=1e-4)
+    assert element_power(split, 3, 4) == pytest.approx(half, rel=1e-4)
+    assert paraxial(split).efl == pytest.approx(paraxial(lens).efl, rel=1e-5)
+
+
+def test_an_inserted_plate_shifts_the_focus_by_t_times_one_minus_one_over_n():
+    lens = load_lens("cooke-triplet-f4")
+    n, t = 1.6, 3.0
+    last = lens.n_surfaces
+    ins = insert_element(lens, last, fixed_index(n), thickness=t, gap=5.0)
+    assert ins.n_surfaces == lens.n_surfaces + 2
+    assert element_power(ins, last + 1, last + 2) == 0.0  # two flat surfaces
+    # every old vertex and the old image plane stay where they were
+    assert list(ins.vertex_z[:last]) == pytest.approx(list(lens.vertex_z))
+    assert ins.image_z == pytest.approx(lens.image_z, abs=1e-12)
+    # the Gaussian image moves back by t (1 - 1/n)
+    z0, z1 = paraxial(lens).z_gauss, paraxial(ins).z_gauss
+    assert z1 - z0 == pytest.approx(t * (1 - 1 / n), rel=1e-9)
+
+
+def test_splitting_a_singlet_lowers_its_least_spherical_aberration():
+    lens = singlet(n=1.5)
+    spec = singlet_spec()
+    one = optimize(lens, spec)
+    lens2, spec2 = split_design(lens, spec, 1)
+    assert [(v.kind, v.surface) for v in spec2.variables] == [
+        ("curvature", 1),
+        ("curvature", 4),
+        ("curvature", 2),
+        ("curvature", 3),
+    ]
+    two = optimize(lens2, replace(spec2, max_evaluations=800))
+    rms1 = [o.value for o in one.operands if o.operand.type == "rms_spot"][0]
+    rms2 = [o.value for o in two.operands if o.operand.type == "rms_spot"][0]
+    assert paraxial(two.lens).efl == pytest.approx(100.0, rel=1e-5)
+    assert rms2 < 0.4 * rms1, (rms1, rms2)
+
+
+def test_split_design_renumbers_the_spec_and_repeats_the_element_rules():
+    lens = load_lens("cooke-triplet-f4")  # elements at 1-2, 3-4, 5-6
+    spec = singlet_spec()
+    spec = replace(
+        spec,
+        start="cooke-triplet-f4",
+        variables=(
+            Variable("curvature", 3, -0.2, 0.0),
+            Variable("curvature", 4, 0.0, 0.2),
+            Variable("thickness", 3, 0.8, 5.0),
+            Variable("thickness", 4, 0.3, 20.0),
+            Variable("curvature", 5),
+        ),
+        operands=(
+            Operand("efl", 50.0, 1.0),
+            Operand("edge_thickness", params={"surface": 3, "height": 5.0, "min": 0.5}),
+            Operand("edge_thickness", params={"surface": 4, "height": 5.0, "min": 0.2}),
+            Operand("ray_height", params={"surface": 6, "field": 10.0, "max": 20.0}),
+            Operand("element_power", params={"surface": 1, "last": 6, "min": 0.0}),
+        ),
+    )
+    new_lens, new = split_design(lens, spec, 3)
+    check_spec(new_lens, new)
+    where = surface_map(3)
+    assert [where(j) for j in (1, 2, 3, 4, 5, 6)] == [1, 2, 3, 6, 7, 8]
+    got = {(v.kind, v.surface): (v.lower, v.upper) for v in new.variables}
+    assert got == {
+        ("curvature", 3): (-0.2, 0.0),
+        ("curvature", 6): (0.0, 0.2),
+        ("thickness", 3): (0.8, 5.0),  # the first half
+        ("thickness", 6): (0.3, 20.0),
+        ("curvature", 7): (-float("inf"), float("inf")),
+        ("curvature", 4): (-0.2, 0.2),  # the cut surfaces: the union of the element's bounds
+        ("curvature", 5): (-0.2, 0.2),
+        ("thickness", 5): (0.8, 5.0),  # the second half
+        ("thickness", 4): (0.1, float("inf")),  # the gap: the spec's smallest air bound 0.3, or 0.1
+    }
+    ops = [(o.type, o.params) for o in new.operands]
+    assert ("ray_height", {"surface": 8, "field": 10.0, "max": 20.0}) in ops
+    assert ("element_power", {"surface": 1, "last": 8, "min": 0.0}) in ops
+    assert ("edge_thickness", {"surface": 6, "height": 5.0, "min": 0.2}) in ops  # air after
+    assert ("edge_thickness", {"surface": 5, "height": 5.0, "min": 0.5}) in ops  # second half
+    assert ("edge_thickness", {"surface": 4, "height": 5.0, "min": 0.2}) in ops  # the gap
+    # the operands evaluate on the split lens
+    assert all(v.value == v.value for v in evaluate(new_lens, new.operands))
+
+
+def test_insert_design_moves_the_air_space_variable_behind_the_new_element():
+    lens = load_lens("cooke-triplet-f4")
+    spec = replace(
+        singlet_spec(),
+        start="cooke-triplet-f4",
+        variables=(Variable("thickness", 2, 0.5, 30.0), Variable("curvature", 1)),
+        operands=(Operand("efl", 50.0, 1.0),),
+    )
+    new_lens, new = insert_design(lens, spec, 2, fixed_index(1.7), thickness=1.5, gap=0.5)
+    check_spec(new_lens, new)
+    got = {(v.kind, v.surface): (v.lower, v.upper) for v in new.variables}
+    assert got == {
+        ("curvature", 1): (-float("inf"), float("inf")),
+        ("curvature", 3): (-float("inf"), float("inf")),
+        ("curvature", 4): (-float("inf"), float("inf")),
+        ("thickness", 3): (1.5, float("inf")),  # the new glass (no glass bound in the spec)
+        ("thickness", 4): (0.5, 30.0),  # the old air space, now behind the new element
+        ("thickness", 2): (0.5, float("inf")),  # the gap in front of it
+    }
+    assert new_lens.surfaces[1].thickness == 0.5
+
+
+def test_edits_refuse_what_is_not_an_element_or_an_air_space():
+    lens = load_lens("cooke-triplet-f4")
+    with pytest.raises(LensError, match=r"surfaces 2-3 are not a single element in air"):
+        split_element(lens, 2)
+    with pytest.raises(LensError, match=r"no element starts at surface 6"):
+        split_element(lens, 6)
+    with pytest.raises(LensError, match=r"the space after surface 1 is not air"):
+        insert_element(lens, 1, fixed_index(1.5))
+    with pytest.raises(LensError, match=r"too short"):
+        insert_element(lens, 2, fixed_index(1.5), thickness=10.0)
+
+
+def test_cli_split_writes_a_lens_that_records_the_edit(tmp_path):
+    spec = tmp_path / "singlet.toml"
+    lens = tmp_path / "start.toml"
+    from raytrace.files import save_lens
+
+    save_lens(singlet(n=1.5), lens)
+    spec.write_text(
+        'start = "start.toml"\nmax_evaluations = 600\n'
+        'variables = [ { kind = "curvature", surface = 1 }, { kind = "curvature", surface = 2 } ]\n'
+        'operands = [ { type = "efl", target = 100, weight = 100 },\n'
+        '  { type = "rms_spot", plane = "best", target = 0, weight = 1000 } ]\n',
+        encoding="utf-8",
+    )
+    cmd = [sys.executable, "-m", "orthoscope", "optimize", str(spec), "--quiet", "-o"]
+    out = tmp_path / "two.toml"
+    r = subprocess.run([*cmd, str(out), "--split", "1"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    two = load_lens(str(out))
+    assert two.n_surfaces == 4
+    assert "edited by --split 1" in two.notes
+    for flag, msg in (
+        ("--split=2", "no element starts at surface 2"),
+        ("--insert=1", "AFTER:GLASS"),
+    ):
+        bad = subprocess.run([*cmd, str(tmp_path / "x.toml"), flag], capture_output=True, text=True)
+        lines = [x for x in bad.stderr.splitlines() if "compiling" not in x]
+        assert bad.returncode == 2 and len(lines) == 1 and msg in lines[0], bad.stderr
+    assert not (tmp_path / "x.toml").exists()
