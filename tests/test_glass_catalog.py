@@ -290,3 +290,59 @@ def test_lens_catalog_span_is_where_every_glass_has_data():
     with pytest.warns(OutOfRangeWarning, match="outside its data range"):
         lens.indices(lo - 1.0)
     assert load_lens("topogon-like-pestrecov").catalog_span() == (0.0, math.inf)  # model glasses
+
+
+# --------------------------------------------------------------------------- prices
+# Vendor data: SCHOTT.xls (opticalglass 1.1.1), sheet "Datatable", column "rel. Price" (N-BK7 =
+# 1 in the sheet); CDGM.xls, "Relative price" / "Volume" (H-K9L = 10 in the sheet, so /10).
+SCHOTT_PRICES = {"N-BK7": 1.0, "N-LAK34": 9.6, "LASF35": 36.68676151434772, "F2": 1.241861586689173}
+CDGM_PRICES = {"H-K9L": 1.0, "H-ZF52": 5.3, "H-FK61": 10.5, "D-ZK3": 4.3}
+
+
+def test_relative_prices_are_the_vendors():
+    for cat, prices in (("Schott", SCHOTT_PRICES), ("CDGM", CDGM_PRICES)):
+        for name, price in prices.items():
+            assert lookup_glass(name, [cat]).price == pytest.approx(price, rel=1e-12), name
+    # vendors that print no price: nan, never a made-up number
+    assert math.isnan(lookup_glass("S-BSL7", ["Ohara"]).price)
+    assert math.isnan(lookup_glass("E-FDS3", ["Hoya"]).price)
+    priced = {c: sum(math.isfinite(g.price) for g in catalog_glasses(c)) for c in VENDORS}
+    assert priced["Ohara"] == priced["Hoya"] == priced["Hikari"] == priced["Sumita"] == 0
+    assert priced["Schott"] >= 90 and priced["CDGM"] >= 200
+
+
+def test_schott_prices_against_the_spreadsheet():
+    # referee where the vendor spreadsheet is installed (opticalglass ships it)
+    og = pytest.importorskip("opticalglass")
+    pd = pytest.importorskip("pandas")
+    pytest.importorskip("xlrd")
+    from pathlib import Path
+
+    sheet = pd.read_excel(
+        Path(og.__file__).parent / "data" / "SCHOTT.xls", "Datatable", header=None
+    )
+    col = [j for j, v in enumerate(sheet.iloc[3]) if v == "rel. Price"]
+    assert len(col) == 1
+    n = 0
+    for _, row in sheet.iloc[4:].iterrows():
+        price = row.iloc[col[0]]
+        if isinstance(row.iloc[0], str) and isinstance(price, (int, float)) and price > 0:
+            assert lookup_glass(row.iloc[0].strip(), ["Schott"]).price == pytest.approx(price)
+            n += 1
+    assert n >= 90
+
+
+def test_cost_class_limits_the_substitution_pool():
+    from raytrace.optimize.glasses import glass_pool
+    from raytrace.optimize.spec import GlassSettings, SpecError
+
+    cheap = glass_pool(GlassSettings(max_price=2.0))
+    names = {g.name for g in cheap.glasses}
+    assert {"N-BK7", "H-K9L", "F2"} <= names  # each vendor's reference glass, 1.24 x N-BK7
+    assert "LASF35" not in names and "N-LAK34" not in names
+    assert {g.catalog for g in cheap.glasses} == {"Schott", "CDGM"}
+    assert all(g.price <= 2.0 for g in cheap.glasses)
+    everything = glass_pool(GlassSettings())
+    assert len(everything.glasses) > 5 * len(cheap.glasses)
+    with pytest.raises(SpecError, match=r"relative price <= 0.5 \(Schott / CDGM prices only\)"):
+        glass_pool(GlassSettings(max_price=0.5))

@@ -209,3 +209,20 @@ def test_glass_pool_errors():
         glass_pool(GlassSettings(glasses=("N-BK77",)))
     with pytest.raises(SpecError, match="widen the windows"):
         glass_pool(GlassSettings(nd=(3.0, 3.1)))
+
+
+def test_glass_max_price_key(tmp_path):
+    head = 'start = "cooke-triplet-f4"\nvariables = [ { kind = "curvature", surface = 1 } ]\n'
+    head += 'operands = [ { type = "efl", target = 50 } ]\n'
+    spec = _read(tmp_path, head + "[glass]\nmax_price = 3\n")
+    assert spec.glass.max_price == 3.0
+    spec = _read(
+        tmp_path,
+        head.replace(
+            "variables = [", 'variables = [ { kind = "glass", surface = 1, max_price = 1.5 },'
+        )
+        + "[glass]\nmax_price = 3\n",
+    )
+    assert spec.glass_settings(spec.variables[0]).max_price == 1.5
+    with pytest.raises(SpecError, match=r"max_price.*positive number"):
+        _read(tmp_path, head + "[glass]\nmax_price = -1\n")

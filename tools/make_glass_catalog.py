@@ -27,7 +27,9 @@ Sources
 Every spreadsheet column is located by its header label and checked, so a changed file fails
 loudly instead of shifting columns. Output: one zip archive of JSON members (``index.json``
 with names, nd, vd and status of every material; one JSON-lines member per catalog,
-``CATALOG.jsonl``, with the full records, one material a line in index order, so that a reader
+``CATALOG.jsonl``, with the full records (formula, printed indices, dn/dT, transmission and,
+where the vendor prints one, the relative price: Schott's "rel. Price", CDGM's price per
+volume), one material a line in index order, so that a reader
 parses only the glasses it needs; ``meta.json`` with file, package, version, sha256 and catalog
 date of every source). The archive is deterministic: same inputs and ``--date`` give
 byte-identical output.
@@ -412,6 +414,28 @@ def _sellmeier_records(sh: Sheet, rows: list[int], at: Columns, c0: int, source:
     return out
 
 
+def _with_prices(
+    records: list[dict], sh: Sheet, rows: list[int], price_col: int, reference: str
+) -> list[dict]:
+    """``rec["price"]``: the catalog's relative price divided by its ``reference`` glass's, where
+    the sheet gives one (Schott's "rel. Price" column, N-BK7 = 1 in the sheet; CDGM's price
+    per volume, H-K9L = 10 in the sheet). The reference's row must carry a price."""
+    by_name = {}
+    for r in rows:
+        v = _num(sh.cell(r, price_col))
+        if v is not None and v > 0:
+            by_name[_clean(sh.cell(r, 0))] = v
+    if reference not in by_name:
+        raise SystemExit(
+            f"{sh.path.name}: no relative price of {reference} in column {price_col + 1}"
+        )
+    ref = by_name[reference]
+    for rec in records:
+        if rec["name"] in by_name:
+            rec["price"] = by_name[rec["name"]] / ref
+    return records
+
+
 def read_schott(path: Path, source: str) -> list[dict]:
     sh = Sheet(path, "Datatable")
     H = 3
@@ -433,7 +457,10 @@ def read_schott(path: Path, source: str) -> list[dict]:
         transmission=tcols,
         dndt=list(range(d0, d0 + 6)),
     )
-    return _sellmeier_records(sh, rows, at, b1, source)
+    records = _sellmeier_records(sh, rows, at, b1, source)
+    if not path.stem.endswith("_prev"):  # the current catalog prints "rel. Price" (N-BK7 = 1)
+        records = _with_prices(records, sh, rows, sh.find(H, r"rel\. Price"), "N-BK7")
+    return records
 
 
 def _ohara_sheet(sh: Sheet, source: str) -> list[dict]:
@@ -520,10 +547,15 @@ def read_cdgm(path: Path, source: str) -> list[dict]:
         transmission=_header_run(sh, 1, sh.find(0, "τ10mm"), _num),
         dndt=list(range(d0, d0 + 6)),
     )
-    return [
+    records = [
         _row_record(sh, r, at, 1, [_num(sh.cell(r, a0 + k)) for k in range(6)], source=source)
         for r in rows
     ]
+    # "Relative price" per mass and per volume (two columns; H-K9L = 10): per volume
+    price = sh.find(0, "Relative price")
+    sh.expect(1, price, "Mass")
+    sh.expect(1, price + 1, "Volume")
+    return _with_prices(records, sh, rows, price + 1, "H-K9L")
 
 
 def read_hikari(path: Path, source: str) -> list[dict]:

@@ -48,6 +48,9 @@ def format_glass(g: CatalogGlass, wavelengths, indices) -> str:
         out.append(
             "  dn/dT (Schott) D0, D1, D2, E0, E1, λTK: " + ", ".join(f"{c:.4g}" for c in g.dndt)
         )
+    if math.isfinite(g.price):
+        ref = "N-BK7" if g.catalog == "Schott" else "H-K9L"
+        out.append(f"  relative price {g.price:.3g} ({g.catalog}'s catalog, {ref} = 1)")
     if g.source:
         out.append(f"  source: {g.source}" + (f" — {g.note}" if g.note else ""))
     printed = {round(w, 4): (lab, n, d) for lab, w, n, d in g.printed_indices}
@@ -82,6 +85,7 @@ def glass_to_dict(g: CatalogGlass, wavelengths, indices) -> dict:
         "dndt": list(g.dndt),
         "source": g.source,
         "note": g.note,
+        "relative_price": g.price if math.isfinite(g.price) else None,
         "printed_indices": [
             {"line": lab, "wavelength_nm": w, "n": n, "decimals": d}
             for lab, w, n, d in g.printed_indices

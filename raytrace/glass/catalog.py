@@ -81,6 +81,11 @@ class CatalogGlass:
     source:
         key of :func:`catalog_sources` the record comes from; ``note``: remarks (basis or
         temperature assumed, what the material is).
+    price:
+        the vendor's relative price, normalised to its catalog's reference glass (Schott: the
+        "rel. Price" column, N-BK7 = 1; CDGM: the price per volume, H-K9L = 1); ``nan`` where
+        the catalog prints none (Ohara, Hoya, Hikari, Sumita, the legacy shelves, some glasses).
+        Prices of different vendors are not on one scale.
     """
 
     name: str
@@ -103,6 +108,7 @@ class CatalogGlass:
     aliases: tuple[str, ...] = ()
     source: str = ""
     note: str = ""
+    price: float = math.nan
 
     @property
     def material(self) -> Material:
@@ -217,6 +223,7 @@ def _glass(catalog: str, i: int) -> CatalogGlass:
         aliases=tuple(r.get("aliases", ())),
         source=r["source"],
         note=r.get("note", ""),
+        price=_float(r.get("price")),
     )
 
 

@@ -120,6 +120,8 @@ def glass_pool(settings: GlassSettings) -> GlassPool:
             continue
         if not (lo_n <= g.nd <= hi_n and lo_v <= g.vd <= hi_v):
             continue
+        if math.isfinite(settings.max_price) and not g.price <= settings.max_price:
+            continue  # no printed price (nan) or above the cost class
         if (g.nd, g.vd) in seen:
             continue
         seen.add((g.nd, g.vd))
@@ -129,6 +131,11 @@ def glass_pool(settings: GlassSettings) -> GlassPool:
             f"glass pool: no glass of {', '.join(settings.catalogs)} with availability "
             f"{', '.join(settings.availability)} lies in nd {settings.nd[0]}..{settings.nd[1]}, "
             f"vd {settings.vd[0]}..{settings.vd[1]}"
+            + (
+                f", relative price <= {settings.max_price:g} (Schott / CDGM prices only)"
+                if math.isfinite(settings.max_price)
+                else ""
+            )
             + (f" among {', '.join(settings.glasses)}" if settings.glasses else "")
             + "; widen the windows or allow more catalogs / classes"
         )

@@ -119,6 +119,10 @@ class GlassSettings:
         first optimize each glass as a continuous nd/vd model glass inside the pool's window,
         then snap to the nearest real glasses (CODE V's glass fitting); otherwise substitute
         real glasses only.
+    max_price:
+        the cost class: the largest relative price the vendor prints
+        (:attr:`raytrace.glass.CatalogGlass.price`: Schott N-BK7 = 1, CDGM H-K9L = 1). A finite
+        value keeps only glasses with a printed price, i.e. of the Schott and CDGM catalogs.
     """
 
     catalogs: tuple[str, ...] = DEFAULT_CATALOGS
@@ -128,6 +132,7 @@ class GlassSettings:
     glasses: tuple[str, ...] = ()
     neighbours: int = 6
     model_phase: bool = True
+    max_price: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -555,11 +560,26 @@ def _glass_settings(d: dict, base: GlassSettings, at: str, probs: _Problems) -> 
             probs.add(f"{at}: 'glasses' must be a list of glass names, got {g!r}")
         else:
             kw["glasses"] = tuple(g)
-    _take(d, {"neighbours": _POSITIVE_INT, "model_phase": _BOOL}, kw, probs, at)
+    _take(
+        d,
+        {"neighbours": _POSITIVE_INT, "model_phase": _BOOL, "max_price": _POSITIVE},
+        kw,
+        probs,
+        at,
+    )
     return replace(base, **kw)
 
 
-GLASS_KEYS = ("catalogs", "availability", "nd", "vd", "glasses", "neighbours", "model_phase")
+GLASS_KEYS = (
+    "catalogs",
+    "availability",
+    "nd",
+    "vd",
+    "glasses",
+    "neighbours",
+    "model_phase",
+    "max_price",
+)
 SEARCH_KEYS = (
     "starts",
     "seed",
