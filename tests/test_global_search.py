@@ -325,3 +325,48 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
 
     notes = read_lens(out).notes
     assert "--global --seed 1" in notes and "stopped early (interrupted)" in notes
+
+
+# --------------------------------------------------------------------------- Dask
+def test_dask_cluster_gives_the_same_design_as_one_process():
+    """The starts as tasks on a Dask LocalCluster (two worker processes): the same per-start
+    merits and the same design, bit for bit, as in this process; a time budget stops it with
+    the best design so far."""
+    pytest.importorskip("distributed")
+    lens = load_lens("cooke-triplet-f4")
+    spec = cooke_multimodal(starts=2)
+    here = global_optimize(lens, spec, seed=7, workers=1)
+    dask = global_optimize(lens, spec, seed=7, executor="local:2")
+    assert np.array_equal(here.start_merits, dask.start_merits)
+    assert here.merit == dask.merit and not dask.stopped
+    for a, b in zip(here.lens.surfaces, dask.lens.surfaces, strict=True):
+        assert a.curvature == b.curvature
+    budget = global_optimize(
+        lens, cooke_multimodal(starts=12), seed=7, executor="local:1", time_budget_s=1.0
+    )
+    assert budget.stopped == "time" and math.isfinite(budget.merit)
+    assert np.isnan(budget.start_merits).any()  # not every start ran to its end
+
+
+def test_cli_dask_flags_are_checked(tmp_path: Path):
+    spec = ROOT / "lenses" / "specs" / "twinplex-like-55-525.toml"
+    for flags, msg in (
+        (["--dask", "local:2"], "--dask belong(s) to the global search"),
+        (["--global", "--dask", "local:2", "--workers", "2"], "--workers is for local processes"),
+    ):
+        r = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "orthoscope",
+                "optimize",
+                str(spec),
+                "-o",
+                str(tmp_path / "x.toml"),
+                *flags,
+            ],
+            capture_output=True,
+            text=True,
+        )
+        lines = [x for x in r.stderr.splitlines() if "compiling" not in x]
+        assert r.returncode == 2 and len(lines) == 1 and msg in lines[0], r.stderr

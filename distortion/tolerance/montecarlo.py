@@ -32,7 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from raytrace.errors import OrthoscopeError, OutputError
+from raytrace.errors import OutputError
+from raytrace.executors import dask_client
 from raytrace.files.output import write_atomic
 from raytrace.lens import Lens
 from raytrace.tolerance import (
@@ -170,47 +171,6 @@ class _Store:
     def load(self, k: int) -> dict:
         with np.load(self.path(k)) as z:
             return {key: z[key] for key in z.files}
-
-
-# ------------------------------------------------------------------------------ executors
-def _dask_client(executor):
-    """(client, close) for an executor spec: a distributed.Client, "local[:N]", "tcp://..."."""
-    try:
-        import distributed
-    except ImportError:
-        raise OrthoscopeError(
-            "Dask is not installed; install the extra: pip install 'orthoscope[dask]'"
-        ) from None
-    if isinstance(executor, distributed.Client):
-        return executor, None
-    if isinstance(executor, str) and executor.startswith("local"):
-        n = None
-        if ":" in executor:
-            try:
-                n = int(executor.split(":", 1)[1])
-            except ValueError:
-                raise OrthoscopeError(
-                    f"--dask {executor!r}: write local or local:N (N workers)"
-                ) from None
-        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                           dashboard_address=None)  # fmt: skip
-        client = distributed.Client(cluster)
-
-        def close():
-            client.close()
-            cluster.close()
-
-        return client, close
-    if isinstance(executor, str) and "://" in executor:
-        try:
-            client = distributed.Client(executor, timeout="20s")
-        except OSError as e:
-            raise OrthoscopeError(f"cannot reach the Dask scheduler {executor}: {e}") from None
-        return client, client.close
-    raise OrthoscopeError(
-        f"executor {executor!r} is not known; use None/'local' (this machine), 'local[:N]' "
-        "(a Dask LocalCluster), 'tcp://HOST:PORT' or a distributed.Client"
-    )
 
 
 # ------------------------------------------------------------------------------ the result
@@ -562,7 +522,7 @@ def monte_carlo(
     else:
         client, close = (None, None)
         if any(k not in on_disk for k, _, _ in chunks):
-            client, close = _dask_client(executor)
+            client, close = dask_client(executor)
         try:
             # hash=False: a key of its own for each run. The default content-hashed key is the
             # same for a second run with the same setup on the same client, and the first run's

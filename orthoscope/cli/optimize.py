@@ -221,8 +221,11 @@ def cmd_optimize(args) -> int:
                 ("--workers", args.workers is not None),
                 ("--hops", args.hops is not None),
                 ("--glass-map", args.glass_map is not None),
+                ("--dask", args.dask is not None),
             ),
         )
+    if args.dask is not None and args.workers is not None:
+        raise CliError("--workers is for local processes; with --dask the cluster has its own")
     spec = read_spec(args.spec)
     if args.method is not None:
         spec = replace(spec, method=args.method)
@@ -364,7 +367,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
     spec = replace(spec, search=replace(spec.search, **over))  # the notes tell the settings
     prog = GlobalProgress(spec.search.starts, args.quiet or args.json)
     try:
-        res = global_optimize(lens, spec, progress=prog)
+        res = global_optimize(lens, spec, progress=prog, executor=args.dask)
     finally:
         prog.close()
     table = _operand_table(res.operands)
@@ -514,6 +517,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Worker processes (default: the spec's, else 1); the result does not depend on it.",
     )
     g.add_argument("--hops", type=int, metavar="N", help="Basin hops per start.")
+    g.add_argument(
+        "--dask",
+        metavar="EXECUTOR",
+        help="Run the starts on a Dask cluster: local:N (N worker processes here) or "
+        "tcp://HOST:PORT (a running scheduler); the same design as without it. Needs the dask "
+        "extra (pip install 'orthoscope[dask]').",
+    )
     g.add_argument(
         "--glass-map",
         metavar="FILE",

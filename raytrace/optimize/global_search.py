@@ -15,7 +15,8 @@ variables and draws a random real glass for every glass variable):
    merit is lower.
 
 The starts run in worker processes (``concurrent.futures.ProcessPoolExecutor``, spawn start
-method) or, with one worker, in this process. A worker receives the spec, the start lens and the
+method), as tasks on a Dask cluster (``executor``; :func:`raytrace.executors.dask_client`) or,
+with one worker, in this process. A worker receives the spec, the start lens and the
 start's number, nothing else. Start k draws its random numbers from
 ``numpy.random.SeedSequence(seed).spawn(starts)[k]`` only, and every local run is deterministic,
 so the same seed gives the same result — bit for bit — whatever the number of workers, as long as
@@ -442,6 +443,7 @@ def global_optimize(
     workers: int | None = None,
     progress: Callable[[SearchProgress], None] | None = None,
     hops: int | None = None,
+    executor=None,
 ) -> GlobalResult:
     """Global search for the spec's best design (module docstring).
 
@@ -458,6 +460,11 @@ def global_optimize(
     progress : callable, optional
         Called with a :class:`SearchProgress` after every local run and start (in this
         process); raising KeyboardInterrupt from it stops the search like Ctrl-C.
+    executor : str or distributed.Client, optional
+        Run the starts on a Dask cluster instead of local processes
+        (:func:`raytrace.executors.dask_client`: ``"local:N"``, ``"tcp://HOST:PORT"`` or a
+        client); ``workers`` then plays no part (the cluster has its own). The result is the
+        same design, bit for bit; progress comes once per finished start.
 
     Returns
     -------
@@ -499,7 +506,7 @@ def global_optimize(
         emit("start", o.index, o.hops - 1, o.merit)
 
     try:
-        if s.workers == 1:
+        if s.workers == 1 and executor is None:
             for k in range(s.starts):
                 if time.time() > deadline:
                     stopped = "time"
@@ -513,6 +520,8 @@ def global_optimize(
                 if o.stopped:
                     stopped = o.stopped
                     break
+        elif executor is not None:
+            stopped = _run_dask(executor, lens, spec, s, deadline, finished)
         else:
             stopped = _run_pool(lens, spec, s, deadline, emit, finished)
     except KeyboardInterrupt:
@@ -584,6 +593,70 @@ def global_optimize(
         converged=converged,
         message=msg,
     )
+
+
+#: how often (s) a start on a Dask worker asks the scheduler whether the search was stopped
+DASK_STOP_POLL_S = 1.0
+
+
+def _dask_start(lens: Lens, spec: DesignSpec, k: int, seed: int, deadline: float, stop: str):
+    """One start on a Dask worker; the stop signal is the distributed Event ``stop``."""
+    from distributed import Event
+
+    event = Event(stop)
+    asked = [-math.inf, False]
+
+    def should_stop() -> str | None:
+        now = time.time()
+        if now - asked[0] > DASK_STOP_POLL_S:
+            asked[0], asked[1] = now, event.is_set()
+        if asked[1]:
+            return "interrupted"
+        return "time" if now > deadline else None
+
+    return run_start(lens, spec, k, seed, should_stop, lambda *_: None)
+
+
+def _run_dask(executor, lens, spec, s: SearchSettings, deadline: float, finished) -> str:
+    """Run the starts as tasks on a Dask cluster; returns why it stopped early. A stop (time
+    budget, Ctrl-C) sets a distributed Event the running starts poll; every task then ends with
+    its best so far, and those are kept."""
+    import uuid
+
+    from distributed import Event, as_completed
+
+    from ..executors import dask_client
+
+    client, close = dask_client(executor)
+    name = f"orthoscope-global-stop-{uuid.uuid4().hex}"
+    event = Event(name, client=client)
+    stopped = ""
+    try:
+        futures = {
+            client.submit(_dask_start, lens, spec, k, s.seed, deadline, name, pure=False): k
+            for k in range(s.starts)
+        }
+        ac = as_completed(futures)
+        try:
+            for f in ac:
+                o = f.result()
+                finished(o)
+                if o.stopped and not stopped:
+                    stopped = o.stopped
+                if time.time() > deadline and not stopped:
+                    stopped = "time"
+                if stopped:
+                    event.set()
+        except KeyboardInterrupt:
+            stopped = "interrupted"
+            event.set()
+            for f in ac:  # the starts end at their next poll with their best so far
+                finished(f.result())
+    finally:
+        event.clear()
+        if close is not None:
+            close()
+    return stopped
 
 
 def _run_pool(lens, spec, s: SearchSettings, deadline: float, emit, finished) -> str:
