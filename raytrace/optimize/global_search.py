@@ -595,6 +595,16 @@ def global_optimize(
     )
 
 
+def _stop_reason(stopped: str, o: StartOutcome, deadline: float) -> str:
+    """Why the search stops after start ``o`` finished: the reason already known, else the
+    start's own (it was stopped), else the time budget (``deadline``, epoch s), else none."""
+    if stopped:
+        return stopped
+    if o.stopped:
+        return o.stopped
+    return "time" if time.time() > deadline else ""
+
+
 #: how often (s) a start on a Dask worker asks the scheduler whether the search was stopped
 DASK_STOP_POLL_S = 1.0
 
@@ -641,10 +651,7 @@ def _run_dask(executor, lens, spec, s: SearchSettings, deadline: float, finished
             for f in ac:
                 o = f.result()
                 finished(o)
-                if o.stopped and not stopped:
-                    stopped = o.stopped
-                if time.time() > deadline and not stopped:
-                    stopped = "time"
+                stopped = _stop_reason(stopped, o, deadline)
                 if stopped:
                     event.set()
         except KeyboardInterrupt:
@@ -687,12 +694,10 @@ def _run_pool(lens, spec, s: SearchSettings, deadline: float, emit, finished) ->
                 done, pending = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
                 drain()
                 for f in sorted(done, key=lambda f: futures[f]):
-                    if f.cancelled():
-                        continue
-                    o = f.result()
-                    finished(o)
-                    if o.stopped and not stopped:
-                        stopped = o.stopped
+                    if not f.cancelled():
+                        o = f.result()
+                        finished(o)
+                        stopped = _stop_reason(stopped, o, deadline)
                 if time.time() > deadline and not stopped:
                     stopped = "time"
                 if stopped:
