@@ -28,15 +28,26 @@ def surface_map(surface: int) -> Callable[[int], int]:
     return lambda j: j if j <= surface else j + 2
 
 
+def _surface_number(lens: Lens, surface, what: str) -> int:
+    if isinstance(surface, bool) or not isinstance(surface, int):
+        raise LensError(
+            f"{lens.name}: {what} must be a surface number (an integer), got {surface!r}"
+        )
+    return surface
+
+
 def _element(lens: Lens, surface: int) -> tuple[Surface, Surface]:
     n = lens.n_surfaces
+    surface = _surface_number(lens, surface, "the element to split")
     if not 1 <= surface < n:
         raise LensError(f"{lens.name}: no element starts at surface {surface} (1..{n - 1})")
     front, back = lens.surfaces[surface - 1], lens.surfaces[surface]
-    if front.material.is_air or not back.material.is_air:
+    before = lens.object_material if surface == 1 else lens.surfaces[surface - 2].material
+    if not before.is_air or front.material.is_air or not back.material.is_air:
         raise LensError(
             f"{lens.name}: surfaces {surface}-{surface + 1} are not a single element in air "
-            "(glass after the first, air after the second); name an element's first surface"
+            "(air before the first, glass after it, air after the second; a cemented group "
+            "cannot be split); name an element's first surface"
         )
     for s in (front, back):
         if s.is_placed or s.mirror or s.coordinate_break:
@@ -86,17 +97,24 @@ def split_element(lens: Lens, surface: int, *, gap: float = DEFAULT_GAP) -> Lens
     note = (
         f"element {surface}-{surface + 1} split in two (cut at c = {c_mid:.6g}/mm, gap {gap:g} mm)"
     )
-    return replace(lens, surfaces=new, notes=_with_note(lens.notes, note), path=None)
+    return _resolved(replace(lens, surfaces=new, notes=_with_note(lens.notes, note), path=None))
 
 
 def insert_element(
-    lens: Lens, after: int, material: Material, *, thickness: float = 2.0, gap: float = DEFAULT_GAP
+    lens: Lens,
+    after: int,
+    material: Material,
+    *,
+    thickness: float = 2.0,
+    gap: float | None = None,
 ) -> Lens:
     """Insert a plane-parallel plate of ``material`` into the air space after surface ``after``.
 
-    The plate (zero power: two flat surfaces, ``thickness`` mm) sits ``gap`` mm behind surface
-    ``after``; the air space behind it is shortened by ``gap + thickness``, so every later
-    vertex stays where it was. An optimizer then bends it into a lens.
+    The plate (zero power: two flat surfaces, ``thickness`` mm) sits in the middle of the air
+    space, or ``gap`` mm behind surface ``after``; the air behind it is shortened by ``gap +
+    thickness``, so every later vertex stays where it was (an image plane that was a Gaussian
+    solve is solved again: the plate moves the focus by t (1 − 1/n)). Its semi-diameter is the
+    larger of its neighbours'. An optimizer then bends it into a lens.
 
     Parameters
     ----------
@@ -105,9 +123,11 @@ def insert_element(
         The surface (1-based) with air after it; the image solve's last space counts.
     material : Material
         The new element's glass.
-    thickness, gap : float
-        Centre thickness of the plate and the air in front of it, mm (> 0); the air space must
-        be longer than ``gap + thickness + gap``.
+    thickness : float
+        Centre thickness of the plate, mm (> 0).
+    gap : float, optional
+        Air in front of the plate, mm (> 0); default: the middle of the space. The air space
+        must be longer than ``gap + thickness``.
 
     Returns
     -------
@@ -115,6 +135,7 @@ def insert_element(
         Two more surfaces; old surface ``j`` is ``surface_map(after)(j)``.
     """
     n = lens.n_surfaces
+    after = _surface_number(lens, after, "the surface to insert after")
     if not 1 <= after <= n:
         raise LensError(f"{lens.name}: no surface {after} to insert after (1..{n})")
     s0 = lens.surfaces[after - 1]
@@ -122,21 +143,37 @@ def insert_element(
         raise LensError(f"{lens.name}: the space after surface {after} is not air")
     if material.is_air:
         raise LensError(f"{lens.name}: an inserted element needs a glass, not air")
+    if gap is None:
+        gap = 0.5 * (s0.thickness - thickness)
     for v, what in ((thickness, "thickness"), (gap, "gap")):
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise LensError(f"{lens.name}: the inserted element's {what} must be positive (mm)")
+            raise LensError(
+                f"{lens.name}: the inserted element's {what} must be positive (mm); the air "
+                f"space after surface {after} is {s0.thickness:g} mm"
+            )
     rest = s0.thickness - gap - thickness
-    if not rest > gap:
+    if not rest > 0.0:
         raise LensError(
             f"{lens.name}: the air space after surface {after} is {s0.thickness:g} mm: too short "
-            f"for an element {thickness:g} mm thick with {gap:g} mm of air on each side"
+            f"for an element {thickness:g} mm thick {gap:g} mm behind the surface"
         )
-    plate1 = Surface(0.0, thickness, material)
-    plate2 = Surface(0.0, rest, AIR)
     s = lens.surfaces
+    sd = max(s0.semi_diameter, s[after].semi_diameter if after < n else s0.semi_diameter)
+    plate1 = Surface(0.0, thickness, material, semi_diameter=sd)
+    plate2 = Surface(0.0, rest, AIR, semi_diameter=sd)
     new = s[: after - 1] + (replace(s0, thickness=gap, line=None), plate1, plate2) + s[after:]
     note = f"element of {material.name or 'glass'} inserted after surface {after}"
-    return replace(lens, surfaces=new, notes=_with_note(lens.notes, note), path=None)
+    return _resolved(replace(lens, surfaces=new, notes=_with_note(lens.notes, note), path=None))
+
+
+def _resolved(lens: Lens) -> Lens:
+    """An image plane that was a Gaussian solve is solved again for the edited lens."""
+    if lens.image_solve != "gaussian":
+        return lens
+    from .paraxial import paraxial
+
+    d = paraxial(lens.with_image_distance(0.0)).gaussian_image_distance
+    return replace(lens.with_image_distance(d), image_solve="gaussian")
 
 
 def _with_note(notes: str, note: str) -> str:

@@ -53,12 +53,13 @@ def test_an_inserted_plate_shifts_the_focus_by_t_times_one_minus_one_over_n():
     ins = insert_element(lens, last, fixed_index(n), thickness=t, gap=5.0)
     assert ins.n_surfaces == lens.n_surfaces + 2
     assert element_power(ins, last + 1, last + 2) == 0.0  # two flat surfaces
-    # every old vertex and the old image plane stay where they were
+    # every old vertex stays where it was
     assert list(ins.vertex_z[:last]) == pytest.approx(list(lens.vertex_z))
-    assert ins.image_z == pytest.approx(lens.image_z, abs=1e-12)
-    # the Gaussian image moves back by t (1 - 1/n)
+    # the Gaussian image moves back by t (1 - 1/n), and the file's Gaussian image solve with it
     z0, z1 = paraxial(lens).z_gauss, paraxial(ins).z_gauss
     assert z1 - z0 == pytest.approx(t * (1 - 1 / n), rel=1e-9)
+    assert lens.image_solve == ins.image_solve == "gaussian"
+    assert ins.image_z - lens.image_z == pytest.approx(t * (1 - 1 / n), rel=1e-9)
 
 
 def test_splitting_a_singlet_lowers_its_least_spherical_aberration():
@@ -114,8 +115,9 @@ def test_split_design_renumbers_the_spec_and_repeats_the_element_rules():
         ("curvature", 4): (-0.2, 0.2),  # the cut surfaces: the union of the element's bounds
         ("curvature", 5): (-0.2, 0.2),
         ("thickness", 5): (0.8, 5.0),  # the second half
-        ("thickness", 4): (0.1, float("inf")),  # the gap: the spec's smallest air bound 0.3, or 0.1
+        ("thickness", 4): (0.3, float("inf")),  # the gap: the spec's smallest air bound
     }
+    assert new_lens.surfaces[3].thickness == 0.3  # the gap, raised from 0.1 to that bound
     ops = [(o.type, o.params) for o in new.operands]
     assert ("ray_height", {"surface": 8, "field": 10.0, "max": 20.0}) in ops
     assert ("element_power", {"surface": 1, "last": 8, "min": 0.0}) in ops
@@ -141,7 +143,7 @@ def test_insert_design_moves_the_air_space_variable_behind_the_new_element():
         ("curvature", 1): (-float("inf"), float("inf")),
         ("curvature", 3): (-float("inf"), float("inf")),
         ("curvature", 4): (-float("inf"), float("inf")),
-        ("thickness", 3): (1.5, float("inf")),  # the new glass (no glass bound in the spec)
+        ("thickness", 3): (0.5, float("inf")),  # the new glass (no glass bound: MIN_GLASS)
         ("thickness", 4): (0.5, 30.0),  # the old air space, now behind the new element
         ("thickness", 2): (0.5, float("inf")),  # the gap in front of it
     }
@@ -156,8 +158,14 @@ def test_edits_refuse_what_is_not_an_element_or_an_air_space():
         split_element(lens, 6)
     with pytest.raises(LensError, match=r"the space after surface 1 is not air"):
         insert_element(lens, 1, fixed_index(1.5))
-    with pytest.raises(LensError, match=r"too short"):
-        insert_element(lens, 2, fixed_index(1.5), thickness=10.0)
+    with pytest.raises(LensError, match=r"too short for an element 5 mm thick 1 mm behind"):
+        insert_element(lens, 2, fixed_index(1.5), thickness=5.0, gap=1.0)
+    with pytest.raises(LensError, match=r"gap must be positive .* space after surface 2 is 6 mm"):
+        insert_element(lens, 2, fixed_index(1.5), thickness=10.0)  # in the middle: no room
+    with pytest.raises(LensError, match=r"a cemented group cannot be split"):
+        split_element(load_lens("tessar-fr1066698"), 7)  # the rear of the cemented doublet
+    with pytest.raises(LensError, match=r"must be a surface number \(an integer\), got True"):
+        split_element(lens, True)
 
 
 def test_cli_split_writes_a_lens_that_records_the_edit(tmp_path):
@@ -188,3 +196,61 @@ def test_cli_split_writes_a_lens_that_records_the_edit(tmp_path):
         lines = [x for x in bad.stderr.splitlines() if "compiling" not in x]
         assert bad.returncode == 2 and len(lines) == 1 and msg in lines[0], bad.stderr
     assert not (tmp_path / "x.toml").exists()
+
+
+def test_split_design_carries_pickups_element_power_and_only_minimum_rules():
+    from raytrace.optimize import Pickup, SpecError
+
+    lens = load_lens("cooke-triplet-f4")
+    spec = replace(
+        singlet_spec(),
+        start="cooke-triplet-f4",
+        variables=(Variable("thickness", 1, 1.0, 5.0), Variable("index", 1, 1.5, 1.9)),
+        pickups=(Pickup("thickness", 5, 1), Pickup("index", 5, 1)),  # the symmetric triplet
+        operands=(
+            Operand("element_power", 0.0, 1.0, {"surface": 5, "min": 0.0}),
+            Operand("center_thickness", 2.0, 1.0, {"surface": 5}),  # a target: first half only
+            Operand("center_thickness", params={"surface": 5, "min": 0.8}),  # a rule: both
+        ),
+    )
+    new_lens, new = split_design(lens, spec, 5)
+    check_spec(new_lens, new)
+    assert set(new.pickups) == {
+        Pickup("thickness", 5, 1, 0.5, 0.0),  # the element's thickness, shared by its halves
+        Pickup("thickness", 7, 1, 0.5, 0.0),
+        Pickup("index", 5, 1),
+        Pickup("index", 7, 1),
+    }
+    ops = [(o.type, o.target, o.params) for o in new.operands]
+    assert ("element_power", 0.0, {"surface": 5, "last": 8, "min": 0.0}) in ops  # the element
+    assert ("center_thickness", 2.0, {"surface": 5}) in ops
+    assert ("center_thickness", 2.0, {"surface": 7}) not in ops
+    assert ("center_thickness", 0.0, {"surface": 7, "min": 0.8}) in ops
+    # the element still has its power: the split keeps it in the thin-lens limit
+    (p0,) = evaluate(lens, spec.operands[:1])
+    (p1,) = evaluate(new_lens, new.operands[:1])
+    assert p1.value == pytest.approx(p0.value, rel=0.05)
+    # an element whose thickness feeds a pick-up cannot be split blindly
+    with pytest.raises(SpecError, match=r"thickness of surface 1 is the source of a pick-up"):
+        split_design(lens, spec, 1)
+    # the spec is checked against the start lens first: errors in the user's numbering
+    bad = replace(
+        spec,
+        operands=(Operand("edge_thickness", params={"surface": -10, "height": 3, "min": 0.1}),),
+    )
+    with pytest.raises(SpecError, match=r"surface -10"):
+        split_design(lens, bad, 3)
+
+
+def test_a_minimax_start_that_cannot_be_traced_is_a_clean_error():
+    from raytrace.errors import TraceError
+
+    lens = load_lens("cooke-triplet-f4")
+    spec = replace(
+        singlet_spec(),
+        start="cooke-triplet-f4",
+        method="minimax",
+        operands=(Operand("ray_height", 0.0, 1.0, {"surface": 2, "field": 95.0, "max": 10.0}),),
+    )
+    with pytest.raises(TraceError, match=r"strictly between -90 and 90"):
+        optimize(lens, spec)

@@ -207,7 +207,7 @@ def test_element_power_parameters_are_checked():
     ]
     lens = _stop_and_lens(10.0)  # 3 surfaces
     for params, msg in (
-        ({"surface": 3}, r"surface 3 does not exist \(1\.\.2"),
+        ({"surface": 3}, r"surface 3 is the last; it needs the next surface \(give 'last'"),
         ({"surface": 1, "last": 4}, r"last surface 4 does not exist \(the lens has 3\)"),
     ):
         spec = DesignSpec(

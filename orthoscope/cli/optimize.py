@@ -269,22 +269,47 @@ def _edit_elements(args, lens, spec):
     for text in args.insert or ():
         after, sep, glass = str(text).partition(":")
         if not (sep and after.strip().isdigit() and glass.strip()):
-            raise CliError(f"--insert {text}: use AFTER:GLASS, e.g. --insert 4:N-BK7")
+            raise CliError(
+                f"--insert {text}: use AFTER:GLASS, e.g. --insert 4:N-BK7 (a catalog glass) or "
+                "--insert 4:1.62/60.3 (nd/vd model glass)"
+            )
         edits.append((int(after), "insert", glass.strip()))
     if not edits:
         return lens, spec
-    from raytrace.glass import lookup_glass
+    places = [(k, what) for k, what, _ in edits]
+    twice = sorted({f"--{w} {k}" for k, w in places if places.count((k, w)) > 1})
+    if twice:
+        raise CliError(
+            f"{', '.join(twice)} given twice: each element is split (each air space filled) "
+            "once per run; run again on the result for more"
+        )
     from raytrace.optimize import insert_design, split_design
 
-    flags = [f"--split {k}" for k in args.split or ()] + [
-        f"--insert {t}" for t in args.insert or ()
-    ]
+    flags = [f"--split {k}" for k in args.split or ()]
+    flags += [f"--insert {t}" for t in args.insert or ()]
     for k, what, glass in sorted(edits, key=lambda e: e[0], reverse=True):
         if what == "split":
             lens, spec = split_design(lens, spec, k)
         else:
-            lens, spec = insert_design(lens, spec, k, lookup_glass(glass).material)
+            lens, spec = insert_design(lens, spec, k, _glass_material(glass))
     return lens, replace(spec, start=f"{spec.start} edited by {' '.join(flags)}")
+
+
+def _glass_material(text: str):
+    """--insert's glass: a catalog name (N-BK7, N-BK7_SCHOTT) or an nd/vd model glass."""
+    from raytrace.glass import lookup_glass
+    from raytrace.materials import model_glass
+
+    nd, sep, vd = text.partition("/")
+    if sep:
+        try:
+            return model_glass(float(nd), float(vd))
+        except ValueError:
+            raise CliError(
+                f"--insert ...:{text}: an nd/vd model glass is two numbers (nd > 1, vd > 0), "
+                "e.g. 1.62/60.3"
+            ) from None
+    return lookup_glass(text).material
 
 
 def _write_design(args, res, spec, out, inputs, notes, source: str) -> bool:

@@ -3,11 +3,9 @@ with the spec renumbered to match, so a run can go on with one element more.
 
 Every surface number of the spec (variables, pick-ups and sources, operands' ``surface`` and
 ``last``) is carried to the edited lens by :func:`raytrace.elements.surface_map`, and the new
-surfaces get variables like their neighbours': a split element's halves both keep the element's
-curvature, thickness and glass freedom (the cut surfaces are free within the union of the
-element's curvature bounds, the gap a thickness variable above the spec's smallest air
-bound); an inserted element's two curvatures are free and its thickness is a variable above the
-spec's smallest glass bound.
+surfaces get variables and rules like their neighbours' (:func:`split_design`,
+:func:`insert_design`). The spec is checked against the start lens first, so its errors speak of
+the surfaces the user wrote.
 """
 
 from __future__ import annotations
@@ -18,12 +16,15 @@ from dataclasses import replace
 from ..elements import DEFAULT_GAP, insert_element, split_element, surface_map
 from ..lens import Lens
 from ..materials import Material
-from .spec import DesignSpec, Operand, Variable
+from .solver import check_spec
+from .spec import DesignSpec, Operand, Pickup, SpecError, Variable
 
 
 def _renumbered(spec: DesignSpec, where) -> DesignSpec:
     def op(o: Operand) -> Operand:
         p = dict(o.params)
+        if o.type == "element_power" and "last" not in p:
+            p["last"] = int(p["surface"]) + 1  # the element it meant, written out
         for k in ("surface", "last"):
             if k in p:
                 p[k] = where(int(p[k]))
@@ -39,8 +40,13 @@ def _renumbered(spec: DesignSpec, where) -> DesignSpec:
     )
 
 
-def _smallest_bound(lens: Lens, spec: DesignSpec, glass: bool, default: float) -> float:
-    """The smallest lower bound of the spec's thickness variables on glass (or air) spaces."""
+#: the lower bound of an inserted element's thickness when the spec bounds no glass thickness
+MIN_GLASS = 0.5
+
+
+def _smallest_bound(lens: Lens, spec: DesignSpec, glass: bool) -> float | None:
+    """The smallest lower bound of the spec's thickness variables on glass (or air) spaces,
+    None when it has none."""
     lows = [
         v.lower
         for v in spec.variables
@@ -49,7 +55,12 @@ def _smallest_bound(lens: Lens, spec: DesignSpec, glass: bool, default: float) -
         and lens.surfaces[v.surface - 1].material.is_air != glass
         and math.isfinite(v.lower)
     ]
-    return min(lows) if lows else default
+    return min(lows) if lows else None
+
+
+def _min_rule(o: Operand) -> bool:
+    """A shop rule: a bound with a minimum only (no target, no maximum)."""
+    return "min" in o.params and "max" not in o.params
 
 
 def split_design(
@@ -65,22 +76,42 @@ def split_design(
     surface : int
         The element's first surface (1-based, numbering of ``lens``).
     gap : float
-        Air between the halves, mm.
+        Air between the halves, mm; raised to the spec's smallest air-thickness bound.
 
     Returns
     -------
     (Lens, DesignSpec)
-        The lens with two surfaces more and the spec for it: the element's variables of
-        curvature, thickness, index / Abbe number and glass also on the new half (surface + 2,
-        the same bounds), the two cut surfaces free in curvature (within the union of the
-        element's curvature bounds) when either element surface was, the gap a thickness
-        variable (from the spec's smallest air bound, else ``gap``) when the element's
-        thickness was. The element's centre and edge thickness operands are repeated on the
-        second half, and the gap gets the spec's smallest air edge rule (``min``) at the
-        element's edge heights.
+        The lens with two surfaces more and the spec for it:
+
+        - the element's variables of curvature, thickness, index, Abbe number and glass are
+          repeated on the second half (surface + 2, the same bounds; a half below a glass
+          thickness bound starts at the bound, which changes the lens), the two cut surfaces are
+          free in curvature within the union of the element's curvature bounds when either
+          element surface was, and the gap is a thickness variable above the spec's smallest
+          air bound when the element's thickness was;
+        - pick-ups onto the element go to both halves (a thickness pick-up at half its factor
+          and offset);
+        - the element's minimum rules (``center_thickness`` / ``edge_thickness`` with ``min``
+          only) are repeated on the second half, and the gap gets the spec's smallest air edge
+          ``min`` at the element's edge heights; targets and maxima on the element's thickness
+          stay on the first half.
+
+    Raises
+    ------
+    SpecError
+        The spec does not fit the lens, or the element's thickness is the source of a pick-up
+        (after the split the element has two).
     """
-    new_lens = split_element(lens, surface, gap=gap)
+    check_spec(lens, spec, need_continuous=False)
     k = surface
+    if any(p.kind == "thickness" and p.source == k for p in spec.pickups):
+        raise SpecError(
+            f"the thickness of surface {k} is the source of a pick-up: split in two, the "
+            "element has two thicknesses; change the pick-up first"
+        )
+    air_low = _smallest_bound(lens, spec, glass=False)
+    gap = max(gap, air_low) if air_low is not None else gap
+    new_lens = split_element(lens, k, gap=gap)
     out = _renumbered(spec, surface_map(k))
     added: list[Variable] = []
     curv = [v for v in spec.variables if v.kind == "curvature" and v.surface in (k, k + 1)]
@@ -91,20 +122,28 @@ def split_design(
         if v.surface == k and v.kind in ("thickness", "index", "abbe", "glass"):
             added.append(replace(v, surface=k + 2))
             if v.kind == "thickness":
-                air_low = _smallest_bound(lens, spec, glass=False, default=gap)
-                added.append(Variable("thickness", k + 1, min(air_low, gap), math.inf))
-    # the element's own rules hold for both halves: its centre / edge thickness operands are
-    # repeated on the second half, and the gap gets the spec's air edge rule at the same height
+                added.append(Variable("thickness", k + 1, gap if air_low is None else air_low))
+    pickups: list[Pickup] = []
+    for p in out.pickups:
+        if p.surface != k:
+            pickups.append(p)
+        elif p.kind == "thickness":  # the element's thickness, shared by its halves
+            half = replace(p, factor=0.5 * p.factor, offset=0.5 * p.offset)
+            pickups += [half, replace(half, surface=k + 2)]
+        else:
+            pickups += [p, replace(p, surface=k + 2)]
     rules = [
         o
         for o in out.operands
-        if o.type in ("center_thickness", "edge_thickness") and o.params["surface"] == k
+        if o.type in ("center_thickness", "edge_thickness")
+        and o.params["surface"] == k
+        and _min_rule(o)
     ]
     air_edges = [
         o.params["min"]
         for o in spec.operands
         if o.type == "edge_thickness"
-        and "min" in o.params
+        and _min_rule(o)
         and o.params["surface"] < lens.n_surfaces
         and lens.surfaces[o.params["surface"] - 1].material.is_air
     ]
@@ -116,7 +155,10 @@ def split_design(
             if o.type == "edge_thickness"
         ]
     return new_lens, replace(
-        out, variables=out.variables + tuple(added), operands=out.operands + tuple(extra)
+        out,
+        variables=out.variables + tuple(added),
+        pickups=tuple(pickups),
+        operands=out.operands + tuple(extra),
     )
 
 
@@ -127,30 +169,43 @@ def insert_design(
     material: Material,
     *,
     thickness: float = 2.0,
-    gap: float = DEFAULT_GAP,
+    gap: float | None = None,
 ) -> tuple[Lens, DesignSpec]:
     """Insert a plate of ``material`` after surface ``after``
-    (:func:`raytrace.elements.insert_element`) and renumber ``spec`` to match: the new
-    element's two curvatures free, its thickness a variable from the spec's smallest glass
-    bound (else ``thickness``); when the air space it was put in was a thickness variable, the
-    air behind the new element takes that variable (its bounds) and the gap in front of it one
-    from the spec's smallest air bound (else ``gap``)."""
+    (:func:`raytrace.elements.insert_element`; in the middle of the air space unless ``gap``)
+    and renumber ``spec`` to match.
+
+    The new element's two curvatures are free and its thickness (raised to the spec's smallest
+    glass-thickness bound) is a variable above that bound (else above :data:`MIN_GLASS`); when
+    the air space it went into was a thickness variable, the air behind the new element takes
+    that variable (its bounds) and the air in front of it one above the spec's smallest air
+    bound (else above :data:`raytrace.elements.DEFAULT_GAP`).
+
+    Raises
+    ------
+    SpecError
+        The spec does not fit the lens.
+    """
+    check_spec(lens, spec, need_continuous=False)
+    glass_low = _smallest_bound(lens, spec, glass=True)
+    air_low = _smallest_bound(lens, spec, glass=False)
+    if glass_low is not None:
+        thickness = max(thickness, glass_low)
     new_lens = insert_element(lens, after, material, thickness=thickness, gap=gap)
     out = _renumbered(spec, surface_map(after))
     a = after
-    glass_low = _smallest_bound(lens, spec, glass=True, default=thickness)
-    air_low = _smallest_bound(lens, spec, glass=False, default=gap)
     keep, added = (
         [],
         [
             Variable("curvature", a + 1),
             Variable("curvature", a + 2),
-            Variable("thickness", a + 1, min(glass_low, thickness), math.inf),
+            Variable("thickness", a + 1, MIN_GLASS if glass_low is None else glass_low),
         ],
     )
     for v in out.variables:
         if v.kind == "thickness" and v.surface == a:  # the space now behind the new element
-            added += [replace(v, surface=a + 2), Variable("thickness", a, min(air_low, gap))]
+            front = DEFAULT_GAP if air_low is None else air_low
+            added += [replace(v, surface=a + 2), Variable("thickness", a, front)]
         else:
             keep.append(v)
     return new_lens, replace(out, variables=tuple(keep) + tuple(added))

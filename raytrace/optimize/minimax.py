@@ -61,7 +61,7 @@ from .solver import (
     start_values,
     variable_scales,
 )
-from .spec import ASPHERIC_KINDS, DesignSpec
+from .spec import ASPHERIC_KINDS, DesignSpec, SpecError
 
 #: the trust radius (in units of :func:`step_scales`) below which the run ends
 MIN_RADIUS = 1e-9
@@ -216,13 +216,18 @@ def minimax(
     n_ev = [0]
     t0 = time.perf_counter()
 
-    def ev(xv: np.ndarray):
+    def ev(xv: np.ndarray, start: bool = False):
         try:
             vals = checked_evaluate(lens, spec, xv, stop, n_ev)
         except EVAL_FAILURES as err:
+            if start:  # the start must evaluate: its own error, as damped least squares gives it
+                raise
             raise _Failed(str(err)) from None
         e, g = split(spec, vals)
         if not (np.all(np.isfinite(e)) and np.all(np.isfinite(g))):
+            if start:
+                bad = next(o for o in vals if not math.isfinite(o.residual))
+                raise SpecError(f"the start lens: operand {bad.operand.label()} is not finite")
             raise _Failed("an operand is not finite")
         if progress is not None:
             progress(n_ev[0], _max_abs(e), max(vals, key=lambda o: abs(o.residual)))
@@ -231,7 +236,7 @@ def minimax(
     def phi(e, g) -> float:
         return _max_abs(e) + P * float(np.sum(np.maximum(g, 0.0)))
 
-    e, g, vals = ev(x)  # the start must evaluate: its errors propagate
+    e, g, vals = ev(x, start=True)
     m0 = _max_abs(e)
     f = phi(e, g)
     radius = 1.0

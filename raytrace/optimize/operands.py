@@ -132,6 +132,15 @@ def _pupil_rays(
     p0 tan α; "height": object height in mm). Every ray starts on one plane before the first
     vertex.
     """
+    if kind == "angle" and not abs(field_value) < 90.0:
+        raise TraceError(
+            f"field {field_value:g} deg: field angles must lie strictly between -90 and 90 degrees"
+        )
+    if kind == "height" and par.infinite:
+        raise TraceError(
+            f"field {field_value:g} mm: object heights need a finite object distance "
+            "(give object_distance, object_s or object_scale, or an angle)"
+        )
     a = par.epd / 2.0
     px, py = np.asarray(px, float), np.asarray(py, float)
     zE = par.z_E0

@@ -260,7 +260,12 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
             op.type == "element_power" and "last" not in op.params
         )
         last = n - 1 if pair else n  # the surface and the next one
-        if not 1 <= s <= last:
+        if pair and s == n:
+            probs.append(
+                f"operand {op.type}: surface {s} is the last; it needs the next surface"
+                + (" (give 'last' for a run of surfaces)" if op.type == "element_power" else "")
+            )
+        elif not 1 <= s <= last:
             probs.append(
                 f"operand {op.type}: surface {s!r} does not exist (1..{last} for this lens)"
             )
@@ -403,7 +408,10 @@ def optimize(
         converged = False
         msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g} ({message})"
     elif status == 0:
-        msg = f"stopped at the evaluation limit ({limit}) before converging"
+        msg = (
+            f"stopped at the evaluation limit ({limit} merit evaluations of the solver's steps; "
+            f"{n_ev[0]} with its finite-difference Jacobians) before converging"
+        )
     return OptimizationResult(
         lens=final,
         x=np.asarray(x_final, dtype=float),
