@@ -28,6 +28,20 @@ def surface_map(surface: int) -> Callable[[int], int]:
     return lambda j: j if j <= surface else j + 2
 
 
+def elements(lens: Lens) -> tuple[int, ...]:
+    """The first surfaces (1-based) of the lens's single elements in air that
+    :func:`split_element` accepts: air in front, glass after the surface, air after the next,
+    both surfaces centred and refracting."""
+    out = []
+    for k in range(1, lens.n_surfaces):
+        try:
+            _element(lens, k)
+        except LensError:
+            continue
+        out.append(k)
+    return tuple(out)
+
+
 def _surface_number(lens: Lens, surface, what: str) -> int:
     if isinstance(surface, bool) or not isinstance(surface, int):
         raise LensError(

@@ -13,6 +13,7 @@ splitting").
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from dataclasses import replace
@@ -254,3 +255,46 @@ def test_a_minimax_start_that_cannot_be_traced_is_a_clean_error():
     )
     with pytest.raises(TraceError, match=r"strictly between -90 and 90"):
         optimize(lens, spec)
+
+
+def test_scan_splits_tries_every_element_and_the_cli_keeps_the_best(tmp_path):
+    from raytrace.optimize import scan_splits
+
+    lens = load_lens("cooke-triplet-f4")
+    spec = replace(
+        singlet_spec(),
+        start="cooke-triplet-f4",
+        variables=tuple(Variable("curvature", k) for k in range(1, 7)),
+        operands=(
+            Operand("efl", 50.0, 100.0),
+            Operand("rms_spot", 0.0, 1000.0, {"field": 0.0, "plane": "best"}),
+        ),
+        max_evaluations=80,
+    )
+    trials = scan_splits(lens, spec)
+    assert [t.surface for t in trials] == [1, 3, 5]
+    assert all(t.result is not None and math.isfinite(t.merit) for t in trials)
+    # each trial is the run split_design + optimize gives (deterministic)
+    l3, s3 = split_design(lens, spec, 3)
+    assert trials[1].merit == optimize(l3, s3).merit
+    best = min(trials, key=lambda t: t.merit)
+    # the CLI: --split auto writes the best split and names every merit in the notes
+    from raytrace.files import save_lens
+
+    save_lens(lens, tmp_path / "start.toml")
+    text = 'start = "start.toml"\nmax_evaluations = 80\nvariables = ['
+    text += ", ".join(f'{{ kind = "curvature", surface = {k} }}' for k in range(1, 7)) + " ]\n"
+    text += 'operands = [ { type = "efl", target = 50, weight = 100 },\n'
+    text += '  { type = "rms_spot", field = 0, plane = "best", target = 0, weight = 1000 } ]\n'
+    (tmp_path / "s.toml").write_text(text, encoding="utf-8")
+    out = tmp_path / "best.toml"
+    cmd = [sys.executable, "-m", "orthoscope", "optimize", str(tmp_path / "s.toml"), "-o", str(out)]
+    r = subprocess.run([*cmd, "--split", "auto", "--write-anyway"], capture_output=True, text=True)
+    assert r.returncode in (0, 1), r.stderr
+    for t in trials:
+        assert f"--split {t.surface}: merit {t.merit:.6g}" in r.stderr
+    written = load_lens(str(out))
+    assert written.n_surfaces == 8
+    assert f"edited by --split {best.surface} (best of --split auto" in written.notes
+    bad = subprocess.run([*cmd, "--split", "auto", "--global"], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--split auto tries each element alone" in bad.stderr

@@ -259,13 +259,60 @@ def cmd_optimize(args) -> int:
         check_output(gm, inputs=inputs, overwrite=args.force, flag="--force")
     if args.global_search:
         return _run_global(args, spec, lens, out, inputs, over)
+    if args.split == ["auto"]:
+        return _run_split_scan(args, spec, lens, out, inputs)
     return _run_local(args, spec, lens, out, inputs)
+
+
+def _run_split_scan(args, spec, lens, out, inputs) -> int:
+    """--split auto: every element split in turn, a local run each; the best goes on."""
+    from raytrace.optimize import scan_splits, split_design
+
+    quiet = args.quiet or args.json
+
+    def said(t) -> None:
+        if not quiet:
+            what = f"merit {t.merit:.6g}" if t.result is not None else f"no run: {t.error}"
+            print(f"--split {t.surface}: {what}", file=sys.stderr, flush=True)
+
+    trials = scan_splits(lens, spec, progress=said)
+    done = [t for t in trials if t.result is not None]
+    if not done:
+        raise CliError(
+            "--split auto: no element could be split and optimized ("
+            + "; ".join(f"{t.surface}: {t.error}" for t in trials)
+            + ")"
+        )
+    best = min(done, key=lambda t: (t.merit, t.surface))
+    tried = ", ".join(
+        f"{t.surface}: {t.merit:.4g}" if t.result is not None else f"{t.surface}: no run"
+        for t in trials
+    )
+    lens, spec = split_design(lens, spec, best.surface)
+    spec = replace(
+        spec,
+        start=f"{spec.start} edited by --split {best.surface} (best of --split auto, merits "
+        f"by element {tried})",
+    )
+    return _run_local(args, spec, lens, out, inputs, res=best.result)
 
 
 def _edit_elements(args, lens, spec):
     """Apply --split K and --insert K:GLASS to the start lens and renumber the spec (surface
     numbers of the start lens; applied from the last surface back so each keeps its meaning)."""
-    edits = [(k, "split", None) for k in args.split or ()]
+    if args.split and "auto" in args.split:
+        if len(args.split) > 1 or args.insert or args.global_search:
+            raise CliError(
+                "--split auto tries each element alone with a local run: give it without "
+                "other --split / --insert and without --global (run --global on its result)"
+            )
+        return lens, spec
+    splits = []
+    for text in args.split or ():
+        if not str(text).strip().isdigit():
+            raise CliError(f"--split {text}: give the element's first surface number, or auto")
+        splits.append(int(text))
+    edits = [(k, "split", None) for k in splits]
     for text in args.insert or ():
         after, sep, glass = str(text).partition(":")
         if not (sep and after.strip().isdigit() and glass.strip()):
@@ -347,13 +394,15 @@ def _result_json(spec, res, out, written, table, before=None, after=None) -> dic
     }
 
 
-def _run_local(args, spec, lens, out, inputs) -> int:
+def _run_local(args, spec, lens, out, inputs, res=None) -> int:
+    """A local run (or its result ``res``, already computed) reported and written."""
     from raytrace.optimize import optimize
 
     name = MERIT_NAMES[spec.method]
-    prog = _Progress(args.quiet or args.json, "max|r|" if spec.method == "minimax" else "merit")
-    res = optimize(lens, spec, progress=prog)
-    prog.done()
+    if res is None:
+        prog = _Progress(args.quiet or args.json, "max|r|" if spec.method == "minimax" else "merit")
+        res = optimize(lens, spec, progress=prog)
+        prog.done()
     table = _operand_table(res.operands)
     written = _write_design(
         args, res, spec, out, inputs,
@@ -562,18 +611,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     e = q.add_argument_group("elements (surface numbers of the start lens; the spec follows)")
     e.add_argument(
         "--split",
-        type=int,
         action="append",
         metavar="K",
         help="Split the element whose first surface is K in two (cut at the mean curvature, "
-        "0.1 mm apart), with variables and rules for the new half; repeatable.",
+        "0.1 mm apart), with variables and rules for the new half; repeatable. 'auto': try "
+        "every element with a local run and keep the best (not with --global).",
     )
     e.add_argument(
         "--insert",
         action="append",
         metavar="K:GLASS",
-        help="Insert a 2 mm plate of catalog GLASS into the air space after surface K (free "
-        "curvatures, thickness variable); repeatable.",
+        help="Insert a 2 mm plate of GLASS (a catalog name, or nd/vd such as 1.62/60.3) in the "
+        "middle of the air space after surface K (free curvatures, thickness variable); "
+        "repeatable.",
     )
     q.add_argument("--quiet", action="store_true", help="No progress display.")
     add_force_arg(q)

@@ -5,7 +5,7 @@ glass-substitution pool (:mod:`.glasses`), the global search (:mod:`.global_sear
 splitting / adding with the spec renumbered (:mod:`.elements`). Imports
 scipy; nothing else in the engine needs it."""
 
-from .elements import insert_design, split_design
+from .elements import SplitTrial, insert_design, scan_splits, split_design
 from .glasses import GlassPool, availability, glass_pool
 from .global_search import GlassChoice, GlobalResult, SearchProgress, global_optimize
 from .operands import OperandValue, evaluate, merit
@@ -38,6 +38,7 @@ __all__ = [
     "SearchProgress",
     "SearchSettings",
     "SpecError",
+    "SplitTrial",
     "Variable",
     "apply",
     "availability",
@@ -50,6 +51,7 @@ __all__ = [
     "optimize",
     "parse_duration",
     "read_spec",
+    "scan_splits",
     "split_design",
     "start_lens",
 ]

@@ -11,12 +11,13 @@ the surfaces the user wrote.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
-from ..elements import DEFAULT_GAP, insert_element, split_element, surface_map
+from ..elements import DEFAULT_GAP, elements, insert_element, split_element, surface_map
 from ..lens import Lens
 from ..materials import Material
-from .solver import check_spec
+from .solver import EVAL_FAILURES, OptimizationResult, check_spec, optimize
 from .spec import DesignSpec, Operand, Pickup, SpecError, Variable
 
 
@@ -209,3 +210,49 @@ def insert_design(
         else:
             keep.append(v)
     return new_lens, replace(out, variables=tuple(keep) + tuple(added))
+
+
+@dataclass(frozen=True)
+class SplitTrial:
+    """One element of :func:`scan_splits`: its first ``surface`` (start-lens numbering), the
+    local run's ``result`` on the lens with that element split (None when the split was refused
+    or the run failed: ``error`` says why)."""
+
+    surface: int
+    result: OptimizationResult | None
+    error: str = ""
+
+    @property
+    def merit(self) -> float:
+        """The run's merit (its method's), inf when there is none."""
+        return math.inf if self.result is None else self.result.merit
+
+
+def scan_splits(
+    lens: Lens,
+    spec: DesignSpec,
+    *,
+    progress: Callable[[SplitTrial], None] | None = None,
+) -> tuple[SplitTrial, ...]:
+    """Where to split: every single element of ``lens`` split in turn (:func:`split_design`)
+    and the spec's local run (its ``method``) from each; ``progress(trial)`` after each.
+
+    Returns
+    -------
+    tuple of SplitTrial
+        One per element (:func:`raytrace.elements.elements`), in surface order; the best is
+        ``min(trials, key=lambda t: t.merit)``. The runs are deterministic: the same lens and
+        spec give the same trials.
+    """
+    check_spec(lens, spec, need_continuous=False)
+    out = []
+    for k in elements(lens):
+        try:
+            l2, s2 = split_design(lens, spec, k)
+            t = SplitTrial(k, optimize(l2, s2))
+        except (SpecError, *EVAL_FAILURES) as e:
+            t = SplitTrial(k, None, str(e))
+        out.append(t)
+        if progress is not None:
+            progress(t)
+    return tuple(out)
