@@ -333,17 +333,23 @@ def test_dask_cluster_gives_the_same_design_as_one_process():
     merits and the same design, bit for bit, as in this process; a time budget stops it with
     the best design so far."""
     pytest.importorskip("distributed")
+    from raytrace.executors import dask_client
+
     lens = load_lens("cooke-triplet-f4")
     spec = cooke_multimodal(starts=2)
     here = global_optimize(lens, spec, seed=7, workers=1)
-    dask = global_optimize(lens, spec, seed=7, executor="local:2")
+    client, close = dask_client("local:2")  # one cluster for both runs (a client is accepted)
+    try:
+        dask = global_optimize(lens, spec, seed=7, executor=client)
+        budget = global_optimize(
+            lens, cooke_multimodal(starts=12), seed=7, executor=client, time_budget_s=1.0
+        )
+    finally:
+        close()
     assert np.array_equal(here.start_merits, dask.start_merits)
     assert here.merit == dask.merit and not dask.stopped
     for a, b in zip(here.lens.surfaces, dask.lens.surfaces, strict=True):
         assert a.curvature == b.curvature
-    budget = global_optimize(
-        lens, cooke_multimodal(starts=12), seed=7, executor="local:1", time_budget_s=1.0
-    )
     assert budget.stopped == "time" and math.isfinite(budget.merit)
     assert np.isnan(budget.start_merits).any()  # not every start ran to its end
 
