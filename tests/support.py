@@ -204,3 +204,12 @@ def australis_camera():
         b1=1e-4,
         b2=-5e-5,
     )
+
+
+def default_sigint() -> None:
+    """``preexec_fn`` of a child that must see Ctrl-C: SIGINT back to its default disposition.
+    A test run started as a background job (``cmd &`` in a non-interactive shell) ignores
+    SIGINT, and a Python child would inherit that and never raise KeyboardInterrupt."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

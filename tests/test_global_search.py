@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import singlet, singlet_spec
+from support import default_sigint, singlet, singlet_spec
 
 from raytrace import AIR, Aperture, Field, Lens, Surface
 from raytrace.files.library import load_lens
@@ -309,6 +309,7 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
         text=True,
         start_new_session=True,
         env=env,
+        preexec_fn=default_sigint,
     )
     try:
         line = p.stderr.readline()  # the first finished start

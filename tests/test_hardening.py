@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import run_cli
+from support import default_sigint, run_cli
 
 from orthoscope.cli import COMMANDS, build_parser
 
@@ -228,6 +228,7 @@ def test_ctrl_c_exits_130_with_one_line_within_a_second(argv, wait, work):
         cwd=work,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
+        preexec_fn=default_sigint,
     )
     time.sleep(wait)  # inside the kernel run
     assert p.poll() is None, "the command finished before it could be interrupted"
