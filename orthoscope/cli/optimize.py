@@ -343,19 +343,18 @@ def _edit_elements(args, lens, spec):
 
 
 def _glass_material(text: str):
-    """--insert's glass: a catalog name (N-BK7, N-BK7_SCHOTT) or an nd/vd model glass."""
-    from raytrace.glass import lookup_glass
-    from raytrace.materials import model_glass
+    """--insert's glass: a catalog name (N-BK7, N-BK7_SCHOTT) or a model glass in the forms the
+    lens files take (nd/vd, nd:vd, a glass code; :func:`raytrace.glass.parse_glass_code`)."""
+    from raytrace.glass import lookup_glass, parse_glass_code
 
-    nd, sep, vd = text.partition("/")
-    if sep:
-        try:
-            return model_glass(float(nd), float(vd))
-        except ValueError:
-            raise CliError(
-                f"--insert ...:{text}: an nd/vd model glass is two numbers (nd > 1, vd > 0), "
-                "e.g. 1.62/60.3"
-            ) from None
+    model = parse_glass_code(text)
+    if model is not None:
+        return model
+    if "/" in text:
+        raise CliError(
+            f"--insert ...:{text}: an nd/vd model glass is two numbers (nd > 1, vd > 0), "
+            "e.g. 1.62/60.3"
+        )
     return lookup_glass(text).material
 
 
