@@ -184,10 +184,9 @@ def _resolved(lens: Lens) -> Lens:
     """An image plane that was a Gaussian solve is solved again for the edited lens."""
     if lens.image_solve != "gaussian":
         return lens
-    from .paraxial import paraxial
+    from .paraxial import gaussian_solved
 
-    d = paraxial(lens.with_image_distance(0.0)).gaussian_image_distance
-    return replace(lens.with_image_distance(d), image_solve="gaussian")
+    return gaussian_solved(lens)
 
 
 def _with_note(notes: str, note: str) -> str:

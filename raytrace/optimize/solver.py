@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 from ..errors import OrthoscopeError
 from ..lens import Lens
 from ..materials import Material
-from ..paraxial import paraxial
+from ..paraxial import gaussian_solved, paraxial
 from .operands import OperandValue, evaluate, merit
 from .spec import (
     ABBE_BOUNDS,
@@ -169,9 +169,7 @@ def apply(lens: Lens, spec: DesignSpec, x) -> Lens:
         out = set_values(out, [(p.kind, p.surface) for p in num_pk], vals)
     last = ("thickness", lens.n_surfaces)
     if lens.image_solve == "gaussian" and last not in ks + [(p.kind, p.surface) for p in num_pk]:
-        out = replace(
-            out.with_image_distance(paraxial(out).gaussian_image_distance), image_solve="gaussian"
-        )
+        out = gaussian_solved(out)
     return out
 
 

@@ -12,7 +12,14 @@ from .conjugates import (
     resolve_object_distance,
     resolve_paraxial,
 )
-from .firstorder import ParaxialResult, element_power, paraxial, ynu_matrix, ynu_trace
+from .firstorder import (
+    ParaxialResult,
+    element_power,
+    gaussian_solved,
+    paraxial,
+    ynu_matrix,
+    ynu_trace,
+)
 from .orthoscopy import (
     PestrecovConstants,
     distortion_slope,
@@ -31,6 +38,7 @@ __all__ = [
     "checked_wavelength",
     "distortion_slope",
     "element_power",
+    "gaussian_solved",
     "ideal_heights",
     "image_planes",
     "object_distance_for_s",

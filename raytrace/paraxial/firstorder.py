@@ -29,7 +29,7 @@ the light) has a positive focal length. A lens that is not centred (decenters, t
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -306,6 +306,14 @@ def aim_geometry(
     )
     ym1, num1 = _marginal_start(lens, epd, float(n_in[0]), z_E0, z_obj)
     return z_E0, abs(a * ym1 + b * num1)
+
+
+def gaussian_solved(lens: Lens) -> Lens:
+    """The lens with its last thickness solved to put the image plane at the paraxial (Gaussian)
+    image of its own object, marked ``image_solve = "gaussian"`` (what a lens file's image solve
+    means; an optimizer or a lens edit keeps it after every change)."""
+    d = paraxial(lens).gaussian_image_distance
+    return replace(lens.with_image_distance(d), image_solve="gaussian")
 
 
 def element_power(lens: Lens, first: int, last: int, wavelength: float | None = None) -> float:
