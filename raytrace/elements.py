@@ -153,7 +153,13 @@ def insert_element(
     if not 1 <= after <= n:
         raise LensError(f"{lens.name}: no surface {after} to insert after (1..{n})")
     s0 = lens.surfaces[after - 1]
-    if not s0.material.is_air or s0.mirror or s0.coordinate_break:
+    if s0.mirror or s0.coordinate_break:
+        what = "a mirror" if s0.mirror else "a coordinate break"
+        raise LensError(
+            f"{lens.name}: surface {after} is {what}; insert the element after a refracting "
+            "surface with air behind it"
+        )
+    if not s0.material.is_air:
         raise LensError(f"{lens.name}: the space after surface {after} is not air")
     if material.is_air:
         raise LensError(f"{lens.name}: an inserted element needs a glass, not air")

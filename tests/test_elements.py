@@ -167,6 +167,13 @@ def test_edits_refuse_what_is_not_an_element_or_an_air_space():
         split_element(load_lens("tessar-fr1066698"), 7)  # the rear of the cemented doublet
     with pytest.raises(LensError, match=r"must be a surface number \(an integer\), got True"):
         split_element(lens, True)
+    # a mirror in air: the space after it is air the light returns into, but not a place for a
+    # plate (the thicknesses after it are negative)
+    s1, s2 = lens.surfaces[:2]
+    mirror = replace(s2, curvature=0.0, thickness=-40.0, mirror=True)
+    folded = replace(lens, surfaces=(replace(s1, stop=True), replace(s2, thickness=20.0), mirror))
+    with pytest.raises(LensError, match=r"surface 3 is a mirror; insert the element after a refr"):
+        insert_element(folded, 3, fixed_index(1.5))
 
 
 def test_cli_split_writes_a_lens_that_records_the_edit(tmp_path):

@@ -123,11 +123,18 @@ def test_glass_run_and_glass_map(tmp_path: Path, capsys):
     cap = capsys.readouterr()
     # a high index bends the rays less: spherical aberration favours N-LASF9 (nd 1.85)
     assert "glass after surface 1: N-LASF9 (Schott" in cap.out
+    # the vendor's relative price beside it (Schott's "rel. Price" column of the shipped catalog)
+    price = lookup_glass("N-LASF9", ("Schott",)).price
+    assert f"relative price {price:g})" in cap.out
     assert cap.err == ""  # --quiet
     lens = read_lens(out)
     assert lens.surfaces[0].material.name == "N-LASF9"
     assert "Glasses: S1 N-LASF9 (Schott)" in lens.notes
     assert gm.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    argv = ["optimize", str(spec), "-o", str(tmp_path / "j.toml"), "--global", "--json"]
+    assert main(argv) == 0
+    (g,) = json.loads(capsys.readouterr().out)["glasses"]
+    assert (g["name"], g["price"]) == ("N-LASF9", price)
 
 
 def test_glass_map_figure():
@@ -140,6 +147,10 @@ def test_glass_map_figure():
     offsets = np.concatenate([c.get_offsets() for c in ax.collections if len(c.get_offsets())])
     assert len(offsets) == len(pool) + 1  # every glass, and the chosen one's marker
     assert any("S1: N-BK7 (Schott)" in t.get_text() for t in ax.texts)
+    # a priced choice carries its price in the label (the unpriced one above: none)
+    priced = [GlassChoice(1, "N-BK7", "Schott", 1.5168, 64.17, "current", 1.0)]
+    ax = plot_glass_map(pool.glasses, priced).axes[0]
+    assert any("S1: N-BK7 (Schott, price 1)" in t.get_text() for t in ax.texts)
 
 
 class _TTY(io.StringIO):

@@ -484,6 +484,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
                     "nd": g.nd,
                     "vd": g.vd,
                     "availability": g.availability,
+                    "price": None if g.price != g.price else g.price,
                 }
                 for g in res.glasses
             ],
@@ -504,7 +505,9 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         for g in res.glasses:
             print(
                 f"glass after surface {g.surface}: {g.name} ({g.catalog}, nd {g.nd:.5f}, "
-                f"vd {g.vd:.2f}, {g.availability})"
+                f"vd {g.vd:.2f}, {g.availability}"
+                + (f", relative price {g.price:g}" if g.price == g.price else "")
+                + ")"
             )
         _print_table(table)
         if written:

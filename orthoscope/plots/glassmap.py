@@ -4,6 +4,7 @@ and labelled."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 
 from matplotlib.figure import Figure
@@ -32,7 +33,8 @@ def plot_glass_map(
     title : str, optional
         Figure title (default: "Glass map").
     annotate : bool
-        Label the chosen glasses with surface and name.
+        Label the chosen glasses with surface, name, catalog and, where the vendor prints one,
+        the relative price (``price``: Schott N-BK7 = 1, CDGM H-K9L = 1).
 
     Returns
     -------
@@ -63,8 +65,12 @@ def plot_glass_map(
         if annotate:
             surf = getattr(c, "surface", None)
             cat = getattr(c, "catalog", "")
+            price = getattr(c, "price", math.nan)
+            extra = ", ".join(x for x in (cat, f"price {price:g}" if price == price else "") if x)
             text = (
-                (f"S{surf}: " if surf is not None else "") + c.name + (f" ({cat})" if cat else "")
+                (f"S{surf}: " if surf is not None else "")
+                + c.name
+                + (f" ({extra})" if extra else "")
             )
             ax.annotate(
                 text,

@@ -63,7 +63,11 @@ from .spec import DesignSpec, SearchSettings, SpecError, Variable
 
 @dataclass(frozen=True)
 class GlassChoice:
-    """The glass a glass variable took: the medium after ``surface`` (1-based)."""
+    """The glass a glass variable took: the medium after ``surface`` (1-based).
+
+    ``price`` is the vendor's relative price (:attr:`raytrace.glass.CatalogGlass.price`: Schott
+    N-BK7 = 1, CDGM H-K9L = 1), ``nan`` where the vendor prints none.
+    """
 
     surface: int
     name: str
@@ -71,6 +75,7 @@ class GlassChoice:
     nd: float
     vd: float
     availability: str
+    price: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -566,6 +571,7 @@ def global_optimize(
             pools[j].glasses[g[j]].nd,
             pools[j].glasses[g[j]].vd,
             availability(pools[j].glasses[g[j]]),
+            pools[j].glasses[g[j]].price,
         )
         for j, v in enumerate(_glass_vars(spec))
         if g
