@@ -6,9 +6,51 @@ it is imported only when a cluster is asked for.
 
 from __future__ import annotations
 
+import os
+import re
+import signal
+import threading
 from collections.abc import Callable
 
 from .errors import OrthoscopeError
+
+#: the executor specs a user can write: ``local``, ``local:N`` (N >= 1) or ``tcp://HOST:PORT``
+#: (HOST a name, an IPv4 address or a bracketed IPv6 address)
+_SPEC = re.compile(r"local(?::(?P<n>\d+))?|tcp://(?:\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):(?P<port>\d+)")
+
+#: at most this many LocalCluster worker processes per CPU (more is a typo, not a plan)
+MAX_LOCAL_PER_CPU = 4
+
+
+def check_executor(text: str) -> str:
+    """``text`` if it is an executor spec :func:`dask_client` takes; else OrthoscopeError.
+
+    Checked before any work: ``local``, ``local:N`` with 1 <= N <= MAX_LOCAL_PER_CPU x the
+    CPUs worker processes, or ``tcp://HOST:PORT`` with a port from 1 to 65535.
+    """
+    m = _SPEC.fullmatch(text) if isinstance(text, str) else None
+    if m is None or (m["n"] is not None and int(m["n"]) < 1):
+        raise OrthoscopeError(
+            f"--dask {text!r}: give local (a LocalCluster of one worker per CPU), local:N (N >= 1 "
+            "workers) or tcp://HOST:PORT (a running scheduler)"
+        )
+    if m["port"] is not None and not 1 <= int(m["port"]) <= 65535:
+        raise OrthoscopeError(f"--dask {text!r}: the port must be 1 to 65535")
+    cpus = os.cpu_count() or 1
+    if m["n"] is not None and int(m["n"]) > MAX_LOCAL_PER_CPU * cpus:
+        raise OrthoscopeError(
+            f"--dask {text!r}: {int(m['n'])} worker processes on a machine with {cpus} CPU(s); "
+            f"use at most {MAX_LOCAL_PER_CPU * cpus} (a tcp:// scheduler for a larger cluster)"
+        )
+    return text
+
+
+def dask_setup(worker) -> None:
+    """Dask preload hook, run in each worker process that :func:`dask_client` starts: Ctrl-C in
+    the terminal reaches the whole process group, and the workers leave it to this process
+    (which stops the work and keeps what finished) instead of dying with tracebacks."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
@@ -17,9 +59,10 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
     Parameters
     ----------
     executor : str or distributed.Client
-        ``"local"`` or ``"local:N"``: a Dask ``LocalCluster`` on this machine (N worker
-        processes, one thread each; default: Dask's choice); ``"tcp://HOST:PORT"``: a running
-        scheduler; a ``distributed.Client``: used as it is.
+        ``"local"`` or ``"local:N"``: a Dask ``LocalCluster`` on this machine (N >= 1 worker
+        processes, one thread each; ``"local"``: one per CPU), whose workers ignore Ctrl-C
+        (:func:`dask_setup`); ``"tcp://HOST:PORT"``: a running scheduler; a
+        ``distributed.Client``: used as it is.
 
     Returns
     -------
@@ -40,17 +83,17 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
         ) from None
     if isinstance(executor, distributed.Client):
         return executor, None
-    if isinstance(executor, str) and executor.startswith("local"):
-        n = None
-        if ":" in executor:
-            try:
-                n = int(executor.split(":", 1)[1])
-            except ValueError:
-                raise OrthoscopeError(
-                    f"--dask {executor!r}: write local or local:N (N workers)"
-                ) from None
+    if not isinstance(executor, str):
+        raise OrthoscopeError(
+            f"executor {executor!r} is not known; use 'local', 'local:N' (a Dask LocalCluster), "
+            "'tcp://HOST:PORT' or a distributed.Client"
+        )
+    check_executor(executor)
+    if executor.startswith("local"):
+        n = int(executor[6:]) if ":" in executor else None
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                           dashboard_address=None)  # fmt: skip
+                                           dashboard_address=None,
+                                           preload=["raytrace.executors"])  # fmt: skip
         client = distributed.Client(cluster)
 
         def close():
@@ -58,13 +101,8 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
             cluster.close()
 
         return client, close
-    if isinstance(executor, str) and "://" in executor:
-        try:
-            client = distributed.Client(executor, timeout="20s")
-        except OSError as e:
-            raise OrthoscopeError(f"cannot reach the Dask scheduler {executor}: {e}") from None
-        return client, client.close
-    raise OrthoscopeError(
-        f"executor {executor!r} is not known; use None/'local' (this machine), 'local[:N]' "
-        "(a Dask LocalCluster), 'tcp://HOST:PORT' or a distributed.Client"
-    )
+    try:
+        client = distributed.Client(executor, timeout="20s")
+    except OSError as e:
+        raise OrthoscopeError(f"cannot reach the Dask scheduler {executor}: {e}") from None
+    return client, client.close

@@ -346,3 +346,9 @@ def test_cost_class_limits_the_substitution_pool():
     assert len(everything.glasses) > 5 * len(cheap.glasses)
     with pytest.raises(SpecError, match=r"relative price <= 0.5 \(Schott / CDGM prices only\)"):
         glass_pool(GlassSettings(max_price=0.5))
+    with pytest.raises(SpecError, match=r"classes or raise max_price$"):
+        glass_pool(GlassSettings(max_price=0.5))
+    # the API checks what the spec reader checks: a positive number (inf: no limit)
+    for bad in (math.nan, 0, -1.0, True, "2"):
+        with pytest.raises(SpecError, match=r"max_price must be a positive number"):
+            GlassSettings(max_price=bad)

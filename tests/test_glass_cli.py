@@ -75,6 +75,31 @@ def test_glass_search(capsys):
     assert rc2 == 0 and "nearest to nd 1.62, vd 60.3" in out2
 
 
+def test_glass_search_by_price(capsys):
+    # --max-price: the nearest glasses among those whose vendor prints a relative price <= P
+    rc, out, _ = run(capsys, "glass", "--search", "nd=1.62,vd=60", "--max-price", "1.2", "--json")
+    assert rc == 0
+    got = json.loads(out)["matches"]
+    assert len(got) == 10 and all(0 < m["relative_price"] <= 1.2 for m in got)
+    assert {m["catalog"] for m in got} <= {"Schott", "CDGM"}
+    # the same as filtering the whole distance-ordered list by the catalog records' prices
+    every = [m for m in search_glass(1.62, 60.0, 10**6) if m.glass.price <= 1.2]
+    assert [(m["name"], m["catalog"]) for m in got] == [
+        (m.glass.name, m.glass.catalog) for m in every[:10]
+    ]
+    rc, out, _ = run(capsys, "glass", "--search", "nd=1.62,vd=60", "--max-price", "1.2")
+    assert "glasses with a relative price <= 1.2 nearest to" in out
+    assert f"{every[0].glass.price:>6.3g}" in out.splitlines()[2]
+    rc, out, _ = run(capsys, "glass", "--search", "nd=1.62,vd=60", "--count", "1", "--json")
+    assert json.loads(out)["matches"][0]["relative_price"] is None  # Hikari prints none
+    for argv, msg in (
+        (("--search", "nd=1.62,vd=60", "--max-price", "0"), "a positive relative price"),
+        (("N-BK7", "--max-price", "2"), "--max-price goes with --search"),
+    ):
+        rc, _, err = run(capsys, "glass", *argv)
+        assert rc == 2 and msg in err and err.count("\n") == 1
+
+
 def test_glass_errors_are_one_line(capsys):
     rc, _, err = run(capsys, "glass")
     assert rc == 2 and "give a glass NAME or --search" in err and err.count("\n") == 1

@@ -134,7 +134,7 @@ def test_glass_run_and_glass_map(tmp_path: Path, capsys):
     argv = ["optimize", str(spec), "-o", str(tmp_path / "j.toml"), "--global", "--json"]
     assert main(argv) == 0
     (g,) = json.loads(capsys.readouterr().out)["glasses"]
-    assert (g["name"], g["price"]) == ("N-LASF9", price)
+    assert (g["name"], g["relative_price"]) == ("N-LASF9", price)  # as orthoscope glass --json
 
 
 def test_glass_map_figure():

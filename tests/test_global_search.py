@@ -282,8 +282,13 @@ def test_ctrl_c_keeps_the_best_design():
     assert merit(evaluate(res.lens, spec.operands)) == pytest.approx(res.merit, rel=1e-12)
 
 
-def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
+@pytest.mark.parametrize("where", [["--workers", "2"], ["--dask", "local:2"]], ids=["pool", "dask"])
+def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path, where):
     # A real Ctrl-C: SIGINT to the whole process group (parent and workers), as a terminal does.
+    # The Dask workers ignore it (raytrace.executors.dask_setup) and end their starts when the
+    # search's stop Event is set; a start that had not begun is not reported.
+    if where[0] == "--dask":
+        pytest.importorskip("distributed")
     spec = tmp_path / "cooke.toml"
     spec.write_text(
         'name = "cooke-multimodal"\nstart = "cooke-triplet-f4"\nmax_evaluations = 200\n'
@@ -302,7 +307,7 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     p = subprocess.Popen(
         [sys.executable, "-m", "orthoscope", "optimize", str(spec), "-o", str(out), "--global"]
-        + ["--workers", "2", "--seed", "1"],
+        + [*where, "--seed", "1"],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -312,7 +317,9 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
         preexec_fn=default_sigint,
     )
     try:
-        line = p.stderr.readline()  # the first finished start
+        line = p.stderr.readline()  # the first finished start (a first run compiles first)
+        while line.startswith("compiling"):
+            line = p.stderr.readline()
         assert line.startswith("start "), line
         os.killpg(p.pid, signal.SIGINT)
         stdout, stderr = p.communicate(timeout=60)
@@ -321,11 +328,17 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path):
             os.killpg(p.pid, signal.SIGKILL)
     assert p.returncode == 130, stderr
     assert "interrupted" in stderr and "Traceback" not in stderr
+    assert "merit nan" not in stderr  # starts that never ran are not reported as done
     assert out.is_file() and "wrote" in stdout
     from raytrace.files.native import read_lens
 
     notes = read_lens(out).notes
     assert "--global --seed 1" in notes and "stopped early (interrupted)" in notes
+    assert "with 2 worker(s)" in notes
+    assert ("on Dask (local:2)" in notes) == (where[0] == "--dask")
+    merits = [float(x.split("merit ")[1].split(",")[0]) for x in stderr.splitlines() if "done" in x]
+    start = float(notes.split("(start ")[1].split(")")[0])
+    assert float(notes.split("; merit ")[1].split(" ")[0]) <= min([start, *merits])
 
 
 # --------------------------------------------------------------------------- Dask
@@ -355,11 +368,55 @@ def test_dask_cluster_gives_the_same_design_as_one_process():
     assert np.isnan(budget.start_merits).any()  # not every start ran to its end
 
 
+def test_a_lost_cluster_stops_the_search_with_the_finished_starts_kept():
+    """The scheduler goes away after the first finished start (here: closed from the progress
+    callback): the search stops with that start's design, says why, and does not hang."""
+    pytest.importorskip("distributed")
+    from raytrace.executors import dask_client
+
+    client, close = dask_client("local:2")
+    seen = []
+
+    def progress(ev):
+        seen.append((ev.event, ev.start, ev.merit))
+        if ev.event == "start" and len(seen) == 1:
+            client.cluster.close()  # the scheduler and its workers; the client stays
+
+    try:
+        res = global_optimize(
+            load_lens("cooke-triplet-f4"), cooke_multimodal(starts=12), seed=7, executor=client,
+            progress=progress,
+        )  # fmt: skip
+    finally:
+        close()
+    assert res.stopped == "cluster" and "the Dask cluster was lost" in res.message
+    assert "\n" not in res.message
+    assert res.workers == 2
+    (_, k, m), *_ = seen
+    assert res.best_start == k and res.merit == pytest.approx(m, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "text", ["local", "local:1", "local:2", "tcp://127.0.0.1:8786", "tcp://[::1]:8786", "tcp://h:1"]
+)
+def test_executor_specs_accepted(text):
+    from raytrace.executors import check_executor
+
+    assert check_executor(text) == text
+
+
 def test_cli_dask_flags_are_checked(tmp_path: Path):
     spec = ROOT / "lenses" / "specs" / "twinplex-like-55-525.toml"
+    many = f"local:{4 * (os.cpu_count() or 1) + 1}"
     for flags, msg in (
         (["--dask", "local:2"], "--dask belong(s) to the global search"),
         (["--global", "--dask", "local:2", "--workers", "2"], "--workers is for local processes"),
+        # a cluster without workers would wait for ever; a host:port is not a LocalCluster size
+        (["--global", "--dask", "local:0"], "local:N (N >= 1 workers)"),
+        (["--global", "--dask", "localhost:8786"], "tcp://HOST:PORT (a running scheduler)"),
+        (["--global", "--dask", "tcp://host:notaport"], "tcp://HOST:PORT (a running scheduler)"),
+        (["--global", "--dask", "tcp://host:70000"], "the port must be 1 to 65535"),
+        (["--global", "--dask", many], "worker processes on a machine with"),
     ):
         r = subprocess.run(
             [

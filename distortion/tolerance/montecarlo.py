@@ -424,9 +424,10 @@ def monte_carlo(
         Folder for chunks, manifest and summary.json; None keeps nothing on disk.
     resume, overwrite : bool
         Continue a matching run found in ``out_dir``; replace any other run there.
-    executor : None | "local" | "local[:N]" | "tcp://HOST:PORT" | distributed.Client
-        None / "local": this process, numba threads over instances; otherwise Dask (imported only
-        then): chunks (instance ranges) are submitted with the shared setup scattered once, at
+    executor : None | "local" | "local:N" | "tcp://HOST:PORT" | distributed.Client
+        None: this process, numba threads over instances; otherwise Dask (imported only then;
+        :func:`raytrace.executors.dask_client`: "local" is a LocalCluster of one worker per
+        CPU): chunks (instance ranges) are submitted with the shared setup scattered once, at
         most a few per worker at a time.
     progress : callable(done, total) or None
         Called after every finished chunk with instance counts.
@@ -513,7 +514,7 @@ def monte_carlo(
     block0 = summary_block if streaming else 0
     first = [c for c in chunks if c[1] < block0]
     rest = [c for c in chunks if c[1] >= block0]
-    if executor in (None, "local"):
+    if executor is None:
         for k, a, b in first + rest:
             if k in on_disk:
                 feed(k, a, store.load(k))

@@ -481,3 +481,23 @@ def print_json(obj) -> None:
     from ..report.jsonout import dumps
 
     print(dumps(obj))
+
+
+def check_dask(text: str | None) -> None:
+    """Check a --dask value before any work (raytrace.executors.check_executor) and, for a run on
+    Dask, keep Dask's own log records (connection errors, with tracebacks) off the terminal: the
+    command's one-line messages say what happened."""
+    if text is None:
+        return
+    import logging
+
+    from raytrace.executors import check_executor
+
+    check_executor(text)
+    try:
+        import distributed  # noqa: F401  (its import sets its loggers' levels)
+    except ImportError:
+        return  # the run says how to install it
+    for name in [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)

@@ -5,6 +5,7 @@ fast."""
 from __future__ import annotations
 
 import argparse
+import math
 
 from .colour import add_wavelengths_arg
 from .common import CliError, add_output_args, add_strict_arg, print_result
@@ -14,6 +15,19 @@ SAMPLES = [
     ["glass", "--search", "nd=1.62,vd=60"],
 ]
 OUTPUTS = []
+
+
+def _price(text: str) -> float:
+    """--max-price: a positive relative price."""
+    try:
+        v = float(text)
+    except ValueError:
+        v = math.nan
+    if not v > 0:
+        raise argparse.ArgumentTypeError(
+            f"--max-price {text!r}: a positive relative price (N-BK7 = 1), e.g. 2"
+        )
+    return v
 
 
 def _search_spec(text: str) -> tuple[float, float]:
@@ -71,15 +85,19 @@ def cmd_glass(args) -> int:
         if args.count < 1:
             raise CliError("--count must be at least 1")
         cats = [c.strip() for c in args.catalog.split(",")] if args.catalog else None
+        limit = math.inf if args.max_price is None else args.max_price
         matches = search_glass(
-            nd, vd, args.count, catalogs=cats, include_retired=args.include_retired
-        )
+            nd, vd, args.count, catalogs=cats, include_retired=args.include_retired,
+            max_price=limit,
+        )  # fmt: skip
         print_result(
             args,
             json=lambda: search_to_dict(nd, vd, matches),
-            text=lambda: format_search(nd, vd, matches),
+            text=lambda: format_search(nd, vd, matches, limit),
         )
         return 0
+    if args.max_price is not None:
+        raise CliError("--max-price goes with --search, not with a glass NAME")
     g = lookup_glass(
         args.name, [args.catalog] if args.catalog else None, first_catalog_wins=bool(args.catalog)
     )
@@ -135,6 +153,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         q, help="Refuse wavelengths outside the glass's data range (default: a warning)."
     )
     q.add_argument("--count", type=int, default=10, metavar="N", help="--search: how many.")
+    q.add_argument(
+        "--max-price",
+        type=_price,
+        metavar="P",
+        help="--search: only glasses whose vendor prints a relative price <= P (Schott: "
+        "N-BK7 = 1; CDGM: H-K9L = 1; the other vendors print none).",
+    )
     q.add_argument(
         "--include-retired",
         action="store_true",

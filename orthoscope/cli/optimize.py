@@ -14,7 +14,14 @@ from dataclasses import replace
 from pathlib import Path
 
 from . import EXIT_INTERRUPTED
-from .common import CliError, add_force_arg, add_output_args, print_json, refuse_flags
+from .common import (
+    CliError,
+    add_force_arg,
+    add_output_args,
+    check_dask,
+    print_json,
+    refuse_flags,
+)
 
 EXIT_NOT_CONVERGED = 1
 
@@ -130,9 +137,9 @@ def provenance_notes(lens, spec, res, start_name: str) -> str:
     )
 
 
-def global_provenance_notes(spec, res, start_name: str) -> str:
+def global_provenance_notes(spec, res, start_name: str, dask: str | None = None) -> str:
     """Notes of a lens designed by the global search: provenance line first, then how to
-    reproduce it (seed, starts) and what it found."""
+    reproduce it (seed, starts) and what it found (``dask``: the --dask cluster it ran on)."""
     date = _dt.date.today().isoformat()
     glasses = "; ".join(f"S{g.surface} {g.name} ({g.catalog})" for g in res.glasses)
     text = (
@@ -140,8 +147,11 @@ def global_provenance_notes(spec, res, start_name: str) -> str:
         f"Designed with 'orthoscope optimize {Path(spec.path).name} --global --seed {res.seed} "
         f"--starts {res.starts}' ({spec.search.hops} hops per start) from the start lens "
         f"{start_name}; merit {res.merit:.9g} (start {res.merit_start:.9g}), best of "
-        f"{res.starts_done}/{res.starts} starts (start {res.best_start}), {res.evaluations} "
-        f"evaluations, {res.seconds:.0f} s with {res.workers} worker(s); {date}."
+        f"{res.starts_done}/{res.starts} starts ("
+        + (f"start {res.best_start}" if res.best_start >= 0 else "the start lens, kept")
+        + f"), {res.evaluations} evaluations, {res.seconds:.0f} s with {res.workers} worker(s)"
+        + (f" on Dask ({dask})" if dask else "")
+        + f"; {date}."
     )
     if glasses:
         text += f" Glasses: {glasses}."
@@ -226,6 +236,7 @@ def cmd_optimize(args) -> int:
         )
     if args.dask is not None and args.workers is not None:
         raise CliError("--workers is for local processes; with --dask the cluster has its own")
+    check_dask(args.dask)
     spec = read_spec(args.spec)
     if args.method is not None:
         spec = replace(spec, method=args.method)
@@ -446,7 +457,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
     table = _operand_table(res.operands)
     written = _write_design(
         args, res, spec, out, inputs,
-        lambda: global_provenance_notes(spec, res, spec.start),
+        lambda: global_provenance_notes(spec, res, spec.start, args.dask),
         f"derived by orthoscope optimize --global from {spec.start} with {Path(spec.path).name}",
     )  # fmt: skip
     if args.glass_map is not None:
@@ -484,7 +495,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
                     "nd": g.nd,
                     "vd": g.vd,
                     "availability": g.availability,
-                    "price": None if g.price != g.price else g.price,
+                    "relative_price": None if g.price != g.price else g.price,
                 }
                 for g in res.glasses
             ],
@@ -519,6 +530,10 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
     if res.stopped == "interrupted":
         print("orthoscope optimize: interrupted; the best design found was kept", file=sys.stderr)
         return EXIT_INTERRUPTED
+    if res.stopped == "cluster":
+        kept = "; the best design of the finished starts was kept" if written else ""
+        print(f"orthoscope optimize: {res.message.split('stopped: ')[-1]}{kept}", file=sys.stderr)
+        return 1
     return 0 if res.converged else EXIT_NOT_CONVERGED
 
 

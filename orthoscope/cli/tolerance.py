@@ -16,6 +16,7 @@ from .common import (
     CliError,
     add_force_arg,
     add_output_args,
+    check_dask,
     check_size,
     parse_list,
     print_json,
@@ -26,7 +27,6 @@ from .common import (
 COMPENSATORS = ("paraxial-refocus", "best-focus", "fixed-sensor")
 #: instances held in memory without --allow-large (outputs ~ 8 bytes x (3 fields + 30) each)
 MAX_INSTANCES = 1_000_000
-_DASK = re.compile(r"^(local(:\d+)?|tcp://[^\s:/]+:\d+)$")
 _LIMIT = re.compile(r"^\s*([0-9.eE+-]+)\s*(um|µm|μm)?\s*@\s*([0-9.eE+-]+)\s*(deg|°)?\s*$")
 
 
@@ -143,11 +143,7 @@ def cmd_tolerance(args) -> int:
         sensitivity_to_dict,
     )
 
-    if args.dask is not None and not _DASK.match(args.dask):
-        raise CliError(
-            f"--dask {args.dask!r}: give local, local:N (a LocalCluster of N workers) or "
-            "tcp://HOST:PORT (a running scheduler)"
-        )
+    check_dask(args.dask)
     if args.sensitivity and args.samples is None:
         for flag, v in (("--dask", args.dask), ("-o", args.output), ("--seed", args.seed)):
             if v is not None:
@@ -231,16 +227,6 @@ def _g_distance(text: str):
         return t
 
 
-def _executor(text: str | None):
-    """--dask → the API's executor: ``local`` alone is a LocalCluster of one worker per CPU
-    (the API's ``"local"`` means this process)."""
-    if text == "local":
-        import os
-
-        return f"local:{os.cpu_count() or 1}"
-    return text
-
-
 def _run_size(args, spec) -> tuple[int, int]:
     """(instances, chunk size) of the run, checked before any work."""
     n = args.samples
@@ -269,7 +255,7 @@ def _monte_carlo(args, lens, spec, kw, limits):
             out_dir=args.output,
             resume=True,
             overwrite=args.force,
-            executor=_executor(args.dask),
+            executor=args.dask,
             progress=prog,
             limits=limits,
             summary=args.summary,

@@ -97,20 +97,30 @@ def glass_to_dict(g: CatalogGlass, wavelengths, indices) -> dict:
     }
 
 
-def format_search(nd: float, vd: float, matches: list[GlassMatch]) -> str:
-    """The nearest catalog glasses to (nd, vd), nearest first."""
+def format_search(
+    nd: float, vd: float, matches: list[GlassMatch], max_price: float = math.inf
+) -> str:
+    """The nearest catalog glasses to (nd, vd), nearest first (``max_price``: the search's
+    price limit, named in the heading)."""
+    limit = f" with a relative price <= {max_price:g}" if math.isfinite(max_price) else ""
     out = [
-        f"catalog glasses nearest to nd {nd:g}, vd {vd:g} (distance in glass-code units: "
-        "0.001 in nd or 0.1 in vd)",
+        f"catalog glasses{limit} nearest to nd {nd:g}, vd {vd:g} (distance in glass-code "
+        "units: 0.001 in nd or 0.1 in vd)",
         f"  {'#':>2}  {'glass':<16} {'catalog':<8} {'nd':>9} {'vd':>7} {'code':>7} "
-        f"{'distance':>8}  status",
+        f"{'distance':>8} {'price':>6}  status",
     ]
     for i, m in enumerate(matches, start=1):
         g = m.glass
         code = f"{round(1000 * (g.nd - 1)):03d}{round(10 * g.vd):03d}"
+        price = f"{g.price:>6.3g}" if g.price == g.price else f"{'':>6}"
         out.append(
             f"  {i:>2}  {g.name:<16} {g.catalog:<8} {g.nd:>9.5f} {g.vd:>7.2f} {code:>7} "
-            f"{m.distance:>8.2f}  {g.status}"
+            f"{m.distance:>8.2f} {price}  {g.status}"
+        )
+    if any(m.glass.price == m.glass.price for m in matches):
+        out.append(
+            "  price: the vendor's relative price (Schott N-BK7 = 1, CDGM H-K9L = 1; not "
+            "comparable across vendors; the others print none)"
         )
     if not matches:
         out.append("  (none)")
@@ -129,6 +139,7 @@ def search_to_dict(nd: float, vd: float, matches: list[GlassMatch]) -> dict:
                 "nd": m.glass.nd,
                 "vd": m.glass.vd,
                 "distance": m.distance,
+                "relative_price": None if m.glass.price != m.glass.price else m.glass.price,
                 "status": m.glass.status,
             }
             for m in matches

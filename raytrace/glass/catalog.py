@@ -426,6 +426,7 @@ def search_glass(
     *,
     catalogs: tuple[str, ...] | list[str] | None = None,
     include_retired: bool = False,
+    max_price: float = math.inf,
 ) -> list[GlassMatch]:
     """The ``n`` catalog materials nearest to (``nd``, ``vd``), nearest first.
 
@@ -433,7 +434,8 @@ def search_glass(
     ``sqrt((1000 Δnd)² + (10 Δvd)²)`` — one unit is 0.001 in nd or 0.1 in vd, the digits a
     code such as 620603 gives. Glasses with status ``withdrawn``/``legacy``/``obsolete`` are
     left out unless ``include_retired``; materials without nd/vd are never returned. Ties keep
-    catalog order.
+    catalog order. A finite ``max_price`` keeps only glasses whose vendor prints a relative
+    price (:attr:`CatalogGlass.price`: Schott, CDGM) no larger than it.
     """
     cats = CATALOGS
     if catalogs:
@@ -449,7 +451,16 @@ def search_glass(
             d = math.hypot(1000.0 * (gnd - nd), 10.0 * (gvd - vd))
             scored.append((d, c, i))
     scored.sort(key=lambda t: t[0])
-    return [GlassMatch(_glass(c, i), d) for d, c, i in scored[: max(n, 0)]]
+    if not math.isfinite(max_price):
+        return [GlassMatch(_glass(c, i), d) for d, c, i in scored[: max(n, 0)]]
+    out = []
+    for d, c, i in scored:  # nearest first: the full records are read only as far as needed
+        if len(out) >= n:
+            break
+        g = _glass(c, i)
+        if g.price <= max_price:
+            out.append(GlassMatch(g, d))
+    return out
 
 
 def parse_glass_code(text: str) -> Material | None:

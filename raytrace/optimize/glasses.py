@@ -138,6 +138,7 @@ def glass_pool(settings: GlassSettings) -> GlassPool:
             )
             + (f" among {', '.join(settings.glasses)}" if settings.glasses else "")
             + "; widen the windows or allow more catalogs / classes"
+            + (" or raise max_price" if math.isfinite(settings.max_price) else "")
         )
     return GlassPool(
         tuple(keep),

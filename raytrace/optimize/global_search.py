@@ -126,10 +126,12 @@ class GlobalResult:
 
     lens: the best design; merit: its merit (sum of squared weighted residuals); merit_start:
     the start lens's merit; start_merits: the best merit of each start (``nan`` for a start that
-    did not run); best_start: the start the design came from; seed: the root seed; glasses: the
-    glass of each glass variable; operands: every operand on the best design; evaluations: merit
-    evaluations in all starts and the polish; seconds: wall time; workers: processes used;
-    stopped: ``""``, ``"time"`` (budget spent) or ``"interrupted"``; converged: the spec's merit
+    did not run); best_start: the start the design came from (-1: the start lens, when no
+    finished start is better); seed: the root seed; glasses: the glass of each glass variable;
+    operands: every operand on the best design; evaluations: merit evaluations in all starts and
+    the polish; seconds: wall time; workers: processes used (on Dask: the cluster's workers);
+    stopped: ``""``, ``"time"`` (budget spent), ``"interrupted"`` or ``"cluster"`` (the Dask
+    cluster went away; the message says how); converged: the spec's merit
     goal is met (always true without a goal); message: a one-line summary.
     """
 
@@ -495,6 +497,7 @@ def global_optimize(
     outcomes: dict[int, StartOutcome] = {}
     best = [math.inf]
     stopped = ""
+    n_workers, lost = s.workers, ""  # on Dask: the cluster's workers; what ended the cluster
 
     def emit(kind: str, k: int, hop: int, m: float) -> None:
         if m < best[0]:
@@ -508,7 +511,8 @@ def global_optimize(
 
     def finished(o: StartOutcome) -> None:
         outcomes[o.index] = o
-        emit("start", o.index, o.hops - 1, o.merit)
+        if math.isfinite(o.merit):  # not a start stopped before its first design
+            emit("start", o.index, o.hops - 1, o.merit)
 
     try:
         if s.workers == 1 and executor is None:
@@ -526,7 +530,7 @@ def global_optimize(
                     stopped = o.stopped
                     break
         elif executor is not None:
-            stopped = _run_dask(executor, lens, spec, s, deadline, finished)
+            stopped, n_workers, lost = _run_dask(executor, lens, spec, s, deadline, finished)
         else:
             stopped = _run_pool(lens, spec, s, deadline, emit, finished)
     except KeyboardInterrupt:
@@ -537,7 +541,10 @@ def global_optimize(
     for o in done:
         start_merits[o.index] = o.merit
     evaluations = sum(o.evaluations for o in outcomes.values())
-    if not done:  # nothing finished: the start lens is the best design known
+    polished = False
+    if not done or min(o.merit for o in done) > merit_start:
+        # nothing finished, or only starts cut short above the start lens (a stop): the start
+        # lens is the best design known
         final = apply(lens, spec, start_values(lens, spec))
         g = ()
         best_k = -1
@@ -553,7 +560,7 @@ def global_optimize(
                     stop=lambda: "time" if time.time() > deadline else None,
                 )
                 evaluations += pol.evaluations
-                stopped = pol.stopped
+                stopped, polished = pol.stopped, True
                 if pol.merit < _merit_of(final, spec):
                     final = pol.lens
             except KeyboardInterrupt:
@@ -562,7 +569,8 @@ def global_optimize(
                 pass
     vals = evaluate(final, spec.operands)
     m = merit(vals)
-    emit("polish", best_k, -1, m)
+    if polished:
+        emit("polish", best_k, -1, m)
     choices = tuple(
         GlassChoice(
             v.surface,
@@ -578,9 +586,18 @@ def global_optimize(
     )
     converged = spec.merit_goal is None or m <= spec.merit_goal
     n_done = len(done)
-    msg = f"best merit {m:.6g} from start {best_k} of {n_done}/{s.starts} starts (seed {s.seed})"
+    if best_k < 0:
+        msg = (
+            f"merit {m:.6g}: the start lens, kept ({n_done}/{s.starts} starts finished, none "
+            f"better; seed {s.seed})"
+        )
+    else:
+        msg = (
+            f"best merit {m:.6g} from start {best_k} of {n_done}/{s.starts} starts (seed {s.seed})"
+        )
     if stopped:
-        msg += f"; stopped: {'time budget spent' if stopped == 'time' else 'interrupted'}"
+        why = {"time": "time budget spent", "interrupted": "interrupted"}
+        msg += f"; stopped: {why.get(stopped, f'the Dask cluster was lost ({lost})')}"
     if not converged:
         msg += f"; above the merit goal {spec.merit_goal:.6g}"
     return GlobalResult(
@@ -594,7 +611,7 @@ def global_optimize(
         operands=vals,
         evaluations=evaluations,
         seconds=time.perf_counter() - t0,
-        workers=s.workers,
+        workers=n_workers,
         stopped=stopped,
         converged=converged,
         message=msg,
@@ -633,21 +650,27 @@ def _dask_start(lens: Lens, spec: DesignSpec, k: int, seed: int, deadline: float
     return run_start(lens, spec, k, seed, should_stop, lambda *_: None)
 
 
-def _run_dask(executor, lens, spec, s: SearchSettings, deadline: float, finished) -> str:
-    """Run the starts as tasks on a Dask cluster; returns why it stopped early. A stop (time
-    budget, Ctrl-C) sets a distributed Event the running starts poll; every task then ends with
-    its best so far, and those are kept."""
+def _run_dask(executor, lens, spec, s: SearchSettings, deadline: float, finished) -> tuple:
+    """Run the starts as tasks on a Dask cluster; returns ``(why it stopped early, workers,
+    what went wrong with the cluster or "")``. A stop (time budget, Ctrl-C) sets a distributed
+    Event the running starts poll; every task then ends with its best so far, and those are
+    kept (starts that had not begun end at once, without a design). A cluster that goes away
+    (scheduler killed, connection lost) stops the search with the finished starts kept."""
     import uuid
-
-    from distributed import Event, as_completed
+    from concurrent.futures import CancelledError
 
     from ..executors import dask_client
 
-    client, close = dask_client(executor)
+    client, close = dask_client(executor)  # a clear error when Dask is not installed
+    from distributed import Event, as_completed
+
     name = f"orthoscope-global-stop-{uuid.uuid4().hex}"
-    event = Event(name, client=client)
-    stopped = ""
+    stopped, lost = "", ""
+    workers = 0
+
     try:
+        workers = len(client.scheduler_info().get("workers", {}))
+        event = Event(name, client=client)
         futures = {
             client.submit(_dask_start, lens, spec, k, s.seed, deadline, name, pure=False): k
             for k in range(s.starts)
@@ -665,11 +688,18 @@ def _run_dask(executor, lens, spec, s: SearchSettings, deadline: float, finished
             event.set()
             for f in ac:  # the starts end at their next poll with their best so far
                 finished(f.result())
+    except (OSError, CancelledError) as e:  # CommClosedError, TimeoutError, cancelled futures
+        text = " ".join(f"{type(e).__name__}: {e}".split()).rstrip(":")  # one line
+        stopped, lost = stopped or "cluster", text[:200]
     finally:
-        event.clear()
-        if close is not None:
-            close()
-    return stopped
+        try:
+            if not lost:
+                Event(name, client=client).clear()
+            if close is not None:
+                close()
+        except (OSError, CancelledError):
+            pass
+    return stopped, workers, lost
 
 
 def _run_pool(lens, spec, s: SearchSettings, deadline: float, emit, finished) -> str:

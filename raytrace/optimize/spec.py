@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import numbers
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -133,6 +134,14 @@ class GlassSettings:
     neighbours: int = 6
     model_phase: bool = True
     max_price: float = math.inf
+
+    def __post_init__(self) -> None:
+        p = self.max_price  # the spec reader checks its [glass] keys; this guards the API
+        if isinstance(p, bool) or not isinstance(p, numbers.Real) or not p > 0:
+            raise SpecError(
+                f"glass settings: max_price must be a positive number (a vendor's relative "
+                f"price, N-BK7 = 1; inf: no limit), got {p!r}"
+            )
 
 
 @dataclass(frozen=True)
