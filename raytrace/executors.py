@@ -48,9 +48,26 @@ def check_executor(text: str) -> str:
 def dask_setup(worker) -> None:
     """Dask preload hook, run in each worker process that :func:`dask_client` starts: Ctrl-C in
     the terminal reaches the whole process group, and the workers leave it to this process
-    (which stops the work and keeps what finished) instead of dying with tracebacks."""
+    (which stops the work and keeps what finished) instead of dying with tracebacks; and the
+    workers, which share this process's terminal, log nothing below CRITICAL (a task's error
+    reaches this process as its exception; what they would log is the noise of a stopped run:
+    cancelled tasks, heartbeats to a scheduler already closed)."""
+    import logging
+
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    quiet_dask_logs(logging.CRITICAL)
+
+
+def quiet_dask_logs(level: int) -> None:
+    """Raise Dask's loggers (``distributed`` and below, as its import configured them) to at
+    least ``level`` (a :mod:`logging` level)."""
+    import logging
+
+    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
+    for name in {"distributed", *names}:
+        log = logging.getLogger(name)
+        log.setLevel(max(log.level, level))
 
 
 def dask_client(executor) -> tuple[object, Callable[[], None] | None]:

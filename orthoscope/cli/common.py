@@ -491,13 +491,11 @@ def check_dask(text: str | None) -> None:
         return
     import logging
 
-    from raytrace.executors import check_executor
+    from raytrace.executors import check_executor, quiet_dask_logs
 
     check_executor(text)
     try:
         import distributed  # noqa: F401  (its import sets its loggers' levels)
     except ImportError:
         return  # the run says how to install it
-    for name in [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]:
-        logging.getLogger(name).setLevel(logging.CRITICAL)
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    quiet_dask_logs(logging.CRITICAL)
