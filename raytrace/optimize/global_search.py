@@ -284,16 +284,29 @@ class _Start:
         if self.k == 0:
             return x0, g0
         efl = paraxial(self.lens).efl
-        g = [int(self.rng.integers(len(pool))) for pool in self.pools]
+
+        def draw() -> list[int]:
+            return [int(self.rng.integers(len(pool))) for pool in self.pools]
+
+        def traces(x, g) -> bool:
+            return math.isfinite(
+                _merit_of(design(self.lens, self.spec, x, g, self.pools), self.spec)
+            )
+
+        g = draw()
         # a perturbed start that cannot be traced (a chief ray fails, an impossible lens) is
-        # drawn again with half the perturbation, up to 8 times, then the lens's own values
+        # drawn again with half the perturbation, up to 8 times, every second time with other
+        # random glasses too (a glass far from the lens's can make it untraceable at any
+        # perturbation); then the lens's own values with the drawn glasses, else with its own
         sigma = self.spec.search.perturbation
-        for _ in range(8):
+        for attempt in range(8):
             x = perturb(x0, self.cont, efl, self.rng, sigma, self.lo, self.hi)
-            if math.isfinite(_merit_of(design(self.lens, self.spec, x, g, self.pools), self.spec)):
+            if traces(x, g):
                 return x, g
             sigma *= 0.5
-        return x0, g
+            if attempt % 2 and self.pools:
+                g = draw()
+        return (x0, g) if traces(x0, g) else (x0, g0)
 
     def fit_glasses(self, x: np.ndarray, g: list[int]) -> tuple[np.ndarray, list[int]]:
         """Glass fitting: nd / vd model glasses optimized, then snapped to real glasses."""
