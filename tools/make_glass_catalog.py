@@ -1037,6 +1037,8 @@ def build(date: str) -> dict[str, bytes]:
                 if first["coefficients"] != r["coefficients"]:
                     raise SystemExit(f"{cur}: {r['name']} and {first['name']} differ")
                 first.setdefault("aliases", []).append(r["name"])
+                if r.get("price") != first.get("price"):  # CDGM prices H-K9L* apart (5 vs 10)
+                    first.setdefault("alias_prices", {})[r["name"]] = r.get("price")
                 continue
             seen[key] = len(recs)
             recs.append(r)

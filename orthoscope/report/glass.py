@@ -51,6 +51,11 @@ def format_glass(g: CatalogGlass, wavelengths, indices) -> str:
     if math.isfinite(g.price):
         ref = "N-BK7" if g.catalog == "Schott" else "H-K9L"
         out.append(f"  relative price {g.price:.3g} ({g.catalog}'s catalog, {ref} = 1)")
+    for alias, p in g.alias_prices:
+        out.append(
+            f"  {alias}: the same optical data, relative price "
+            + (f"{p:.3g}" if math.isfinite(p) else "not printed")
+        )
     if g.source:
         out.append(f"  source: {g.source}" + (f" — {g.note}" if g.note else ""))
     printed = {round(w, 4): (lab, n, d) for lab, w, n, d in g.printed_indices}
@@ -86,6 +91,7 @@ def glass_to_dict(g: CatalogGlass, wavelengths, indices) -> dict:
         "source": g.source,
         "note": g.note,
         "relative_price": g.price if math.isfinite(g.price) else None,
+        "alias_prices": {a: p if math.isfinite(p) else None for a, p in g.alias_prices},
         "printed_indices": [
             {"line": lab, "wavelength_nm": w, "n": n, "decimals": d}
             for lab, w, n, d in g.printed_indices

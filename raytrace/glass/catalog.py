@@ -85,7 +85,9 @@ class CatalogGlass:
         the vendor's relative price, normalised to its catalog's reference glass (Schott: the
         "rel. Price" column, N-BK7 = 1; CDGM: the price per volume, H-K9L = 1); ``nan`` where
         the catalog prints none (Ohara, Hoya, Hikari, Sumita, the legacy shelves, some glasses).
-        Prices of different vendors are not on one scale.
+        Prices of different vendors are not on one scale. ``alias_prices``: ((alias, price),
+        ...) for an alias the vendor lists with the same optical data but its own price (CDGM:
+        H-K9L* at 0.5 beside H-K9L at 1).
     """
 
     name: str
@@ -109,6 +111,7 @@ class CatalogGlass:
     source: str = ""
     note: str = ""
     price: float = math.nan
+    alias_prices: tuple[tuple[str, float], ...] = ()
 
     @property
     def material(self) -> Material:
@@ -224,6 +227,7 @@ def _glass(catalog: str, i: int) -> CatalogGlass:
         source=r["source"],
         note=r.get("note", ""),
         price=_float(r.get("price")),
+        alias_prices=tuple((a, _float(v)) for a, v in (r.get("alias_prices") or {}).items()),
     )
 
 
