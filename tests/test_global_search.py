@@ -227,17 +227,22 @@ def test_two_seeds_reach_merits_within_five_percent():
     assert not np.array_equal(a.start_merits, b.start_merits)  # the seeds do differ
 
 
-def test_same_seed_same_result_with_one_and_two_workers():
-    lens = singlet()
+def crown_singlet_spec(starts: int, hops: int) -> DesignSpec:
+    """The singlet's spec with its glass chosen among four Schott crowns."""
     crowns = GlassSettings(
         glasses=("N-BK7", "N-SK16", "N-LAK22", "N-K5"), catalogs=("Schott",), neighbours=2
     )
-    spec = replace(
+    return replace(
         SINGLET_SPEC,
         variables=SINGLET_SPEC.variables + (Variable("glass", 1, glass=crowns),),
         max_evaluations=60,
-        search=SearchSettings(starts=3, hops=1, perturbation=0.3),
+        search=SearchSettings(starts=starts, hops=hops, perturbation=0.3),
     )
+
+
+def test_same_seed_same_result_with_one_and_two_workers():
+    lens = singlet()
+    spec = crown_singlet_spec(starts=3, hops=1)
     one = global_optimize(lens, spec, seed=7, workers=1)
     two = global_optimize(lens, spec, seed=7, workers=2)
     assert one.stopped == two.stopped == ""
@@ -257,15 +262,7 @@ def test_an_untraceable_random_glass_is_drawn_again(monkeypatch, poisoned):
     from raytrace.optimize import global_search as gs
 
     lens = singlet()  # N-BK7
-    crowns = GlassSettings(
-        glasses=("N-BK7", "N-SK16", "N-LAK22", "N-K5"), catalogs=("Schott",), neighbours=2
-    )
-    spec = replace(
-        SINGLET_SPEC,
-        variables=SINGLET_SPEC.variables + (Variable("glass", 1, glass=crowns),),
-        max_evaluations=60,
-        search=SearchSettings(starts=2, hops=0, perturbation=0.3),
-    )
+    spec = crown_singlet_spec(starts=2, hops=0)
     st = gs._Start(lens, spec, 1, 7, lambda: None, lambda *a: None)
     names = [g.name for g in st.pools[0].glasses]
     first = int(np.random.default_rng(np.random.SeedSequence(7, spawn_key=(1,))).integers(4))
