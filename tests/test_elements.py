@@ -25,7 +25,15 @@ from raytrace.elements import insert_element, split_element, surface_map
 from raytrace.errors import LensError
 from raytrace.files.library import load_lens
 from raytrace.materials import fixed_index
-from raytrace.optimize import Operand, Variable, check_spec, evaluate, optimize, split_design
+from raytrace.optimize import (
+    Operand,
+    SpecError,
+    Variable,
+    check_spec,
+    evaluate,
+    optimize,
+    split_design,
+)
 from raytrace.optimize.elements import insert_design
 from raytrace.paraxial import element_power, paraxial
 
@@ -258,10 +266,17 @@ def test_a_minimax_start_that_cannot_be_traced_is_a_clean_error():
         singlet_spec(),
         start="cooke-triplet-f4",
         method="minimax",
-        operands=(Operand("ray_height", 0.0, 1.0, {"surface": 2, "field": 95.0, "max": 10.0}),),
+        operands=(Operand("ray_height", 0.0, 1.0, {"surface": 6, "field": 40.0, "max": 10.0}),),
     )
-    with pytest.raises(TraceError, match=r"strictly between -90 and 90"):
+    # the f/4 rim ray at 40 deg does not get through the Cooke triplet (a trace failure)
+    with pytest.raises(TraceError, match=r"ray_height\(surface=6, field=40.0"):
         optimize(lens, spec)
+    # a field no object can have is refused before any trace, naming the operand
+    bad = replace(spec, operands=(Operand("ray_height", 0.0, 1.0, {"surface": 2, "field": 95.0}),))
+    with pytest.raises(
+        SpecError, match=r"operands\[0\] \(ray_height\(.*field 95 deg: field angles"
+    ):
+        optimize(lens, bad)
 
 
 def test_scan_splits_tries_every_element_and_the_cli_keeps_the_best(tmp_path):

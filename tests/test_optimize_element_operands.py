@@ -156,6 +156,11 @@ def test_a_ray_that_misses_its_surface_is_an_error():
     op = Operand("ray_height", 0.0, 1.0, {"surface": 3, "field": 20.0})
     with pytest.raises(TraceError, match=r"ray_height.*does not reach surface 3"):
         evaluate(lens, (op,))
+    # the Cooke triplet's f/4 upper rim ray at 40 deg reaches surface 4 and is totally
+    # reflected there: said so, not "does not reach"
+    tir = Operand("ray_height", 0.0, 1.0, {"surface": 4, "field": 40.0, "pupil": [0, 1]})
+    with pytest.raises(TraceError, match=r"the ray is totally reflected at surface 4 \(total"):
+        evaluate(load_lens("cooke-triplet-f4"), (tir,))
 
 
 def test_ray_height_parameters_are_checked():
@@ -174,7 +179,9 @@ def test_ray_height_parameters_are_checked():
         variables=(Variable("thickness", 1, 1.0, 60.0),),
         operands=(Operand("ray_height", 0.0, 1.0, {"surface": 4, "max": 12.0}),),
     )
-    with pytest.raises(SpecError, match=r"ray_height: surface 4 does not exist \(1\.\.3"):
+    with pytest.raises(
+        SpecError, match=r"\(ray_height\(surface=4, max=12.0\)\): surface 4 does not exist \(1\.\.3"
+    ):
         check_spec(_stop_and_lens(10.0), spec)
 
 
@@ -217,3 +224,76 @@ def test_element_power_parameters_are_checked():
         )
         with pytest.raises(SpecError, match=msg):
             check_spec(lens, spec)
+
+
+def test_evaluate_checks_what_it_is_given():
+    # the API path (no check_spec before it): a surface the lens lacks is an error naming the
+    # operand, never another surface's value (surface 0 read as Python's index -1 once)
+    lens = load_lens("cooke-triplet-f4")  # 6 surfaces
+    for params, msg in (
+        ({"surface": 0}, r"operands\[0\] \(ray_height\(surface=0\)\): surface 0 does not exist"),
+        ({"surface": -1}, r"surface -1 does not exist"),
+        ({"surface": 7}, r"surface 7 does not exist \(1\.\.6"),
+        ({"surface": 1.7}, r"'surface' must be an integer"),
+        ({"surface": True}, r"'surface' must be an integer"),
+        ({"surface": 2, "pupil": [0, 0, 1]}, r"'pupil' must be two numbers"),
+        ({"surface": 2, "field": 90.0}, r"field 90 deg: field angles lie strictly between"),
+        ({"surface": 2, "field": 5.0, "field_kind": "height"}, r"needs a finite object distance"),
+    ):
+        with pytest.raises(SpecError, match=msg):
+            evaluate(lens, (Operand("ray_height", 0.0, 1.0, params),))
+    with pytest.raises(SpecError, match=r"'surface' must be an integer \(1-based\), got 1.5"):
+        evaluate(lens, (Operand("element_power", 0.0, 1.0, {"surface": 1.5, "last": 3}),))
+    # numpy numbers are numbers (an API user's loop variables)
+    numpy_params = {"surface": np.int64(1), "pupil": np.array([0.0, 1.0])}
+    (v,) = evaluate(lens, (Operand("ray_height", 0.0, 1.0, numpy_params),))
+    (w,) = evaluate(lens, (Operand("ray_height", 0.0, 1.0, {"surface": 1, "pupil": [0.0, 1.0]}),))
+    assert v.value == w.value
+
+
+def test_element_power_default_refuses_a_cemented_element():
+    # Tessar surfaces 6-7: the flint of the cemented rear group. Its power "in its media" (air in
+    # front, the crown behind) is not the element's power in air (the thick-lens formula gives a
+    # negative element): the default 'element' is refused and 'last' names the run meant.
+    lens = load_lens("tessar-fr1066698")
+    assert lens.surfaces[5].material.is_air is False and lens.surfaces[6].material.is_air is False
+    with pytest.raises(SpecError, match=r"surfaces 6-7 are not an element in air .* give 'last'"):
+        evaluate(lens, (Operand("element_power", 0.0, 1.0, {"surface": 6}),))
+    (group,) = evaluate(lens, (Operand("element_power", 0.0, 1.0, {"surface": 6, "last": 8}),))
+    assert math.isfinite(group.value)
+
+
+def test_failed_evaluations_are_counted_and_named(tmp_path):
+    # a thickness pushed against the wall where the rim ray starts to fail: the run says how many
+    # trial lenses could not be traced and why the first one failed
+    from raytrace.optimize.solver import EvaluationLog
+
+    log = EvaluationLog()
+    assert log.note() == ""
+    log.n, log.failed, log.first_failure = 10, 3, "ray_height(surface=2): travels backwards"
+    assert log.note() == (
+        "; 3 of 10 evaluations failed (trial lenses that cannot be traced; the first: "
+        "ray_height(surface=2): travels backwards)"
+    )
+    # the Cooke triplet's first element thinned towards 0.5 mm: below about 1.8 mm its edge
+    # closes and the 20 deg lower rim ray meets surface 2 before surface 1 (travels backwards)
+    from dataclasses import replace
+
+    lens = load_lens("cooke-triplet-f4")
+    spec = DesignSpec(
+        start="cooke-triplet-f4",
+        variables=(Variable("thickness", 1, 0.1),),
+        operands=(
+            Operand("center_thickness", 0.5, 10.0, {"surface": 1}),
+            Operand("ray_height", 0.0, 1.0, {"surface": 2, "field": 20.0, "pupil": [0, -0.8],
+                                             "max": 100.0}),
+        ),
+        max_evaluations=30,
+    )  # fmt: skip
+    for method in ("least_squares", "minimax"):
+        res = optimize(lens, replace(spec, method=method))
+        n_failed = int(res.message.split(" evaluations failed")[0].split("; ")[-1].split(" of ")[0])
+        assert n_failed > 0, res.message
+        assert "the first: ray_height(surface=2, field=20.0, pupil=[0, -0.8]" in res.message
+        assert "travels backwards to surface 2" in res.message
+        assert res.lens.surfaces[0].thickness > 1.8  # the best traceable design is kept

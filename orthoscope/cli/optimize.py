@@ -194,9 +194,10 @@ def _operand_table(operands) -> list[dict]:
 
 
 def _print_table(table: list[dict]) -> None:
-    print(f"{'operand':40} {'value':>14} {'target / bound':>20} {'weighted resid.':>16}")
-    for r in table:
-        print(f"{r['operand'][:40]:40} {r['value']:14.6f} {r['aim']:>20} {r['residual']:16.6g}")
+    w = max([len("operand"), *(len(r["operand"]) for r in table)])  # whole labels: two rim
+    print(f"{'operand':{w}} {'value':>14} {'target / bound':>20} {'weighted resid.':>16}")
+    for r in table:  # rays on one surface differ only at the end of theirs
+        print(f"{r['operand']:{w}} {r['value']:14.6f} {r['aim']:>20} {r['residual']:16.6g}")
 
 
 def _search_overrides(args) -> dict:

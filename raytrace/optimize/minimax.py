@@ -50,6 +50,7 @@ from ..paraxial import paraxial
 from .operands import OperandValue
 from .solver import (
     EVAL_FAILURES,
+    EvaluationLog,
     OptimizationResult,
     Stopped,
     apply,
@@ -213,12 +214,12 @@ def minimax(
     sc = step_scales(lens, spec)
     P = float(spec.penalty)
     n = len(x)
-    n_ev = [0]
+    log = EvaluationLog()
     t0 = time.perf_counter()
 
     def ev(xv: np.ndarray, start: bool = False):
         try:
-            vals = checked_evaluate(lens, spec, xv, stop, n_ev)
+            vals = checked_evaluate(lens, spec, xv, stop, log)
         except EVAL_FAILURES as err:
             if start:  # the start must evaluate: its own error, as damped least squares gives it
                 raise
@@ -230,7 +231,7 @@ def minimax(
                 raise SpecError(f"the start lens: operand {bad.operand.label()} is not finite")
             raise _Failed("an operand is not finite")
         if progress is not None:
-            progress(n_ev[0], _max_abs(e), max(vals, key=lambda o: abs(o.residual)))
+            progress(log.n, _max_abs(e), max(vals, key=lambda o: abs(o.residual)))
         return e, g, vals
 
     def phi(e, g) -> float:
@@ -244,7 +245,7 @@ def minimax(
     h = DIFF_STEP * sc
     try:
         while True:
-            if n_ev[0] + 2 * n + 1 > limit:
+            if log.n + 2 * n + 1 > limit:
                 status, message = "limit", f"stopped at the evaluation limit ({limit})"
                 break
             J = np.zeros((len(e), n))
@@ -280,7 +281,7 @@ def minimax(
                     status = "converged"
                     message = "converged: the linearised problem predicts no further decrease"
                     break
-                if n_ev[0] + 1 > limit:
+                if log.n + 1 > limit:
                     status, message = "limit", f"stopped at the evaluation limit ({limit})"
                     break
                 xn = np.clip(x + z * sc, lo, hi)
@@ -292,7 +293,7 @@ def minimax(
                     continue
                 fn = phi(en, gn)
                 ratio = (f - fn) / pred
-                if not (fn < f and ratio > 0.05) and n_ev[0] + 1 <= limit:
+                if not (fn < f and ratio > 0.05) and log.n + 1 <= limit:
                     corr = _second_order_correction(e, g, Js, Gs, z, t_lp, en, gn, f)
                     if corr is not None:
                         xc = np.clip(xn + corr * sc, lo, hi)
@@ -337,13 +338,14 @@ def minimax(
     elif converged and spec.merit_goal is not None and m > spec.merit_goal:
         converged = False
         message = f"max weighted residual {m:.6g} is above the goal {spec.merit_goal:.6g}"
+    message += log.note()
     return OptimizationResult(
         lens=final,
         x=np.asarray(x, dtype=float),
         merit_start=m0,
         merit=m,
         operands=vals,
-        evaluations=n_ev[0],
+        evaluations=log.n,
         converged=converged,
         message=message,
         seconds=time.perf_counter() - t0,

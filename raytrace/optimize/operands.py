@@ -25,10 +25,11 @@ docs/design.md, "Conventions"; the spec language is documented in ``docs/spec.md
 ``ray_height``        distance from the axis (mm, ≥ 0) at which one real ray meets ``surface``: the
                       ray from ``field`` through ``pupil = [px, py]`` (fractions of the paraxial
                       entrance-pupil radius, centred on the axis; default [0, 1], the upper rim
-                      of the meridional section), the rays of the spot operands' bundles; as a
+                      of the meridional section), built as the spot operands' rays; as a
                       ``max`` bound it keeps a footprint inside a clear aperture.
 ``element_power``     paraxial power (1/mm) of the surfaces ``surface`` .. ``last`` (default
-                      ``surface + 1``: an element), :func:`raytrace.paraxial.element_power`.
+                      ``surface + 1``: an element in air; refused inside a cemented group),
+                      :func:`raytrace.paraxial.element_power`.
 ``axial_color``       paraxial axial colour: the Gaussian image plane at ``wavelengths[0]`` minus
                       the one at ``wavelengths[1]`` (default F 486.1327 − C 656.2725 nm), mm.
 ``center_thickness``  axial thickness after ``surface``.
@@ -60,7 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import TraceError
-from ..kernels.codes import status_message
+from ..kernels.codes import STATUS_TIR, status_message
 from ..lens import Lens
 from ..packing import pack
 from ..paraxial import (
@@ -73,7 +74,7 @@ from ..paraxial import (
     paraxial,
     resolve_object_distance,
 )
-from .spec import Operand, SpecError
+from .spec import SURFACE_OPERANDS, Operand, SpecError, operand_problems
 
 
 @dataclass(frozen=True)
@@ -273,13 +274,73 @@ def _ray_heights(lens: Lens, ops: list[Operand], par_for, pack_for) -> dict[int,
             i = int(op.params["surface"]) - 1
             x, y = paths.x[j, i], paths.y[j, i]
             if not (math.isfinite(x) and math.isfinite(y)):
-                why = status_message(int(paths.status[j]), int(paths.surface[j]))
-                raise TraceError(f"{op.label()}: the ray does not reach surface {i + 1} ({why})")
+                st, at = int(paths.status[j]), int(paths.surface[j])
+                fate = (  # reflected totally at the surface itself: it did reach it
+                    "is totally reflected at"
+                    if st == STATUS_TIR and at == i + 1
+                    else "does not reach"
+                )
+                why = status_message(st, at)
+                raise TraceError(f"{op.label()}: the ray {fate} surface {i + 1} ({why})")
             out[id(op)] = math.hypot(x, y)
     return out
 
 
-def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, ...]:
+def operand_lens_problems(lens: Lens, op: Operand) -> list[str]:
+    """What makes a well-formed operand (:func:`~raytrace.optimize.spec.operand_problems` found
+    nothing) impossible on ``lens``: a surface it names that the lens lacks (or that rays do not
+    meet), a run of surfaces that ends inside glass by default, a field the object cannot have.
+    Empty when it applies."""
+    n = lens.n_surfaces
+    p = op.params
+    out: list[str] = []
+    if op.type in SURFACE_OPERANDS:
+        s = p["surface"]
+        pair = op.type == "edge_thickness" or (op.type == "element_power" and "last" not in p)
+        last = n - 1 if pair else n  # the surface and the next one
+        if pair and s == n:
+            out.append(
+                f"surface {s} is the last; it needs the next surface"
+                + (" (give 'last' for a run of surfaces)" if op.type == "element_power" else "")
+            )
+        elif not 1 <= s <= last:
+            out.append(f"surface {s!r} does not exist (1..{last} for this lens)")
+        elif not p.get("last", s) <= n:
+            out.append(f"last surface {p['last']!r} does not exist (the lens has {n})")
+        elif op.type == "ray_height" and lens.surfaces[s - 1].coordinate_break:
+            out.append(f"surface {s} is a coordinate break (not traced); name a surface rays meet")
+        elif (
+            op.type == "element_power"
+            and "last" not in p
+            and not (
+                lens.surfaces[s].material.is_air
+                and (s == 1 or lens.surfaces[s - 2].material.is_air)
+            )
+        ):
+            out.append(
+                f"surfaces {s}-{s + 1} are not an element in air (glass before or after them: "
+                "a cemented group); give 'last' for the run of surfaces whose power you mean, e.g. "
+                "the whole group, which is then taken between the media around it"
+            )
+    if "field" in p:
+        try:
+            od = _object_distance(lens, op)
+        except SpecError as e:
+            return [*out, str(e).split(": ", 1)[-1]]
+        f = float(p["field"])
+        if _field_kind(lens, op, od) == "angle" and not abs(f) < 90.0:
+            out.append(f"field {f:g} deg: field angles lie strictly between -90 and 90 degrees")
+        elif _field_kind(lens, op, od) == "height" and math.isinf(od):
+            out.append(
+                f"field {f:g} mm is an object height, which needs a finite object distance "
+                '(give object_distance, or field_kind = "angle")'
+            )
+    return out
+
+
+def evaluate(
+    lens: Lens, operands: tuple[Operand, ...], *, check: bool = True
+) -> tuple[OperandValue, ...]:
     """Compute every operand for ``lens``.
 
     Chief rays are batched: one kernel call per (object distance, field kind, wavelength) for all
@@ -287,8 +348,19 @@ def evaluate(lens: Lens, operands: tuple[Operand, ...]) -> tuple[OperandValue, .
     distortion_slope, landing_angle); every image plane is reached by analytic transfer of the
     final segments. Paraxial data are computed once per (object, wavelength), the lens is packed
     once per wavelength for the spot operands.
+
+    ``check``: first check every operand (its keys and types, and that it applies to ``lens``:
+    :func:`operand_lens_problems`) and raise :class:`SpecError` naming it; the optimizers, which
+    checked the spec once with :func:`~raytrace.optimize.check_spec`, pass False.
     """
     from ..trace import aim, trace_rays
+
+    if check:
+        for i, op in enumerate(operands):
+            bad = operand_problems(op.type, op.params, op.target, op.weight)
+            bad = bad or operand_lens_problems(lens, op)
+            if bad:
+                raise SpecError(f"operands[{i}] ({op.label()}): {bad[0]}")
 
     pars: dict[tuple[float, float | None], ParaxialResult] = {}
     packs: dict[float | None, object] = {}

@@ -7,6 +7,7 @@ or minimax (:mod:`.minimax`)."""
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -18,14 +19,13 @@ from ..errors import OrthoscopeError
 from ..lens import Lens
 from ..materials import Material
 from ..paraxial import gaussian_solved, paraxial
-from .operands import OperandValue, evaluate, merit
+from .operands import OperandValue, evaluate, merit, operand_lens_problems
 from .spec import (
     ABBE_BOUNDS,
     ASPHERIC_KINDS,
     INDEX_BOUNDS,
     METHODS,
     PICKUP_KINDS,
-    SURFACE_OPERANDS,
     VARIABLE_KINDS,
     DesignSpec,
     SpecError,
@@ -204,7 +204,7 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
         if v.kind not in VARIABLE_KINDS:
             probs.append(f"unknown variable kind {v.kind!r}{suggest(v.kind, VARIABLE_KINDS)}")
             continue
-        if not isinstance(v.surface, int) or isinstance(v.surface, bool):
+        if not isinstance(v.surface, numbers.Integral) or isinstance(v.surface, bool):
             probs.append(f"variable {v.kind}: surface must be an integer, got {v.surface!r}")
             continue
         if not 1 <= v.surface <= n:
@@ -248,35 +248,10 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
         probs.append(f"unknown method {spec.method!r}{suggest(spec.method, METHODS)}")
     if not (isinstance(spec.penalty, (int, float)) and spec.penalty > 0):
         probs.append(f"penalty must be a positive number, got {spec.penalty!r}")
-    for op in spec.operands:
+    for i, op in enumerate(spec.operands):
         bad = operand_problems(op.type, op.params, op.target, op.weight)
-        probs += [f"operand {op.type}: {b}" for b in bad]
-        if bad or op.type not in SURFACE_OPERANDS:
-            continue
-        s = op.params["surface"]
-        pair = op.type == "edge_thickness" or (
-            op.type == "element_power" and "last" not in op.params
-        )
-        last = n - 1 if pair else n  # the surface and the next one
-        if pair and s == n:
-            probs.append(
-                f"operand {op.type}: surface {s} is the last; it needs the next surface"
-                + (" (give 'last' for a run of surfaces)" if op.type == "element_power" else "")
-            )
-        elif not 1 <= s <= last:
-            probs.append(
-                f"operand {op.type}: surface {s!r} does not exist (1..{last} for this lens)"
-            )
-        elif not op.params.get("last", s) <= n:
-            probs.append(
-                f"operand {op.type}: last surface {op.params['last']!r} does not exist (the "
-                f"lens has {n})"
-            )
-        elif op.type == "ray_height" and lens.surfaces[s - 1].coordinate_break:
-            probs.append(
-                f"operand ray_height: surface {s} is a coordinate break (not traced); name a "
-                "surface that rays meet"
-            )
+        bad = bad or operand_lens_problems(lens, op)
+        probs += [f"operands[{i}] ({op.label()}): {b}" for b in bad]
     if len(probs) == 1:
         raise SpecError(probs[0])
     if probs:
@@ -288,22 +263,49 @@ def check_spec(lens: Lens, spec: DesignSpec, *, need_continuous: bool = True) ->
 EVAL_FAILURES = (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError)
 
 
+@dataclass
+class EvaluationLog:
+    """The merit evaluations of one optimizer run (a counter, so not frozen): how many, how many
+    failed (a trial lens that cannot be traced: a ray misses a surface, total internal
+    reflection, ...), and the first failure's reason."""
+
+    n: int = 0
+    failed: int = 0
+    first_failure: str = ""
+
+    def note(self) -> str:
+        """What to add to the run's message: nothing, or how many evaluations failed and why."""
+        if not self.failed:
+            return ""
+        return (
+            f"; {self.failed} of {self.n} evaluations failed (trial lenses that cannot be traced; "
+            f"the first: {self.first_failure})"
+        )
+
+
 def checked_evaluate(
     lens: Lens,
     spec: DesignSpec,
     x: np.ndarray,
     stop: Callable[[], str | None] | None,
-    count: list[int],
+    log: EvaluationLog,
 ) -> tuple[OperandValue, ...]:
     """One merit evaluation of an optimizer: ask ``stop()`` first (raise :class:`Stopped` with
-    its reason), count it in ``count[0]``, evaluate the operands of ``spec`` applied to ``lens``
-    at ``x``. An impossible trial lens raises one of :data:`EVAL_FAILURES`."""
+    its reason), count it in ``log``, evaluate the operands of ``spec`` (checked against the
+    lens by :func:`check_spec` before the run) applied to ``lens`` at ``x``. An impossible trial
+    lens raises one of :data:`EVAL_FAILURES`, counted in ``log`` with the first reason."""
     if stop is not None:
         why = stop()
         if why:
             raise Stopped(why)
-    count[0] += 1
-    return evaluate(apply(lens, spec, x), spec.operands)
+    log.n += 1
+    try:
+        return evaluate(apply(lens, spec, x), spec.operands, check=False)
+    except EVAL_FAILURES as e:
+        log.failed += 1
+        if not log.first_failure:
+            log.first_failure = " ".join(str(e).split())[:300]
+        raise
 
 
 def variable_scales(lens: Lens, spec: DesignSpec) -> np.ndarray:
@@ -358,14 +360,14 @@ def optimize(
     sc = variable_scales(lens, spec)
     start_vals = evaluate(apply(lens, spec, x0), spec.operands)
     m0 = merit(start_vals)
-    n_ev = [0]
+    log = EvaluationLog()
     best = [m0, x0.copy()]
     big = math.sqrt(m0 + 1.0) * 1e3
     t0 = time.perf_counter()
 
     def fun(xs):
         try:
-            vals = checked_evaluate(lens, spec, xs * sc, stop, n_ev)
+            vals = checked_evaluate(lens, spec, xs * sc, stop, log)
         except EVAL_FAILURES:
             # an impossible lens in the middle of a step: a large, smooth-ish penalty
             return np.full(len(spec.operands), big)
@@ -374,7 +376,7 @@ def optimize(
         if m < best[0]:
             best[0], best[1] = m, xs * sc
         if progress is not None:
-            progress(n_ev[0], m, max(vals, key=lambda o: abs(o.residual)))
+            progress(log.n, m, max(vals, key=lambda o: abs(o.residual)))
         return r
 
     stopped = ""
@@ -408,15 +410,16 @@ def optimize(
     elif status == 0:
         msg = (
             f"stopped at the evaluation limit ({limit} merit evaluations of the solver's steps; "
-            f"{n_ev[0]} with its finite-difference Jacobians) before converging"
+            f"{log.n} with its finite-difference Jacobians) before converging"
         )
+    msg += log.note()
     return OptimizationResult(
         lens=final,
         x=np.asarray(x_final, dtype=float),
         merit_start=m0,
         merit=m,
         operands=vals,
-        evaluations=n_ev[0],
+        evaluations=log.n,
         converged=converged,
         message=msg,
         seconds=time.perf_counter() - t0,

@@ -341,11 +341,11 @@ def suggest(word: str, choices) -> str:
 
 
 def _is_int(v) -> bool:
-    return isinstance(v, int) and not isinstance(v, bool)
+    return isinstance(v, numbers.Integral) and not isinstance(v, bool)  # numpy integers too
 
 
 def _is_num(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
 
 
 def _num_or_inf(v) -> bool:
@@ -441,7 +441,7 @@ def operand_problems(
     if "pupil" in p:
         pp = p["pupil"]
         if not (
-            isinstance(pp, (list, tuple))
+            (isinstance(pp, (list, tuple)) or type(pp).__name__ == "ndarray")  # API: an array
             and len(pp) == 2
             and all(_is_num(c) and math.isfinite(c) for c in pp)
             and math.hypot(*pp) <= 1.0 + 1e-12
