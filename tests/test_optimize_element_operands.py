@@ -297,3 +297,21 @@ def test_failed_evaluations_are_counted_and_named(tmp_path):
         assert "the first: ray_height(surface=2, field=20.0, pupil=[0, -0.8]" in res.message
         assert "travels backwards to surface 2" in res.message
         assert res.lens.surfaces[0].thickness > 1.8  # the best traceable design is kept
+
+
+def test_a_coordinate_break_is_no_element_and_no_footprint():
+    # a coordinate break is a frame, not a surface rays meet (docs/design.md): both operands
+    # refuse it instead of giving the next surface's power / a meaningless height
+    from raytrace.frames import Placement
+
+    cooke = load_lens("cooke-triplet-f4")
+    cb = Surface(0.0, 0.0, coordinate_break=True, placement=Placement((0, 0.5, 0), (0, 0, 0)))
+    lens = Lens("cb", (cb, *cooke.surfaces), cooke.aperture, cooke.field)
+    for op, msg in (
+        (Operand("element_power", 0.0, 1.0, {"surface": 1}), "name the element's first surface"),
+        (Operand("ray_height", 0.0, 1.0, {"surface": 1}), "name a surface rays meet"),
+    ):
+        with pytest.raises(
+            SpecError, match=r"surface 1 is a coordinate break \(not traced\); " + msg
+        ):
+            evaluate(lens, (op,))

@@ -307,8 +307,15 @@ def operand_lens_problems(lens: Lens, op: Operand) -> list[str]:
             out.append(f"surface {s!r} does not exist (1..{last} for this lens)")
         elif not p.get("last", s) <= n:
             out.append(f"last surface {p['last']!r} does not exist (the lens has {n})")
-        elif op.type == "ray_height" and lens.surfaces[s - 1].coordinate_break:
-            out.append(f"surface {s} is a coordinate break (not traced); name a surface rays meet")
+        elif op.type in ("ray_height", "element_power") and lens.surfaces[s - 1].coordinate_break:
+            out.append(
+                f"surface {s} is a coordinate break (not traced); name "
+                + (
+                    "a surface rays meet"
+                    if op.type == "ray_height"
+                    else "the element's first surface"
+                )
+            )
         elif (
             op.type == "element_power"
             and "last" not in p
