@@ -267,3 +267,11 @@ def test_strict_turns_a_failed_field_into_exit_2(capsys):
     assert rc == 2 and len(lines) == 1 and "--strict" in lines[0]
     rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--strict")
     assert rc == 0
+    # trace too (the README's example): the table first, then the one error line
+    rc, out, err = run(capsys, "trace", "cooke-triplet-f4", "--fields", "0,10,30,60", "--strict")
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert rc == 2 and "aim_failed" in out
+    assert lines == ["orthoscope trace: error: 2 field(s) could not be traced (see the table); "
+                     "--strict fails"]  # fmt: skip
+    rc, out, err = run(capsys, "trace", "cooke-triplet-f4", "--fields", "0,10,20", "--strict")
+    assert rc == 0

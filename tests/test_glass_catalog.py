@@ -303,6 +303,10 @@ def test_relative_prices_are_the_vendors():
     for cat, prices in (("Schott", SCHOTT_PRICES), ("CDGM", CDGM_PRICES)):
         for name, price in prices.items():
             assert lookup_glass(name, [cat]).price == pytest.approx(price, rel=1e-12), name
+    # a glass prints as one line (the record holds long tables)
+    assert repr(lookup_glass("N-BK7", ["Schott"])) == (
+        "CatalogGlass(N-BK7 (Schott): nd 1.516800, vd 64.170, price 1)"
+    )
     # CDGM.xls prices H-K9L* (same optical data, an alias of H-K9L here) 5 per volume: 0.5
     assert lookup_glass("H-K9L", ["CDGM"]).alias_prices == (("H-K9L*", 0.5),)
     # vendors that print no price: nan, never a made-up number

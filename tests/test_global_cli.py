@@ -49,6 +49,13 @@ def test_global_writes_the_lens_with_seed_and_merit(refocus: Path, tmp_path: Pat
     assert "wrote" in cap.out and "merit per start" in cap.out
     # off a terminal: plain progress lines, one per finished start
     assert "start 0 done (1/2)" in cap.err and "start 1 done (2/2)" in cap.err
+    # two starts: the median is their mean (it once printed the larger one)
+    done = [
+        float(x.split("merit ")[1].split(",")[0]) for x in cap.err.splitlines() if " done " in x
+    ]
+    line = next(x for x in cap.out.splitlines() if x.startswith("merit per start"))
+    median = float(line.split("median ")[1].split(",")[0])
+    assert len(done) == 2 and median == pytest.approx(sum(done) / 2, rel=1e-5)
     lens = read_lens(out)
     assert lens.notes.startswith("provenance: derived")
     assert "--global --seed 9 --starts 2' (0 hops per start)" in lens.notes

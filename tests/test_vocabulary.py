@@ -5,6 +5,7 @@ work with a warning; values with units are read in their unit."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -85,6 +86,15 @@ def test_old_spellings_work_with_a_warning(capsys):
     old, err = _cli(capsys, "--s", "-650", "--image-distance", "50.5")
     assert "deprecated" in err and "--object-s" in err and "--s-prime" in err
     assert old == new
+    # calibrate's --criterion (now --method, which it requires): the old spelling still runs
+    table = str(Path(__file__).parent / "data" / "pestrecov_table1.csv")
+    assert main(["calibrate", table, "--method", "minimax", "--json"]) == 0
+    new = capsys.readouterr().out
+    assert main(["calibrate", table, "--criterion", "minimax", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert cap.out == new and "--criterion is deprecated" in cap.err and "--method" in cap.err
+    assert main(["calibrate", table]) == 2
+    assert "the following argument is required: --method" in capsys.readouterr().err
 
 
 def test_lengths_and_wavelengths_with_units(capsys):

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 
 from .common import (
+    METHODS,
+    CliError,
     add_force_arg,
     add_output_args,
     add_table_layout_arg,
@@ -34,6 +36,8 @@ def cmd_calibrate(args) -> int:
 
     from ..report.distortion import calibration_csv, calibration_to_dict, format_calibration
 
+    if args.method is None:
+        raise CliError(f"the following argument is required: --method {{{','.join(METHODS)}}}")
     args._inputs = [args.table]
     for flag in ("plot", "plot_rotation"):
         check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)

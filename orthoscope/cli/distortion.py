@@ -66,7 +66,9 @@ OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png"), ("--layout", ".png")
 def add_calibration_args(q: argparse.ArgumentParser, *, required: bool) -> None:
     g = q.add_argument_group("calibration")
     if required:
-        g.add_argument("--method", required=True, choices=METHODS, help=METHOD_HELP)
+        # required, checked by the command (argparse's required=True would refuse the
+        # deprecated spelling --criterion, which stores to the same place)
+        g.add_argument("--method", choices=METHODS, help=METHOD_HELP + " Required.")
         add_alias(g, "--criterion", "--method", "method", choices=METHODS)
     else:
         g.add_argument("--calibrate", metavar="METHOD", choices=METHODS, help=METHOD_HELP)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import math
+import statistics
 import sys
 import time
 from dataclasses import replace
@@ -511,7 +512,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         fin = [m for m in res.start_merits if m == m]
         if fin:
             print(
-                f"merit per start: min {min(fin):.6g}, median {sorted(fin)[len(fin) // 2]:.6g}, "
+                f"merit per start: min {min(fin):.6g}, median {statistics.median(fin):.6g}, "
                 f"max {max(fin):.6g}"
             )
         for g in res.glasses:

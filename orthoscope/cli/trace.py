@@ -11,14 +11,16 @@ from .common import (
     add_object_args,
     add_output_args,
     add_plane_args,
+    add_strict_arg,
     add_wavelength_arg,
     check_finite_object,
-    load,
+    load_input,
     plane_origin,
     print_result,
     resolve_fields,
     resolve_object,
     resolve_planes,
+    strict_check,
 )
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -34,7 +36,7 @@ def cmd_trace(args) -> int:
 
     from ..report.trace import format_trace, image_plane_dict, trace_csv, trace_to_dict
 
-    lens = load(args.lens)
+    lens = load_input(args)
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
     par = paraxial(lens, od, args.wavelength)
@@ -51,6 +53,7 @@ def cmd_trace(args) -> int:
         csv=lambda: trace_csv(cr, z_img),
         text=lambda: format_trace(lens, par, cr, plane),
     )
+    strict_check(args, cr.status)
     return 0
 
 
@@ -68,5 +71,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_field_args(q)
     add_plane_args(q)
     add_wavelength_arg(q)
+    add_strict_arg(q)
     add_output_args(q)
     q.set_defaults(func=cmd_trace)

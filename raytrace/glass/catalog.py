@@ -113,6 +113,14 @@ class CatalogGlass:
     price: float = math.nan
     alias_prices: tuple[tuple[str, float], ...] = ()
 
+    def __repr__(self) -> str:  # one line (docs/design.md): the record holds long tables
+        price = f", price {self.price:g}" if math.isfinite(self.price) else ""
+        status = f", {self.status}" if self.status else ""
+        return (
+            f"CatalogGlass({self.name} ({self.catalog}): nd {self.nd:.6f}, vd {self.vd:.3f}"
+            f"{status}{price})"
+        )
+
     @property
     def material(self) -> Material:
         """The :class:`~raytrace.materials.Material` that evaluates the vendor formula."""
