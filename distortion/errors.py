@@ -14,3 +14,8 @@ class DataError(OrthoscopeError):
 class CalibrationError(DataError, ValueError):
     """An impossible calibration request (unknown criterion, a field not in the curve, too few
     points, a degenerate fit). A :class:`DataError` and a :class:`ValueError`."""
+
+
+class UnitWarning(UserWarning):
+    """A value that was read in the unit the input defines but looks like another unit (e.g. a
+    plain distance read as metres that looks like millimetres)."""

@@ -9,13 +9,14 @@ plane).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
 from distortion.characteristic import characteristic_distortion
-from distortion.errors import DataError
+from distortion.errors import DataError, UnitWarning
 from distortion.variation.models import Conjugate, brown_alpha_scales
 from distortion.variation.traced import (
     conjugate_geometry,
@@ -51,9 +52,19 @@ def test_parse_conjugate():
     assert parse_conjugate("1.5") == Conjugate(1.5, "m")
     assert parse_conjugate("1.5m") == Conjugate(1.5, "m")
     assert math.isinf(parse_conjugate("inf").value)
-    for bad in ("", "12q", "-3x", "0", "x"):
+    for bad in ("", "12q", "-3x", "0", "x", "mm"):
         with pytest.raises(DataError):
             parse_conjugate(bad)
+    # the rest of orthoscope speaks millimetres: a unit written out is converted
+    assert parse_conjugate("1500mm") == Conjugate(1.5, "m")
+    assert parse_conjugate("150cm") == Conjugate(1.5, "m")
+    # a plain number is metres here (Fraser & Shortis); one this large looks like millimetres
+    with pytest.warns(UnitWarning, match=r"'2000' is read as 2000 m .* write 2000mm, or 2000m"):
+        assert parse_conjugate("2000") == Conjugate(2000.0, "m")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a unit written out, or a small plain number: silent
+        assert parse_conjugate("2000m").value == 2000.0
+        assert parse_conjugate("30").value == 30.0
 
 
 def test_image_scale_is_gaussian_magnification(s65):

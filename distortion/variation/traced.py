@@ -64,6 +64,7 @@ the grid radii themselves).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -74,10 +75,12 @@ from raytrace.errors import TraceError
 from raytrace.lens import Lens
 from raytrace.paraxial.orthoscopy import object_distance_for_magnification
 
-from ..errors import DataError
+from ..errors import DataError, UnitWarning
 from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
 from .models import WEAK_THRESHOLD_UM, Conjugate
 
+#: a plain distance (metres) this large looks like millimetres (parse_conjugate warns)
+PLAIN_METRES_WARN = 100.0
 DEFAULT_N_FIELDS = 121
 DEFAULT_N_R = 25
 
@@ -107,31 +110,43 @@ def parse_conjugate(text: str) -> Conjugate:
     """A focus or object distance as a person types it.
 
     ``"12x"`` (also ``12X``, ``12×``): image scale N (Gaussian magnification −1/N);
-    ``"1.5"`` or ``"1.5m"``: metres from the first principal point H (positive);
-    ``"inf"``: infinity (metres). Raises DataError otherwise.
+    ``"1.5"`` or ``"1.5m"``: metres from the first principal point H (positive; Fraser &
+    Shortis's unit); ``"1500mm"`` / ``"150cm"``: the same distance with its unit;
+    ``"inf"``: infinity (metres). Raises DataError otherwise. A plain number of
+    :data:`PLAIN_METRES_WARN` or more warns (:class:`~distortion.errors.UnitWarning`) that it
+    looks like millimetres; a unit written out (``"1500m"``) says it is meant.
     """
+    from raytrace.units import LENGTH_UNITS, UnitError, split_unit
+
     t = str(text).strip()
     if not t:
         raise DataError("empty distance (expected e.g. '12x' or '1.5' metres)")
-    low = t.lower()
-    if low in ("inf", "infinity", "infm", "inf m"):
-        return Conjugate(math.inf, "m", "inf")
-    if low.endswith(("x", "×")):
-        num, unit = t[:-1].strip(), "x"
-    elif low.endswith("m") and not low.endswith("mm"):
-        num, unit = t[:-1].strip(), "m"
-    else:
-        num, unit = t, "m"
+    if t.lower() in ("infinity", "inf m", "infm"):
+        t = "inf"
     try:
-        v = float(num)
-    except ValueError:
+        v, u = split_unit(t)
+    except UnitError:
+        u = "?"
+    if u not in ("", "x", *LENGTH_UNITS):
         raise DataError(
             f"distance {t!r}: expected an image scale like '12x' (magnification -1/12) or a "
-            "distance in metres from the lens like '1.5'"
-        ) from None
-    if not (v > 0 and (math.isfinite(v) or unit == "m")):
+            "distance from the lens like '1.5' (metres), '1.5m' or '1500mm'"
+        )
+    if not (v > 0 and (math.isfinite(v) or u != "x")):
         raise DataError(f"distance {t!r} must be positive (a magnitude) and finite")
-    return Conjugate(v, unit, t)
+    if u == "x":
+        return Conjugate(v, "x", t)
+    if u:  # a length unit written out (the one table: raytrace.units)
+        return Conjugate(v * LENGTH_UNITS[u] / LENGTH_UNITS["m"], "m", t)
+    if v >= PLAIN_METRES_WARN and math.isfinite(v):
+        warnings.warn(
+            UnitWarning(
+                f"distance {t!r} is read as {v:g} m from the lens (a plain number is metres "
+                f"here); it looks like millimetres: write {t}mm, or {t}m to keep metres"
+            ),
+            stacklevel=2,
+        )
+    return Conjugate(v, "m", t)
 
 
 def parse_conjugates(text: str) -> list[Conjugate]:

@@ -24,7 +24,8 @@ from .common import (
 CONJ_HELP = (
     "Distances are positive magnitudes: 'Nx' (also 'NX') is an image scale, Gaussian "
     "magnification -1/N (12x: the image is 1/12 of the object; with unit focusing the object is "
-    "f(1+N) in front of the first principal point H); a plain number (or '1.5m') is metres from H; "
+    "f(1+N) in front of the first principal point H); a plain number (or '1.5m') is metres from H "
+    "('1500mm' also works; a plain number of 100 or more warns that it looks like millimetres); "
     "'inf' is infinity."
 )
 UNITS_EPILOG = (
