@@ -108,3 +108,20 @@ def test_bad_requests(cooke):
         osc.spot_diagram(cooke, 0.0, pattern="spiral")
     with pytest.raises(TraceError, match="one image plane"):
         osc.spot_diagram(cooke, 0.0, s_prime=[40.0, 41.0])
+
+
+def test_fan_and_spot_json_carry_the_field_unit_in_a_key(capsys):
+    # README "JSON output": lengths and angles carry their unit in the key
+    import json
+
+    from orthoscope.cli import main
+
+    assert main(["spot", "cooke-triplet-f4", "--fields", "0,20", "--json"]) == 0
+    spots = json.loads(capsys.readouterr().out)["spots"]
+    assert [(s["field"], s["angle_deg"], s["field_kind"]) for s in spots] == [
+        (0.0, 0.0, "angle"),
+        (20.0, 20.0, "angle"),
+    ]
+    assert main(["fan", "cooke-triplet-f4", "--field", "14", "--json"]) == 0
+    fans = json.loads(capsys.readouterr().out)["fans"]
+    assert all(f["angle_deg"] == 14.0 and "object_height_mm" not in f for f in fans)

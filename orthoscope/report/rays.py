@@ -11,11 +11,17 @@ def _field(f) -> str:
     return f"{f.field:g} deg" if f.field_kind == "angle" else f"object height {f.field:g} mm"
 
 
+def _field_keys(f) -> dict:
+    """The field as the trace JSON keys it (``angle_deg`` or ``object_height_mm``: the unit in
+    the key, README "JSON output"), after the unitless ``field`` / ``field_kind`` pair."""
+    unit_key = "angle_deg" if f.field_kind == "angle" else "object_height_mm"
+    return {"field": f.field, "field_kind": f.field_kind, unit_key: f.field}
+
+
 def fan_to_dict(f: RayFan) -> dict:
     return {
         "axis": "tangential" if f.axis == "y" else "sagittal",
-        "field": f.field,
-        "field_kind": f.field_kind,
+        **_field_keys(f),
         "object_distance_mm": f.object_distance,
         "image_plane_z_mm": f.z_plane,
         "chief_height_mm": f.chief_height,
@@ -53,8 +59,7 @@ def fans_csv(fans: list[RayFan]) -> str:
 
 def spot_to_dict(s: SpotDiagram) -> dict:
     return {
-        "field": s.field,
-        "field_kind": s.field_kind,
+        **_field_keys(s),
         "object_distance_mm": s.object_distance,
         "image_plane_z_mm": s.z_plane,
         "chief_height_mm": s.chief_height,
