@@ -57,6 +57,9 @@ def match_fields(fields: np.ndarray, at, what: str) -> list[int]:
         if not math.isfinite(a):
             raise CalibrationError(f"{what}: field {a!r} is not a finite number")
         hit = np.nonzero(np.abs(fields - a) <= 1e-9 * span)[0]
+        if not hit.size:  # a value copied from the listing below (6 significant digits)
+            hit = np.nonzero([f"{v:g}" == f"{a:g}" for v in fields])[0]
+            hit = hit if hit.size == 1 else hit[:0]
         if hit.size:
             idx.append(int(hit[0]))
             continue
@@ -140,8 +143,11 @@ def fit_scale(
         if idx is None or len(idx) != 2:
             raise CalibrationError("method 'two-point' needs exactly two fields (at=(A, B))")
         a, b = idx
-        if a == b or x[a] + x[b] == 0.0:
-            raise CalibrationError("method 'two-point' needs two different off-axis fields")
+        if a == b or x[a] == 0.0 or x[b] == 0.0 or x[a] + x[b] == 0.0:
+            raise CalibrationError(
+                "method 'two-point' needs two different off-axis fields (D_c is 0 on the axis "
+                "for every constant)"
+            )
         return float((r[a] + r[b]) / (x[a] + x[b]))
     if method == "zero-at":
         if idx is None or len(idx) != 1:
@@ -306,6 +312,15 @@ def calibrate(
     idx = match_fields(curve.fields, at_t, what) if need else None
     if method == "given" and value is None:
         raise CalibrationError(f"{what} needs the calibrated constant {curve.symbol}_c (value=)")
+    if (
+        method == "given"
+        and isinstance(value, (int, float, np.number))
+        and value * curve.constant < 0
+    ):
+        raise CalibrationError(
+            f"{what}: {curve.symbol}_c = {value!r} must have the sign of {curve.symbol}0 = "
+            f"{curve.constant:.6g} (a calibration rescales the image; it does not flip it)"
+        )
     Kc = fit_scale(curve.x, curve.yp, method, idx=idx, given=value)
     if not math.isfinite(Kc) or Kc == 0.0:
         raise CalibrationError(f"{what} gave a degenerate constant {Kc!r}")

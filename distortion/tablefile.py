@@ -185,22 +185,28 @@ def read_distortion_table(
     tol_y = 0.5 * 10.0 ** -np.array(decs["y0p"], dtype=float) + 1e-12 * np.abs(y0p)
     sym = "F0" if kind == ANGLE else "M0"
     on = x != 0.0
+    # field angles are nominal values (10°, 37.5°); object heights printed with decimals are
+    # computed values rounded to their last digit (a projector's y for a given y0'), and half
+    # that digit moves K·y by |K| times it
+    dec_f = np.array(decs[field_role], dtype=float)
+    dx = np.where(dec_f > 0, 0.5 * 10.0**-dec_f, 0.0) if kind == HEIGHT else np.zeros_like(x)
     if constant is None:
         K = float(np.dot(x[on], y0p[on]) / np.dot(x[on], x[on]))
-        tol = 2.0 * tol_y
+        tol = 2.0 * (tol_y + abs(K) * dx)
         origin = f"{sym} = {K:.6g} inferred from y0'/x"
     else:
         K = float(constant)
         if not math.isfinite(K) or K == 0.0:
             raise DataError(f"{where}: {sym} must be a finite nonzero number, got {constant!r}")
-        tol = tol_y
+        tol = tol_y + abs(K) * dx
         origin = f"{sym} = {K:.6g}"
     bad = np.nonzero(np.abs(y0p - K * x) > tol)[0]
     if bad.size:
         i = int(bad[0])
         raise DataError(
-            f"{where}:{lines[i]}: y0' = {y0p[i]:g} mm is inconsistent with {origin} "
-            f"({sym}·{'tan α' if kind == ANGLE else 'y'} = {K * x[i]:.6g} mm)"
+            f"{where}:{lines[i]}: y0' = {y0p[i]:.10g} mm is inconsistent with {origin} "
+            f"({sym}·{'tan α' if kind == ANGLE else 'y'} = {K * x[i]:.10g} mm, beyond the "
+            "rounding of the printed numbers)"
         )
     if "Dr" in roles:
         dr = np.array(data["Dr"])

@@ -191,6 +191,39 @@ def test_bad_requests(table1):
     one = make_curve([0.0, 10.0], [0.0, 0.01], constant=100.0)
     with pytest.raises(CalibrationError, match="at least two off-axis"):
         calibrate(one, "minimax")
+    # the axis is no calibration field (D_c = 0 there for every constant): it gave zero-at-45
+    with pytest.raises(CalibrationError, match="two different off-axis fields"):
+        calibrate(table1, "two-point", at=(0, 45))
+    # a calibration rescales the image; a constant of the other sign would flip it
+    with pytest.raises(CalibrationError, match=r"F_c = -154.0 must have the sign of F0"):
+        calibrate(table1, "given", value=-154.0)
+
+
+def test_a_field_copied_from_the_listing_is_found():
+    # fields with more digits than the error message lists (6 significant): the listed value
+    # names the field, as long as it names only one
+    x = np.array([0.0, -38.452312, -54.915634])
+    c = make_curve(x, [0.0, 0.01, 0.02], constant=-3.0, field_kind="height")
+    with pytest.raises(CalibrationError, match=r"\(0, -38.4523, -54.9156\)"):
+        calibrate(c, "two-point", at=(-38.45, -54.9156))
+    got = calibrate(c, "two-point", at=(-38.4523, -54.9156))
+    assert got.at == (-38.4523, -54.9156) and math.isfinite(got.Kc)
+
+
+def test_a_height_table_rounded_to_its_printed_digits_is_read(tmp_path):
+    # a projector's table: object heights y computed for given image sizes and printed to 4
+    # decimals, as y0' is; y0' = M0·y holds to the rounding of both columns, not of y0' alone
+    m0 = -7.727571
+    y = np.array([0.0, -9.683123, -14.714617, -19.987613])
+    rows = [f"{v:.4f}, {m0 * v:.4f}, {0.001 * i:+.5f}" for i, v in enumerate(y)]
+    (tmp_path / "t.csv").write_text("y_mm, y0p_mm, D0_mm\n" + "\n".join(rows) + "\n")
+    curve = read_distortion_table(tmp_path / "t.csv")
+    assert curve.constant == pytest.approx(m0, rel=1e-5)
+    # a y0' off by more than the rounding still fails
+    rows[2] = rows[2].replace(f"{m0 * y[2]:.4f}", f"{m0 * y[2] + 0.01:.4f}")
+    (tmp_path / "u.csv").write_text("y_mm, y0p_mm, D0_mm\n" + "\n".join(rows) + "\n")
+    with pytest.raises(DataError, match=r"u.csv:[34]: y0' = .* is inconsistent with M0"):
+        read_distortion_table(tmp_path / "u.csv")
     assert issubclass(CalibrationError, DataError) and issubclass(CalibrationError, ValueError)
     assert issubclass(CalibrationError, OrthoscopeError)
     assert set(CRITERIA) == {"two-point", "minimax", "least-squares", "zero-at", "given"}
