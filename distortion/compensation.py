@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .calibration import METHODS, fit_scale, match_fields
+from .calibration import METHODS, axis_spread, fit_scale, match_fields
 from .curve import DistortionCurve, require_choice
 from .errors import CalibrationError, DataError
 
@@ -65,7 +65,8 @@ class CompensationResult:
 
     @property
     def spread(self) -> float:
-        return float(np.max(self.residual) - np.min(self.residual))
+        """max − min of R over the field, the axis (R = 0) included."""
+        return axis_spread(self.residual, 0.0)
 
 
 def printer_negative_distortion(printer: DistortionCurve, h) -> np.ndarray:

@@ -199,6 +199,18 @@ def test_bad_requests(table1):
         calibrate(table1, "given", value=-154.0)
 
 
+def test_spreads_include_the_axis_whether_or_not_the_table_lists_it(table1):
+    # Pestrecov's Table I: the spreads of D0 and Dr run from the axis (0) to the largest value,
+    # 0.355 mm at 40 deg and 0.298 % at 35 / 37.5 deg (the table's printed maxima)
+    on = table1.fields != 0.0
+    no_axis = make_curve(table1.fields[on], table1.D0[on], constant=table1.constant)
+    for c in (table1, no_axis):
+        cal = calibrate(c, "two-point", at=(37.5, 45))
+        assert cal.D0_spread == pytest.approx(0.355, abs=1e-12)
+        assert 100 * cal.Dr_spread == pytest.approx(0.298, abs=5e-4)
+        assert cal.Drc_spread >= abs(cal.Drc_axis)  # the axis value of D_rc is in it
+
+
 def test_a_field_copied_from_the_listing_is_found():
     # fields with more digits than the error message lists (6 significant): the listed value
     # names the field, as long as it names only one
