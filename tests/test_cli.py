@@ -275,3 +275,17 @@ def test_strict_turns_a_failed_field_into_exit_2(capsys):
                      "--strict fails"]  # fmt: skip
     rc, out, err = run(capsys, "trace", "cooke-triplet-f4", "--fields", "0,10,20", "--strict")
     assert rc == 0
+
+
+def test_two_outputs_naming_one_file_are_refused_before_any_work(capsys, tmp_path):
+    # the second plot silently replaced the first (with --force), or the run failed half-way
+    # after writing the first (without it)
+    same = tmp_path / "same.png"
+    for argv in (
+        ["distortion", "cooke-triplet-f4", "--plot", str(same), "--layout", str(same)],
+        ["distortion", "cooke-triplet-f4", "--plot", str(same), "--layout",
+         str(tmp_path / "." / "same.png"), "--force"],
+    ):  # fmt: skip
+        rc, _, err = run(capsys, *argv)
+        assert rc == 2 and "two outputs of this command name the same file" in err
+        assert not same.exists()

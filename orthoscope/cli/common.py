@@ -435,9 +435,17 @@ def check_output_path(path, args) -> None:
     check."""
     if path is None:
         return
+    import os
+
     from raytrace.files.output import check_output
 
     check_output(path, inputs=getattr(args, "_inputs", ()), overwrite=args.force, flag="--force")
+    # two outputs of one run naming one file: the second would replace the first
+    seen = args.__dict__.setdefault("_outputs", set())
+    key = os.path.realpath(path)
+    if key in seen:
+        raise CliError(f"{path}: two outputs of this command name the same file; give each its own")
+    seen.add(key)
 
 
 def check_plot_path(path: str | None, flag: str, args) -> None:
