@@ -5,6 +5,7 @@ work with a warning; values with units are read in their unit."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -95,6 +96,17 @@ def test_old_spellings_work_with_a_warning(capsys):
     assert cap.out == new and "--criterion is deprecated" in cap.err and "--method" in cap.err
     assert main(["calibrate", table]) == 2
     assert "the following argument is required: --method" in capsys.readouterr().err
+
+
+def test_an_object_inside_the_focal_length_is_explained(capsys):
+    # 1.5 typed for 1.5 m: the object sits 1.5 mm in front of the lens, inside the front focal
+    # length, and the error says so in one line (it once read "image plane the Gaussian ...")
+    rc = main(["distortion", LENS, "--object-distance", "1.5", "--fields", "5"])
+    err = [x for x in capsys.readouterr().err.splitlines() if "compiling" not in x]
+    assert rc == 2 and len(err) == 1
+    assert re.search(r"error: the Gaussian image plane lies -\d+\.\d+ mm from the last", err[0])
+    assert "1.5 mm in front of the first vertex, is inside the front focal length" in err[0]
+    assert "1.5m for metres" in err[0]
 
 
 def test_lengths_and_wavelengths_with_units(capsys):

@@ -141,9 +141,19 @@ def plane_z(par: ParaxialResult, planes: list[ImagePlane]) -> np.ndarray:
     bad = np.nonzero((z - par.z_last) * direction <= 0.0)[0]
     if bad.size:
         i = int(bad[0])
+        d = planes[i].describe()
+        what = d if d.startswith("the ") else f"the image plane {d}"
+        why = ""
+        if planes[i].kind == "gaussian" and math.isfinite(par.object_distance):
+            # the object inside the front focal length: a virtual image
+            why = (
+                f" (the object, {par.object_distance:g} mm in front of the first vertex, is "
+                "inside the front focal length: its image is virtual; lengths are in mm, "
+                "1.5m for metres)"
+            )
         raise TraceError(
-            f"image plane {planes[i].describe()} lies {z[i] - par.z_last:+.4f} mm from the last "
-            "vertex, on or before the last surface; an image plane must be behind the lens"
+            f"{what} lies {z[i] - par.z_last:+.4f} mm from the last vertex, on or before the last "
+            f"surface; an image plane must be behind the lens{why}"
         )
     return z
 
