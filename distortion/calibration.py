@@ -267,9 +267,9 @@ class CalibrationResult:
 
 def calibrate(
     distortion: DistortionCurve | CharacteristicDistortion,
-    method: str = "two-point",
+    method: str = "minimax",
     *,
-    at: float | Sequence[float] | None = None,
+    at: float | Sequence[float] | str | None = None,
     value: float | None = None,
     k: float = 200.0,
     plane: int = 0,
@@ -284,8 +284,9 @@ def calibrate(
     method : {"two-point", "minimax", "least-squares", "zero-at", "given"}
         How the calibrated constant K_c (F_c in mm, or M_c) is chosen (module docstring):
         equal and opposite D_c at the two ``at`` fields (the paper's example), the smallest
-        maximum |D_c| (exact), least squares, D_c = 0 at the ``at`` field, or ``value``.
-    at : float or sequence of float, optional
+        maximum |D_c| (exact; the default, the one that needs no fields), least squares,
+        D_c = 0 at the ``at`` field, or ``value``.
+    at : float, sequence of float or "A,B", optional
         Field values (same kind and unit as the curve's fields: degrees or mm) for
         ``two-point`` (two) and ``zero-at`` (one); they must be field points of the curve.
     value : float, optional
@@ -300,18 +301,25 @@ def calibrate(
     CalibrationResult
         K_c, D_c (mm), D_rc (fraction), ρ, ρ_k and spreads (one row of Table II per field).
     """
-    curve = _as_curve(distortion, plane, at)
     what = f"calibration ({method})"
+    try:
+        if at is None:
+            at_t: tuple[float, ...] = ()
+        elif isinstance(at, str):  # "37.5,45", as the command line writes it
+            at_t = tuple(float(a) for a in at.split(",") if a.strip())
+        elif np.ndim(at) == 0:
+            at_t = (float(at),)  # type: ignore[arg-type]
+        else:
+            at_t = tuple(float(a) for a in at)  # type: ignore[union-attr]
+    except (TypeError, ValueError):
+        raise CalibrationError(
+            f"{what}: at={at!r} is not a field value or a list of them (e.g. at=(37.5, 45))"
+        ) from None
+    curve = _as_curve(distortion, plane, at_t)
     require_choice(method, METHODS, "calibration method", CalibrationError)
     if curve.fields.size < 2:
         raise CalibrationError(f"{what}: a curve needs at least two field points")
     need = {"two-point": 2, "zero-at": 1}.get(method, 0)
-    if at is None:
-        at_t: tuple[float, ...] = ()
-    elif np.ndim(at) == 0:
-        at_t = (float(at),)  # type: ignore[arg-type]
-    else:
-        at_t = tuple(float(a) for a in at)  # type: ignore[union-attr]
     if need and len(at_t) != need:
         raise CalibrationError(f"{what} needs exactly {need} field(s) in at=, got {len(at_t)}")
     if not need and at_t:

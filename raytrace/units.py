@@ -47,6 +47,14 @@ def split_unit(text: str) -> tuple[float, str]:
     return v, unit.lower() if unit not in ("µm",) else unit
 
 
+def _split(text: str, what: str) -> tuple[float, str]:
+    """:func:`split_unit`, its error naming ``what``."""
+    try:
+        return split_unit(text)
+    except UnitError as e:
+        raise UnitError(f"{what}: {e}") from None
+
+
 def length_mm(
     value: float | str,
     what: str,
@@ -61,7 +69,7 @@ def length_mm(
     ``allow_inf``: ``inf`` is accepted. ``positive``: the value must be > 0.
     """
     if isinstance(value, str):
-        v, unit = split_unit(value)
+        v, unit = _split(value, what)
         if not unit:
             if require_unit:
                 raise UnitError(
@@ -119,7 +127,7 @@ def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
 def image_scale(value: float | str, what: str = "image scale") -> float:
     """An image scale N ("N×", Gaussian magnification −1/N) from ``12``, ``"12"`` or ``"12x"``."""
     if isinstance(value, str):
-        v, unit = split_unit(value)
+        v, unit = _split(value, what)
         if unit not in ("", "x"):
             raise UnitError(f"{what}: {value!r} is not an image scale such as 12x")
     else:

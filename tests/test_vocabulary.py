@@ -98,6 +98,26 @@ def test_old_spellings_work_with_a_warning(capsys):
     assert "the following argument is required: --method" in capsys.readouterr().err
 
 
+def test_the_api_reads_lengths_and_scales_as_the_command_line_does():
+    # README: "lengths may carry a unit" held only for the flags; the keywords raised
+    lens = osc.load_lens(LENS)
+    a = osc.characteristic_distortion(lens, fields_deg=FIELDS, object_distance="1.5m")
+    b = osc.characteristic_distortion(lens, fields_deg=FIELDS, object_distance=1500.0)
+    assert a.object_distance == b.object_distance == 1500.0
+    np.testing.assert_array_equal(a.D0, b.D0)
+    c = osc.characteristic_distortion(lens, fields_deg=FIELDS, object_scale="12x")
+    d = osc.characteristic_distortion(lens, fields_deg=FIELDS, object_scale=12)
+    assert c.object_distance == d.object_distance
+    with pytest.raises(osc.OrthoscopeError, match=r"^object_scale: 'abc' is not a number"):
+        osc.characteristic_distortion(lens, fields_deg=FIELDS, object_scale="abc")
+    # calibrate: the default needs no fields (minimax); at= may be written as on the CLI
+    assert osc.calibrate(b).method == "minimax"
+    two = osc.calibrate(b, "two-point", at=f"{FIELDS[-2]:g},{FIELDS[-1]:g}")
+    assert two.Kc == osc.calibrate(b, "two-point", at=(FIELDS[-2], FIELDS[-1])).Kc
+    with pytest.raises(osc.CalibrationError, match=r"at='a,b' is not a field value"):
+        osc.calibrate(b, "two-point", at="a,b")
+
+
 def test_an_object_inside_the_focal_length_is_explained(capsys):
     # 1.5 typed for 1.5 m: the object sits 1.5 mm in front of the lens, inside the front focal
     # length, and the error says so in one line (it once read "image plane the Gaussian ...")

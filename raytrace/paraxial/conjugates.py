@@ -228,10 +228,14 @@ def resolve_object_distance(
     ]
     if len(given) > 1:
         raise TraceError(f"give the object one way, not {' and '.join(given)}")
-    if object_s is not None:
-        return object_distance_for_s(lens, float(object_s), wavelength)
-    if object_scale is not None:
-        return object_distance_for_scale(lens, float(object_scale), wavelength)
+    from ..units import UnitError, image_scale, length_mm
+
+    if object_s is not None:  # a number (mm) or a length with its unit ("-1.5m")
+        return object_distance_for_s(lens, length_mm(object_s, "object_s"), wavelength)
+    if object_scale is not None:  # 12 or "12x"
+        return object_distance_for_scale(
+            lens, image_scale(object_scale, "object_scale"), wavelength
+        )
     if object_distance is None:
         return float(lens.object_distance)
     if isinstance(object_distance, str):
@@ -241,12 +245,12 @@ def resolve_object_distance(
         n = parse_scale(t)
         if n is not None:
             return object_distance_for_scale(lens, n, wavelength)
-        try:
-            object_distance = float(t)
-        except ValueError:
+        try:  # mm, or a length with its unit ("1.5m", "250mm")
+            object_distance = length_mm(t, "object_distance", allow_inf=True)
+        except UnitError:
             raise TraceError(
-                f"object_distance {object_distance!r}: expected mm, 'inf' or an image scale "
-                "such as '12x'"
+                f"object_distance {object_distance!r}: expected mm (or a length with its unit: "
+                "1.5m, 250mm), 'inf' or an image scale such as '12x'"
             ) from None
     od = float(object_distance)
     if not od > 0:
