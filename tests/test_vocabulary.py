@@ -140,3 +140,12 @@ def test_lengths_and_wavelengths_with_units(capsys):
     err = capsys.readouterr().err
     assert rc == 2
     assert "looks like micrometres" in err and "0.5461um" in err
+
+
+def test_gaussian_adds_its_plane_to_a_list_of_planes(capsys):
+    # "--s-prime 49,51 --gaussian": three planes, the last the Gaussian one (it was refused, with
+    # a hint that led to another refusal)
+    three, _ = _cli(capsys, "--s-prime", "49,51", "--gaussian")
+    alone, _ = _cli(capsys, "--gaussian")
+    assert [p["s_prime_mm"] for p in three["planes"][:2]] == [49.0, 51.0]
+    assert three["planes"][2] == alone["planes"][0]

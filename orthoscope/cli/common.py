@@ -238,7 +238,9 @@ def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> N
         "--defocus", type=str, action=act, metavar="DZ", help="mm from the Gaussian plane."
     )
     g.add_argument(
-        "--gaussian", action="store_true", help="the Gaussian image plane of the object."
+        "--gaussian",
+        action="store_true",
+        help="the Gaussian image plane of the object (with the flags above: one plane more).",
     )
     for old, new, dest in (
         ("--image-distance", "--s-prime", "s_prime"),
@@ -269,14 +271,10 @@ def resolve_planes(lens, args) -> list:
     if len(given) > 1:
         flags = ", ".join("--" + k.replace("_", "-") for k in given)
         raise CliError(f"give the image planes one way, not {flags}")
-    if given and args.gaussian:
-        raise CliError(
-            "--gaussian names the image plane: give it alone, or give the planes with "
-            "--s-prime / --from-last-vertex / --defocus (which may include 0)"
-        )
-    if given:
+    if given:  # --gaussian with them adds the Gaussian plane to the list
         ((kind, vals),) = given.items()
-        return [ImagePlane(kind, float(v)) for v in vals]
+        gauss = [ImagePlane("gaussian")] if args.gaussian else []
+        return [ImagePlane(kind, float(v)) for v in vals] + gauss
     if args.gaussian or lens.image_solve == "gaussian":
         return [ImagePlane("gaussian")]
     return [ImagePlane("file")]
