@@ -115,9 +115,17 @@ def read_distortion_table(
     for i, h in enumerate(header):
         role = _ALIASES.get(_normalise(h))
         if role is None:
+            sep = next((c for c in ";\t|" if c in h), None)
+            hint = (
+                f" (columns separated by {sep!r}: separate them with commas)"
+                if sep
+                else " (an empty column: a trailing comma?)"
+                if not h
+                else ""
+            )
             raise DataError(
-                f"{where}:{hline}: unknown column {h!r}; expected a field column (alpha_deg or "
-                "y_mm), then y0p_mm, D0_mm and optionally Dr_pct"
+                f"{where}:{hline}: unknown column {h!r}{hint}; expected a field column "
+                "(alpha_deg or y_mm), then y0p_mm, D0_mm and optionally Dr_pct"
             )
         if role in roles or (
             role in ("angle", "height") and ("angle" in roles or "height" in roles)

@@ -337,6 +337,8 @@ GOOD = (
         ),
         ("alpha_deg,y0p_mm,D0_mm\n10,17.633\n20,36.397,0.02\n", r"t\.csv:2: 2 value\(s\)"),
         ("alpha_deg,y0p_mm,D0_mm,foo\n", r"t\.csv:1: unknown column 'foo'"),
+        ("alpha_deg;y0p_mm;D0_mm\n", r"columns separated by ';': separate them with commas"),
+        ("alpha_deg,y0p_mm,D0_mm,\n", r"unknown column '' \(an empty column: a trailing comma"),
         ("# only a comment\n", r"no header"),
         (
             "alpha_deg,y0p_mm,D0_mm\n10,17.633,0.01\n20,36.500,0.02\n",
