@@ -206,7 +206,6 @@ def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
             "90 degrees",
         ),
         (["distortion", "cooke-triplet-f4", "--plot", "x.gif"], ".png"),
-        (["distortion", "cooke-triplet-f4", "--gaussian", "--defocus", "1"], "--gaussian"),
         (["calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,50"], "50"),
         (["calibrate", "/nonexistent.csv", "--method", "minimax"], "nonexistent"),
         (["convert", "cooke-triplet-f4", "out.seq"], ".seq"),
