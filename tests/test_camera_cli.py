@@ -258,3 +258,37 @@ def test_plots_keep_the_ax_convention(cooke, sensor):
     two = plot_calibration_comparison(cmp)
     assert len([a for a in two.axes if a.get_label() != "<colorbar>"]) == 2
     plt.close("all")
+
+
+def test_convert_keeps_to_the_model_and_coefficient_count_asked_for(tmp_path, monkeypatch, cooke):
+    # --model opencv on a fisheye calibration is the perspective model (a refit), not the
+    # fisheye again; --coefficients N refits to N coefficients (the exact path ignored N)
+    import cv2
+
+    from distortion.camera import format_calibration
+
+    setup = CameraSetup(sensor=Sensor.from_spec(size="24x16", pixels="1200x800"), grid=(9, 7))
+    fe = camera_model(cooke, setup, "fisheye")
+    (tmp_path / "fe.yml").write_text(format_calibration(fe.camera, "opencv-yaml"))
+    rc, out, err = run(["camera", "convert", "fe.yml", "--model", "opencv", "--json"],
+                       tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    conv = json.loads(out)["conversion"]
+    assert conv["method"] == "refit" and conv["target"]["model"] == "opencv", conv
+    cal = str(DATA / "cooke-measured-2m.yml")
+    rc, _, err = run(["camera", "convert", cal, "--model", "opencv", "--coefficients", "4",
+                      "-o", "c4.yml"], tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    fs = cv2.FileStorage(str(tmp_path / "c4.yml"), cv2.FILE_STORAGE_READ)
+    assert fs.getNode("distortion_coefficients").mat().size == 4  # what cv2 reads
+    fs.release()
+
+
+def test_a_sensor_beyond_the_image_circle_is_said(tmp_path, monkeypatch):
+    # the Cooke triplet images to r = 28 mm; a 60 x 40 sensor's corners are at 36 mm: the model
+    # is extrapolated there (a warning), and --strict refuses before writing anything
+    argv = ["camera", "cooke-triplet-f4", "--sensor", "60x40", "--pixels", "1500x1000"]
+    rc, _, err = run([*argv, "-o", "big.yml"], tmp_path, monkeypatch)
+    assert rc == 0 and "chief rays do not reach the sensor" in err and "--strict" in err
+    rc, _, err = run([*argv, "-o", "strict.yml", "--strict"], tmp_path, monkeypatch)
+    assert rc == 2 and "--strict fails" in err and not (tmp_path / "strict.yml").exists()

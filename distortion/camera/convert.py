@@ -200,7 +200,8 @@ def convert_camera_model(
     pixel_size_mm:
         Pixel size for a target in mm (``australis``) when the source has none.
     exact:
-        Try exact algebra first (default). ``False`` forces a refit.
+        Try exact algebra first (default; not when ``free`` is given: naming what a refit may
+        change asks for a refit). ``False`` forces a refit.
 
     Returns
     -------
@@ -221,7 +222,7 @@ def convert_camera_model(
     )
     grid_px = sensor_grid(src.width, src.height, grid)
     lost: tuple[str, ...] = ()
-    if exact:
+    if exact and free is None:
         try:
             out = convert_exact(src, spec.name)
         except NotRepresentable as e:
@@ -239,6 +240,12 @@ def convert_camera_model(
     names = free if free is not None else _REFIT_FREE.get(spec.name, spec.params)
     fit = None
     for start in _refit_starts(src, spec.name, back.points[ok], grid_px[ok]):
+        if isinstance(free, int | np.integer):  # N coefficients: the others are 0, not held
+            keep = {"fx", "fy", "cx", "cy", *OPENCV_ORDERS.get(int(free), ())}
+            p = {k: (v if k in keep else 0.0) for k, v in start.as_dict().items()}
+            start = CameraModel.create(
+                spec.name, start.width, start.height, pixel_size_mm=start.pixel_size_mm, **p
+            )
         trial = fit_camera_model(back.points[ok], grid_px[ok], start, free=names)
         if fit is None or trial.rms_px < fit.rms_px:
             fit = trial

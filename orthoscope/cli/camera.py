@@ -18,6 +18,7 @@ Four actions, chosen by the first word:
 from __future__ import annotations
 
 import argparse
+import math
 
 from .common import (
     OBJECT_HELP,
@@ -33,6 +34,7 @@ from .common import (
     load,
     print_json,
     save_plot,
+    warn,
 )
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -249,6 +251,23 @@ def _cmd_lens(args, lens_name: str) -> int:
         _model_table_out(args, table, setup.resolve(lens).projection_centre)
         return 0
     tc = camera_model(lens, setup, args.model, n_coefficients=n)
+    if tc.points.n_failed:
+        import numpy as np
+
+        pts = tc.points
+        r = np.hypot(*pts.image_mm[pts.ok].T)
+        reach = float(r.max()) if r.size else 0.0
+        corner = 0.5 * math.hypot(tc.sensor.width_mm, tc.sensor.height_mm)
+        what = (
+            f"{pts.n_failed} of {pts.status.size} chief rays do not reach the sensor (the lens "
+            f"images out to r = {reach:.2f} mm; the sensor's corners are at {corner:.2f} mm)"
+        )
+        if args.strict:  # before anything is written
+            raise CliError(f"{what}; --strict fails")
+        warn(
+            f"{what}: the model is fitted inside that circle and extrapolated beyond it, where "
+            "it (and its maps and picture) is not the lens's; --strict refuses such a run"
+        )
     if args.output:
         fmt = _calibration_format(args.output, args.format)
         _write(args.output, tc.calibration_text(fmt), args)
@@ -264,8 +283,6 @@ def _cmd_lens(args, lens_name: str) -> int:
     if args.maps:
         maps = remap_maps(tc.camera, args.maps_direction)
         _write(args.maps, _npz(maps), args)
-    if tc.points.n_failed and args.strict:
-        raise CliError(f"{tc.points.n_failed} chief ray(s) could not be traced; --strict fails")
     return 0
 
 
@@ -348,9 +365,13 @@ def _cmd_convert(args, cal_path: str) -> int:
         raise CliError("--coefficients applies to --model opencv")
     if args.model in ("colmap", "opencv", "metashape", "australis") and args.coefficients is None:
         try:  # the smallest model of the family that holds the calibration exactly
-            target = smallest_exact(cal, args.model).model
+            exact = smallest_exact(cal, args.model).model
         except DataError:
-            pass
+            exact = target
+        # a fisheye is of the opencv / colmap family, but --model opencv / colmap is the
+        # perspective one (fisheye / colmap-fisheye name the others): refit then
+        if "fisheye" not in exact.lower() or "fisheye" in target.lower():
+            target = exact
     conv = convert_camera_model(cal, target, free=args.coefficients)
     if args.output:
         fmt = _calibration_format(args.output, args.format)
