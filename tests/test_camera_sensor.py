@@ -95,3 +95,16 @@ def test_camera_from_sensor_places_the_principal_point_in_each_convention():
         )
     centred = camera_from_sensor("colmap:PINHOLE", Sensor.from_spec("36x24", "6000x4000"), 50.0)
     assert (centred["cx"], centred["cy"]) == (3000.0, 2000.0)  # COLMAP: centred cx = W/2
+
+
+def test_a_size_and_pixel_count_that_make_no_pixel_say_so():
+    # no pitch was given: the message names what was (it advised "give the pitch in µm")
+    with pytest.raises(DataError, match=r"200x150 mm over 800x600 pixels makes pixels of 250 x "):
+        Sensor.from_spec(size="200x150", pixels="800x600")
+    with pytest.raises(DataError, match=r"makes pixels of 0.08 x 0.08 µm, outside"):
+        Sensor.from_spec(size="24x16", pixels="300000x200000")
+    # far from square pixels: width and height swapped in one of the two (a warning)
+    from distortion.errors import UnitWarning
+
+    with pytest.warns(UnitWarning, match=r"5.333 x 12 µm, far from square: .* swapped"):
+        Sensor.from_spec(size="16x24", pixels="3000x2000")

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError
+from ..errors import DataError, UnitWarning
 from .conventions import (
     from_opencv_pixels,
     image_centre,
@@ -201,7 +202,23 @@ class Sensor:
         object.__setattr__(
             self, "principal_point_offset_mm", _parse_offset(self.principal_point_offset_mm)
         )
-        parse_pitch_um(self.pixel_pitch_um)  # range check with the mm hint
+        px, py = self.pixel_pitch_um
+        lo, hi = PITCH_RANGE_UM
+        if not all(lo <= v <= hi for v in (px, py)):
+            raise DataError(
+                f"sensor {self.width_mm:g}x{self.height_mm:g} mm over {self.width_px}x"
+                f"{self.height_px} pixels makes pixels of {px:g} x {py:g} µm, outside "
+                f"{lo:g}..{hi:g} µm: check the size (mm) and the pixel count"
+            )
+        if max(px, py) > 1.5 * min(px, py):
+            warnings.warn(
+                UnitWarning(
+                    f"sensor {self.width_mm:g}x{self.height_mm:g} mm over {self.width_px}x"
+                    f"{self.height_px} pixels makes pixels of {px:.4g} x {py:.4g} µm, far from "
+                    "square: width and height swapped in one of them?"
+                ),
+                stacklevel=3,
+            )
 
     # ---- construction -----------------------------------------------------------------------
     @classmethod
