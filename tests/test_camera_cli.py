@@ -201,6 +201,13 @@ def test_picture_and_maps(tmp_path, monkeypatch):
         (["camera", "cooke-triplet-f4", "extra"], "one LENS"),
         ([*BASE, "--coefficients", "6"], "n_coefficients"),
         (["camera", "variation", "a.yml", "b.yml"], "--calibrated-at"),
+        # too few points: the grid's fault, or rays that miss the sensor (said apart)
+        ([*BASE[:-1], "2x2"], "the grid gives 4 points (a larger grid)"),
+        ([*BASE, "--principal-point", "50,0", "--no-clip"], "only 0 of 63 chief rays reached"),
+        (
+            ["camera", "cooke-triplet-f4", "--sensor", "200x150", "--pixels", "800x600"],
+            "makes pixels of 250 x 250 µm",
+        ),
     ],
 )
 def test_errors_are_one_line(argv, words):

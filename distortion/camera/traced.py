@@ -381,18 +381,21 @@ def fit_correspondences(
     xy, uv = xy[ok], uv[ok]
     ladder, family = _ladder(model, n_coefficients, free)
     w, h, ps = sensor.width_px, sensor.height_px, sensor.pixel_size_mm
+    need = max(len(_free_of(n, f)) for n, f in ladder)
+    if xy.shape[0] * 2 <= need:  # before any start is fitted to too few points
+        n, total = xy.shape[0], ok.size
+        why = (
+            f"the grid gives {total} points (a larger grid)"
+            if n == total
+            else f"only {n} of {total} chief rays reached the sensor (a sensor the lens covers, "
+            "or a principal point inside its image)"
+        )
+        raise DataError(f"{need} free parameters need more than {need // 2} traced points: {why}")
     starts = []
     for name, fr in ladder:
         names = _free_of(name, fr)
         start = initial_camera(name, xy, uv, width=w, height=h, pixel_size_mm=ps)
         starts.append((_identity_start(start, names), fr if isinstance(fr, int) else names))
-    need = max(len(_free_of(n, f)) for n, f in ladder)
-    if xy.shape[0] * 2 <= need:
-        raise DataError(
-            f"{need} free parameters need more than {need // 2} traced points; only "
-            f"{xy.shape[0]} chief rays reached the sensor (a larger grid, or a sensor the lens "
-            "covers)"
-        )
     sel = select_camera_model(xy, uv, starts, width=w, height=h, pixel_size_mm=ps)
     if family:
         return sel.chosen, sel, sel.criterion
@@ -520,7 +523,9 @@ def fit_points(
 ) -> TracedCamera:
     """Fit a camera model (or choose one of a family) to traced correspondences
     (:func:`fit_correspondences` for the words of ``model``)."""
-    ideal, img = points.valid()
+    # every grid point, the failed ones NaN: the fit drops them and can say how many failed
+    ideal = np.where(points.ok[:, None], points.ideal, np.nan)
+    img = np.where(points.ok[:, None], points.image_px, np.nan)
     f, sel, crit = fit_correspondences(
         ideal, img, points.sensor, model, n_coefficients=n_coefficients, free=free
     )
