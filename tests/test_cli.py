@@ -288,3 +288,19 @@ def test_two_outputs_naming_one_file_are_refused_before_any_work(capsys, tmp_pat
         rc, _, err = run(capsys, *argv)
         assert rc == 2 and "two outputs of this command name the same file" in err
         assert not same.exists()
+
+
+def test_api_keywords_in_errors_are_said_as_flags(capsys):
+    # one vocabulary (docs/design.md): the science packages name API keywords, the command
+    # line names the same things with dashes
+    from orthoscope.cli import cli_words
+
+    assert cli_words("needs exactly 2 field(s) in at=, got 1") == (
+        "needs exactly 2 field(s) in --at, got 1"
+    )
+    assert cli_words("give format= one of x") == "give --format one of x"
+    assert cli_words("n_coefficients=6 does not apply") == "--coefficients 6 does not apply"
+    assert cli_words("e.g. at=(37.5, 45)") == "e.g. at=(37.5, 45)"  # an API example stays
+    assert cli_words("thickness=0.5") == "thickness=0.5"  # not a flag
+    rc, _, err = run(capsys, "calibrate", str(TABLE1), "--method", "given")
+    assert rc == 2 and "needs the calibrated constant F_c (--value)" in err

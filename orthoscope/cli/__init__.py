@@ -175,6 +175,40 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return p
 
 
+#: API keywords (as the science packages' errors name them: "at=") -> the flags that give them
+CLI_FLAGS = {
+    "at": "--at",
+    "value": "--value",
+    "format": "--format",
+    "object_s": "--object-s",
+    "object_distance": "--object-distance",
+    "object_scale": "--object-scale",
+    "s_prime": "--s-prime",
+    "from_last_vertex": "--from-last-vertex",
+    "defocus": "--defocus",
+    "n_coefficients": "--coefficients",
+    "pixel_size_mm": "--pitch (or --sensor)",
+    "camera_id": "--camera-id",
+}
+
+
+def cli_words(message: str) -> str:
+    """An error of the API said with the command line's flags: ``at=`` -> ``--at`` (the same
+    words, docs/design.md "Vocabulary"); ``name=value`` examples are left as they are."""
+    import re
+
+    message = message.replace("pixel_size_mm=(pitch_x, pitch_y) in mm", "--pitch (or --sensor)")
+    keys = "|".join(CLI_FLAGS)
+    message = re.sub(  # key=6 -> --flag 6 (a number the person gave)
+        rf"(?<![\w.])({keys})=(-?[0-9][0-9.eE+-]*)\b",
+        lambda m: f"{CLI_FLAGS[m.group(1)]} {m.group(2)}",
+        message,
+    )
+    return re.sub(  # key= -> --flag (the flag named, no value)
+        rf"(?<![\w.])({keys})=(?![\w'\"(\[-])", lambda m: CLI_FLAGS[m.group(1)], message
+    )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 a run that did not succeed, 2 a
     usage or input error, 130 interrupted)."""
@@ -213,7 +247,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OrthoscopeError as e:
         if debug:
             raise
-        print(f"{command}: error: {e}", file=sys.stderr)
+        print(f"{command}: error: {cli_words(str(e))}", file=sys.stderr)
         return EXIT_USAGE
     except BrokenPipeError:
         _silence_stdout()
