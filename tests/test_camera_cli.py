@@ -299,3 +299,23 @@ def test_a_sensor_beyond_the_image_circle_is_said(tmp_path, monkeypatch):
     assert rc == 0 and "chief rays do not reach the sensor" in err and "--strict" in err
     rc, _, err = run([*argv, "-o", "strict.yml", "--strict"], tmp_path, monkeypatch)
     assert rc == 2 and "--strict fails" in err and not (tmp_path / "strict.yml").exists()
+
+
+def test_a_measured_affinity_is_fitted_in_the_prediction(cooke):
+    # design.md: the prediction frees "every coefficient it holds away from identity"; Metashape's
+    # b1 (affinity) is not among its fits' defaults and was held at 0 although the file had it
+    from distortion.camera import convert_camera_model
+    from distortion.camera.models import CameraModel
+    from distortion.camera.traced import prediction_like, trace_camera_points
+
+    cal = read_calibration(str(DATA / "cooke-measured-2m.yml"))
+    ms = convert_camera_model(cal, "metashape").camera
+    params = ms.as_dict() | {"b1": 8.8e-5}
+    measured = CameraModel.create(ms.model, ms.width, ms.height,
+                                  pixel_size_mm=ms.pixel_size_mm, **params)  # fmt: skip
+    setup = CameraSetup(
+        sensor=Sensor.from_spec(size="24x16", pixels=f"{ms.width}x{ms.height}"), grid=(9, 7),
+        focus="2m", object_distance="2m",
+    )  # fmt: skip
+    pred = prediction_like(measured, trace_camera_points(cooke, setup))
+    assert "b1" in pred.fit.free

@@ -673,8 +673,11 @@ def prediction_like(measured: CameraModel, points: CameraPoints) -> TracedCamera
     if measured.model == "opencv":
         return fit_points(points, "opencv", n_coefficients=measured.n_opencv_coefficients)
     d = measured.as_dict()
-    free = [
-        n for n in spec.default_free if n in _GEOMETRY or d[n] != float(spec.identity.get(n, 0.0))
+    free = [  # every term it holds away from identity, also those its own fits keep fixed
+        n  # (Metashape's b1 affinity is not in default_free)
+        for n in spec.params
+        if (n in _GEOMETRY and n in spec.default_free)
+        or (n not in _GEOMETRY and d[n] != float(spec.identity.get(n, 0.0)))
     ]
     return fit_points(points, measured.model, free=free)
 

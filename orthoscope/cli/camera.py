@@ -433,7 +433,7 @@ def cmd_camera(args) -> int:
         if len(words) != 3:
             raise CliError(
                 "usage: orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 "
-                "--focal-length F --focus S --object-distances D1,D2,..."
+                "--focal-length F --focus S --object-distances D1,D2,... --sensor WxH"
             )
         return _cmd_variation(args, words[1], words[2])
     if len(words) != 1:
@@ -454,7 +454,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "       orthoscope camera compare LENS CALIBRATION --sensor WxH [flags]\n"
             "       orthoscope camera convert CALIBRATION --model M [-o FILE]\n"
             "       orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 --focal-length F "
-            "--focus S --object-distances D1,D2,..."
+            "--focus S --object-distances D1,D2,... --sensor WxH (or --pitch)"
         ),
         description=(
             "Real chief rays (through the centre of the real stop) traced onto a sensor give "
