@@ -319,3 +319,19 @@ def test_a_measured_affinity_is_fitted_in_the_prediction(cooke):
     )  # fmt: skip
     pred = prediction_like(measured, trace_camera_points(cooke, setup))
     assert "b1" in pred.fit.free
+
+
+def test_camera_id_chooses_a_camera_of_a_colmap_file(tmp_path, monkeypatch):
+    # COLMAP's cameras.txt format (CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]), two cameras
+    (tmp_path / "cameras.txt").write_text(
+        "# Camera list\n1 PINHOLE 3000 2000 6000 6000 1500 1000\n"
+        "2 SIMPLE_RADIAL 4000 3000 3000 2000 1500 0.01\n"
+    )
+    rc, _, err = run(["camera", "convert", "cameras.txt", "--model", "opencv"],
+                     tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 2 and "choose one with --camera-id" in err
+    rc, out, err = run(["camera", "convert", "cameras.txt", "--model", "opencv", "--camera-id",
+                        "2", "--json"], tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    src = json.loads(out)["conversion"]["source"]
+    assert src["model"] == "colmap:SIMPLE_RADIAL" and src["image_width_px"] == 4000

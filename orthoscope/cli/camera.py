@@ -321,7 +321,7 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
     check_output_path(args.output, args)
-    cal = read_calibration(cal_path)
+    cal = read_calibration(cal_path, camera_id=args.camera_id)
     sensor = _sensor(args, cal)
     setup = _setup(args, sensor)
     cmp = compare_calibration(lens, cal, setup, label=f"measured ({cal_path})")
@@ -353,7 +353,7 @@ def _cmd_convert(args, cal_path: str) -> int:
 
     args._inputs = [p for p in (cal_path, args.camera) if p]
     check_output_path(args.output, args)
-    cal = read_calibration(cal_path)
+    cal = read_calibration(cal_path, camera_id=args.camera_id)
     target = {"fisheye": "opencv_fisheye", "colmap": "colmap:FULL_OPENCV",
               "colmap-fisheye": "colmap:OPENCV_FISHEYE"}.get(args.model, args.model)  # fmt: skip
     ps = cal.pixel_size_mm
@@ -395,7 +395,8 @@ def _cmd_variation(args, cal1: str, cal2: str) -> int:
     if args.object_distances is None:
         raise CliError("give --object-distances D1,D2,... (distances from the lens)")
     objs = [s.strip() for s in str(args.object_distances).split(",") if s.strip()]
-    c1, c2 = read_calibration(cal1), read_calibration(cal2)
+    c1 = read_calibration(cal1, camera_id=args.camera_id)
+    c2 = read_calibration(cal2, camera_id=args.camera_id)
     ps = c1.pixel_size_mm or c2.pixel_size_mm
     if args.sensor is not None or args.pitch is not None or args.camera:
         ps = _sensor(args, c1).pixel_size_mm
@@ -579,6 +580,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="FILE",
         help="Calibration file (.yml/.yaml/.json OpenCV, cameras.txt COLMAP, .xml Metashape, "
         ".aus Australis); a table of models: .csv or .json; compare: .json or .csv.",
+    )
+    o.add_argument(
+        "--camera-id",
+        type=int,
+        metavar="N",
+        help="compare / convert / variation: the camera of a COLMAP cameras.txt that holds "
+        "several (its CAMERA_ID).",
     )
     o.add_argument("--format", metavar="FMT", help="The calibration file format, when the name "
                    "does not say (opencv-yaml, opencv-json, colmap, metashape, photoscan, "
