@@ -304,3 +304,12 @@ def test_api_keywords_in_errors_are_said_as_flags(capsys):
     assert cli_words("thickness=0.5") == "thickness=0.5"  # not a flag
     rc, _, err = run(capsys, "calibrate", str(TABLE1), "--method", "given")
     assert rc == 2 and "needs the calibrated constant F_c (--value)" in err
+
+
+def test_an_unknown_flag_is_said_by_its_subcommand(capsys):
+    # "orthoscope: error: unrecognized arguments" did not say which command's --help to read
+    rc, _, err = run(capsys, "distortion", "cooke-triplet-f4", "--bogus")
+    assert rc == 2 and err.strip().splitlines()[-1] == (
+        "orthoscope distortion: error: unrecognized arguments: --bogus "
+        "(see orthoscope distortion --help)"
+    )

@@ -101,6 +101,14 @@ class Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def _subparser(parser: argparse.ArgumentParser, name: str | None):
+    """The parser of subcommand ``name`` (None if there is none)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return action.choices.get(name)
+    return None
+
+
 _SIGNED = re.compile(r"^-(\d|\.\d)")
 
 
@@ -231,7 +239,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         words = signed_values(sys.argv[1:] if argv is None else list(argv))
         parser = build_parser(command_of(words))
         try:
-            args = parser.parse_args(words)
+            args, extra = parser.parse_known_args(words)
+            if extra:  # said by the subcommand's parser: its name, its --help
+                sub = _subparser(parser, getattr(args, "command", None)) or parser
+                sub.error(f"unrecognized arguments: {' '.join(extra)}")
         except SystemExit as e:  # --help, --version, or a usage error already printed
             return e.code if isinstance(e.code, int) else EXIT_USAGE
         command = f"orthoscope {args.command}"

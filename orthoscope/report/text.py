@@ -51,7 +51,7 @@ def format_columns(
         layout = "rows"
     if layout not in ("paper", "rows"):
         raise ValueError(f"unknown table layout {layout!r}; expected rows or paper")
-    fcells = [f"{v:g}" for v in fields]
+    fcells = [f"{v + 0.0:g}" for v in fields]  # + 0.0: no "-0" for a table's -0.0000 axis row
     qcells = [[_cell(float(v), dec, sg) for v in vals] for _, vals, dec, sg in quantities]
     labels = [field_label] + [q[0] for q in quantities]
     lw = max(len(s) for s in labels)
