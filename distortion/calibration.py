@@ -327,6 +327,10 @@ def calibrate(
     idx = match_fields(curve.fields, at_t, what) if need else None
     if method == "given" and value is None:
         raise CalibrationError(f"{what} needs the calibrated constant {curve.symbol}_c (value=)")
+    if method != "given" and value is not None:
+        raise CalibrationError(
+            f"{what} chooses {curve.symbol}_c itself: value= goes with method 'given'"
+        )
     if (
         method == "given"
         and isinstance(value, (int, float, np.number))

@@ -127,6 +127,13 @@ def compensate(
     x = y1 / M2
     r = D1 - D2 + y1
     need = {"two-point": 2, "zero-at": 1}.get(method, 0)
+    if not need and at:
+        raise CalibrationError(f"compensation ({method}) takes no at= fields")
+    if method != "given" and magnification is not None:
+        raise CalibrationError(
+            f"compensation ({method}) chooses the magnification itself: magnification= goes "
+            "with method 'given'"
+        )
     idx = match_fields(camera.fields, at or (), f"compensation ({method})") if need else None
     if need and (idx is None or len(idx) != need):
         raise CalibrationError(f"method {method!r} needs {need} field(s) in at=")

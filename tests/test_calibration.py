@@ -194,6 +194,9 @@ def test_bad_requests(table1):
     # the axis is no calibration field (D_c = 0 there for every constant): it gave zero-at-45
     with pytest.raises(CalibrationError, match="two different off-axis fields"):
         calibrate(table1, "two-point", at=(0, 45))
+    # a value with a method that chooses the constant itself was ignored
+    with pytest.raises(CalibrationError, match=r"value= goes with method 'given'"):
+        calibrate(table1, "least-squares", value=154.0)
     # a calibration rescales the image; a constant of the other sign would flip it
     with pytest.raises(CalibrationError, match=r"F_c = -154.0 must have the sign of F0"):
         calibrate(table1, "given", value=-154.0)

@@ -120,3 +120,20 @@ def test_bad_input(camera):
         compensate(camera, short)
     with pytest.raises(CalibrationError, match="unknown method"):
         compensate(camera, printer, method="magic")
+
+
+def test_flags_a_method_does_not_use_are_refused(capsys):
+    # they were silently ignored: --at with 'given', --magnification with 'minimax', --fields
+    # with a camera table
+    from support import run_cli
+
+    table = str(Path(__file__).parent / "data" / "pestrecov_table1.csv")
+    pair = ["topogon-us2031792-fig1", "twinplex-like-55-525", "--fields", "0,10,20,30"]
+    for argv, msg in (
+        ([*pair, "--method", "given", "--at", "30"], "compensation (given) takes no --at fields"),
+        ([*pair, "--method", "minimax", "--magnification", "-2"], "--magnification goes with"),
+        ([table, "twinplex-like-55-525", "--fields", "0,10"], "--fields goes with a CAMERA lens"),
+    ):
+        rc, _, err = run_cli(["compensate", *argv])
+        assert rc == 2 and msg in err, err
+    assert run_cli(["compensate", *pair])[0] == 0  # the same pair runs without them

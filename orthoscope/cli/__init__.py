@@ -197,6 +197,7 @@ CLI_FLAGS = {
     "n_coefficients": "--coefficients",
     "pixel_size_mm": "--pitch (or --sensor)",
     "camera_id": "--camera-id",
+    "magnification": "--magnification",
 }
 
 

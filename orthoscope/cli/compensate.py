@@ -35,6 +35,8 @@ def _curve_from(arg: str, role: str, args, camera_curve=None):
     from distortion.tablefile import read_distortion_table
 
     if Path(arg).suffix.lower() == ".csv":
+        if role == "camera" and args.fields:
+            raise CliError(f"--fields goes with a CAMERA lens; the table {arg} has its own fields")
         return read_distortion_table(arg)
     lens = load(arg)
     if role == "camera":
