@@ -203,6 +203,8 @@ def test_picture_and_maps(tmp_path, monkeypatch):
         (["camera", "variation", "a.yml", "b.yml"], "--calibrated-at"),
         # too few points: the grid's fault, or rays that miss the sensor (said apart)
         ([*BASE[:-1], "2x2"], "the grid gives 4 points (a larger grid)"),
+        ([*BASE, "--object-distances", "10m,1m,,1m"], "an empty entry"),
+        ([*BASE, "--object-distances", "10m,1m,1m"], "1m is listed twice"),
         ([*BASE, "--principal-point", "50,0", "--no-clip"], "only 0 of 63 chief rays reached"),
         (
             ["camera", "cooke-triplet-f4", "--sensor", "200x150", "--pixels", "800x600"],

@@ -206,6 +206,7 @@ def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
             "90 degrees",
         ),
         (["distortion", "cooke-triplet-f4", "--plot", "x.gif"], ".png"),
+        (["distortion", "cooke-triplet-f4", "--s-prime", "50,50"], "50 is listed twice"),
         (["calibrate", str(TABLE1), "--method", "two-point", "--at", "37.5,50"], "50"),
         (["calibrate", "/nonexistent.csv", "--method", "minimax"], "nonexistent"),
         (["convert", "cooke-triplet-f4", "out.seq"], ".seq"),

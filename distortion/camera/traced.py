@@ -712,7 +712,7 @@ def sensor_for_calibration(
         return Sensor(pixels[0] * px, pixels[1] * py, pixels[0], pixels[1],
                       principal_point_offset_mm)  # fmt: skip
     raise DataError(
-        f"a {calibration.model} calibration holds pixels only: give the sensor size (e.g. "
+        f"the {calibration.model} calibration holds pixels only: give the sensor size (e.g. "
         "'36x24' mm) or the pixel pitch (um) so that the lens's millimetres land on its pixels"
     )
 

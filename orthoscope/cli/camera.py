@@ -244,9 +244,7 @@ def _cmd_lens(args, lens_name: str) -> int:
     if args.object_distances is not None:
         if any(k is not None for k in (args.object_distance, args.object_s, args.object_scale)):
             raise CliError("--object-distances are the table's rows: leave out --object-distance")
-        objs = [s.strip() for s in str(args.object_distances).split(",") if s.strip()]
-        if not objs:
-            raise CliError("--object-distances: empty list")
+        objs = _distances(args.object_distances)
         table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
         _model_table_out(args, table, setup.resolve(lens).projection_centre)
         return 0
@@ -284,6 +282,17 @@ def _cmd_lens(args, lens_name: str) -> int:
         maps = remap_maps(tc.camera, args.maps_direction)
         _write(args.maps, _npz(maps), args)
     return 0
+
+
+def _distances(text: str) -> list[str]:
+    """--object-distances D1,D2,...: each once, none empty (one row per distance)."""
+    objs = [p.strip() for p in str(text).split(",")]
+    if not objs or any(not p for p in objs):
+        raise CliError(f"--object-distances {text!r}: an empty entry; write e.g. 1m,2m,5m")
+    dup = next((p for i, p in enumerate(objs) if p in objs[:i]), None)
+    if dup is not None:
+        raise CliError(f"--object-distances {text!r}: {dup} is listed twice")
+    return objs
 
 
 def _png(image) -> bytes:
@@ -394,7 +403,7 @@ def _cmd_variation(args, cal1: str, cal2: str) -> int:
         raise CliError("--calibrated-at: give the two focus distances S1,S2 of the calibrations")
     if args.object_distances is None:
         raise CliError("give --object-distances D1,D2,... (distances from the lens)")
-    objs = [s.strip() for s in str(args.object_distances).split(",") if s.strip()]
+    objs = _distances(args.object_distances)
     c1 = read_calibration(cal1, camera_id=args.camera_id)
     c2 = read_calibration(cal2, camera_id=args.camera_id)
     ps = c1.pixel_size_mm or c2.pixel_size_mm

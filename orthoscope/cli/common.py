@@ -273,6 +273,9 @@ def resolve_planes(lens, args) -> list:
         raise CliError(f"give the image planes one way, not {flags}")
     if given:  # --gaussian with them adds the Gaussian plane to the list
         ((kind, vals),) = given.items()
+        dup = next((v for i, v in enumerate(vals) if v in vals[:i]), None)
+        if dup is not None:
+            raise CliError(f"--{kind.replace('_', '-')}: the plane {dup:g} is listed twice")
         gauss = [ImagePlane("gaussian")] if args.gaussian else []
         return [ImagePlane(kind, float(v)) for v in vals] + gauss
     if args.gaussian or lens.image_solve == "gaussian":
