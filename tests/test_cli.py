@@ -314,3 +314,11 @@ def test_an_unknown_flag_is_said_by_its_subcommand(capsys):
         "orthoscope distortion: error: unrecognized arguments: --bogus "
         "(see orthoscope distortion --help)"
     )
+
+
+def test_a_height_field_table_has_one_y_column(capsys):
+    # the field column of a height table is the object height; it was printed twice
+    rc, out, _ = run(capsys, "distortion", "twinplex-like-55-525", "--object-s", "-55.0009",
+                     "--fields", "-1,-2", "--field-kind", "height")  # fmt: skip
+    header = next(x for x in out.splitlines() if "y0' (mm)" in x)
+    assert rc == 0 and header.split().count("y") == 1, header

@@ -70,7 +70,7 @@ def format_characteristic(
             f"scale = {res.scale[0]:.6f}{unit}"
         )
         q = []
-        if res.finite:
+        if res.finite and res.field_kind != HEIGHT:  # a height field is y already
             q.append(("y (mm)", res.x, decimals, True))
         q += [
             ("y0' (mm)", res.y0p[0], decimals, True),
