@@ -222,3 +222,29 @@ def test_writers_refuse_to_overwrite_and_to_lose_terms(tmp_path):
         write_calibration(_opencv(14), tmp_path / "m.xml")  # prism/tilt: a refit, not a rename
     with pytest.raises(DataError, match="format"):
         write_calibration(cam, tmp_path / "a.cal")
+
+
+@pytest.mark.parametrize(
+    "suffix,names",
+    [
+        (".xml", ("camera_matrix", "distortion_coefficients")),  # cv2.FileStorage's XML
+        (".yml", ("cameraMatrix", "distCoeffs")),  # the names of OpenCV's tutorials
+    ],
+)
+def test_files_cv2_writes_in_other_forms_are_read(tmp_path, suffix, names):
+    # written by cv2.FileStorage itself (the referee): the same camera as the matrices given
+    cv2 = pytest.importorskip("cv2")
+    k = np.array([[6000.0, 0, 1499.5], [0, 6000.0, 999.5], [0, 0, 1]])
+    d = np.array([[-0.1, 0.01, 0.001, -0.002, 0.0]])
+    path = str(tmp_path / f"cal{suffix}")
+    fs = cv2.FileStorage(path, cv2.FILE_STORAGE_WRITE)
+    fs.write("image_width", 3000)
+    fs.write("image_height", 2000)
+    fs.write(names[0], k)
+    fs.write(names[1], d)
+    fs.release()
+    cam = read_calibration(path)
+    assert cam.model == "opencv" and (cam.width, cam.height) == (3000, 2000)
+    got = cam.as_dict()
+    assert (got["fx"], got["fy"], got["cx"], got["cy"]) == (6000.0, 6000.0, 1499.5, 999.5)
+    assert [got[n] for n in ("k1", "k2", "p1", "p2", "k3")] == [-0.1, 0.01, 0.001, -0.002, 0.0]

@@ -12,6 +12,8 @@ Formats (``format=`` names; inferred from the file name when left out):
     do not say which model they hold; a file without the key is read as the standard model), its
     skew α as camera_matrix[0][1] = α·fx as ``cv2.fisheye`` stores it. A standard-model file with
     a nonzero camera_matrix[0][1] is refused (``cv2.projectPoints`` ignores that element).
+    Read also: the tutorials' key names ``cameraMatrix`` / ``distCoeffs`` (and ``K`` / ``D``),
+    and the same layout in ``cv2.FileStorage``'s XML (``<opencv_storage>``, a ``.xml`` file).
 ``colmap`` (``cameras.txt``)
     COLMAP's text format: ``CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]``, one camera a line, ``#``
     comments; parameters in COLMAP's order (pixel centres at +0.5).
@@ -192,8 +194,15 @@ def _parse_opencv_yaml(text: str, path: Path) -> dict:
     return out
 
 
+#: other names of the two matrices in files written by OpenCV's samples and tutorials
+_MATRIX_NAMES = {
+    "camera_matrix": ("cameraMatrix", "camera_matrix_K", "K"),
+    "distortion_coefficients": ("distCoeffs", "dist_coeffs", "distortion_coeffs", "D"),
+}
+
+
 def _matrix(nodes: dict, key: str, path: Path) -> np.ndarray:
-    node = nodes.get(key)
+    node = next((nodes[k] for k in (key, *_MATRIX_NAMES.get(key, ())) if k in nodes), None)
     if node is None:
         raise DataError(
             f"{path}: no {key!r}; an OpenCV calibration has camera_matrix and "
@@ -305,11 +314,33 @@ def _xml_number(el: ET.Element, tag: str, path: Path, default: float | None = 0.
         raise DataError(f"{path}: <{tag}> is not a number: {child.text!r}") from None
 
 
+def _storage_nodes(root, path: Path) -> dict:
+    """``<opencv_storage>`` children as the YAML reader's nodes: a matrix (``<rows>``,
+    ``<cols>``, ``<data>``) as a dict, a scalar as its value."""
+    out: dict = {}
+    for child in root:
+        if child.find("data") is not None:
+            try:
+                data = [float(v) for v in (child.findtext("data") or "").split()]
+                out[child.tag] = {
+                    "rows": int(child.findtext("rows") or 1),
+                    "cols": int(child.findtext("cols") or len(data)),
+                    "data": data,
+                }
+            except ValueError:
+                raise DataError(f"{path}: <{child.tag}> holds something not a number") from None
+        else:
+            out[child.tag] = _scalar(child.text or "")
+    return out
+
+
 def _read_metashape(text: str, path: Path) -> CameraModel:
     try:
         root = ET.fromstring(text)
     except ET.ParseError as e:
         raise DataError(f"{path}:{e.position[0]}: not valid XML: {e}") from None
+    if root.tag == "opencv_storage":  # cv2.FileStorage's XML: the nodes of its YAML
+        return _opencv_from_nodes(_storage_nodes(root, path), path)
     cals = [root] if root.tag == "calibration" else list(root.iter("calibration"))
     if not cals:
         raise DataError(f"{path}: no <calibration> element")
