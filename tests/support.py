@@ -213,3 +213,40 @@ def default_sigint() -> None:
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def interrupt_group(argv: list[str], *, cwd, ready: Callable[[str], bool]):
+    """A real Ctrl-C in a terminal: ``python -m orthoscope ARGV`` in a session of its own (its
+    default SIGINT disposition, unbuffered), its stderr read line by line until ``ready(line)``,
+    then SIGINT to the whole process group (the command and any worker processes) and up to 60 s
+    to end. Returns (the stderr lines read before the signal, exit status, stdout, the rest of
+    stderr); a child still running then is killed with its group."""
+    import os
+    import signal
+    import subprocess
+
+    p = subprocess.Popen(
+        [sys.executable, "-m", "orthoscope", *argv],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
+        preexec_fn=default_sigint,
+    )
+    before: list[str] = []
+    try:
+        while True:
+            line = p.stderr.readline()
+            assert line, "the command ended before it could be interrupted: " + "".join(before)
+            before.append(line)
+            if ready(line):
+                break
+        os.killpg(p.pid, signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+    return before, p.returncode, out, err

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -29,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import default_sigint, singlet, singlet_spec
+from support import interrupt_group, singlet, singlet_spec
 
 from raytrace import AIR, Aperture, Field, Lens, Surface
 from raytrace.files.library import load_lens
@@ -347,29 +346,13 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path, 
         + "]\n[global]\nstarts = 40\nhops = 3\nlocal_evaluations = 20\n"
     )
     out = tmp_path / "best.toml"
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
-    p = subprocess.Popen(
-        [sys.executable, "-m", "orthoscope", "optimize", str(spec), "-o", str(out), "--global"]
-        + [*where, "--seed", "1"],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-        env=env,
-        preexec_fn=default_sigint,
+    argv = ["optimize", str(spec), "-o", str(out), "--global", *where, "--seed", "1"]
+    # the first line after a first run's "compiling" notice: the first finished start
+    before, rc, stdout, stderr = interrupt_group(
+        argv, cwd=ROOT, ready=lambda line: "compiling" not in line
     )
-    try:
-        line = p.stderr.readline()  # the first finished start (a first run compiles first)
-        while "compiling" in line:
-            line = p.stderr.readline()
-        assert line.startswith("start "), line
-        os.killpg(p.pid, signal.SIGINT)
-        stdout, stderr = p.communicate(timeout=60)
-    finally:
-        if p.poll() is None:
-            os.killpg(p.pid, signal.SIGKILL)
-    assert p.returncode == 130, stderr
+    assert before[-1].startswith("start "), before[-1]
+    assert rc == 130, stderr
     assert "interrupted" in stderr and "Traceback" not in stderr
     assert "merit nan" not in stderr  # starts that never ran are not reported as done
     assert out.is_file() and "wrote" in stdout

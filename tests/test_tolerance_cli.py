@@ -171,37 +171,19 @@ def test_ctrl_c_on_a_dask_run_stops_once_and_keeps_the_chunks(tmp_path):
     # processes included. They leave it to the command (raytrace.executors.dask_setup): one
     # line, exit 130, no Dask traceback or log line, the finished chunks on disk.
     pytest.importorskip("distributed")
-    import os
-    import signal
-    import subprocess
-    import sys
-
-    from support import default_sigint
+    from support import interrupt_group
 
     out = tmp_path / "run"
-    p = subprocess.Popen(
-        [sys.executable, "-m", "orthoscope", "tolerance", "cooke-triplet-f4", str(SPEC)]
-        + ["--samples", "200000", "--dask", "local:2", "-o", str(out)],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-        env=dict(os.environ, PYTHONUNBUFFERED="1"),
-        preexec_fn=default_sigint,
-    )
-    try:
-        seen = 0
-        while seen < 2:  # two progress lines: chunks have come back
-            line = p.stderr.readline()
-            assert line, "the run ended before its progress lines"
-            seen += line.startswith("tolerance: ") and "instances" in line
-        os.killpg(p.pid, signal.SIGINT)
-        _, err = p.communicate(timeout=60)
-    finally:
-        if p.poll() is None:
-            os.killpg(p.pid, signal.SIGKILL)
-    assert p.returncode == 130, err
+    progress = []
+
+    def ready(line: str) -> bool:  # two progress lines: chunks have come back
+        progress.append(line.startswith("tolerance: ") and "instances" in line)
+        return sum(progress) >= 2
+
+    argv = ["tolerance", "cooke-triplet-f4", str(SPEC), "--samples", "200000", "--dask",
+            "local:2", "-o", str(out)]  # fmt: skip
+    _, rc, _, err = interrupt_group(argv, cwd=ROOT, ready=ready)
+    assert rc == 130, err
     rest = [
         x for x in err.splitlines() if not x.startswith(("tolerance: ", "orthoscope: compiling"))
     ]
