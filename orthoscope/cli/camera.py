@@ -30,6 +30,7 @@ from .common import (
     add_wavelength_arg,
     check_output_path,
     check_plot_path,
+    first_repeat,
     length,
     load,
     print_json,
@@ -289,7 +290,7 @@ def _distances(text: str) -> list[str]:
     objs = [p.strip() for p in str(text).split(",")]
     if not objs or any(not p for p in objs):
         raise CliError(f"--object-distances {text!r}: an empty entry; write e.g. 1m,2m,5m")
-    dup = next((p for i, p in enumerate(objs) if p in objs[:i]), None)
+    dup = first_repeat(objs)
     if dup is not None:
         raise CliError(f"--object-distances {text!r}: {dup} is listed twice")
     return objs

@@ -76,6 +76,12 @@ def warn(message: str) -> None:
     print(f"orthoscope: warning: {message}", file=sys.stderr)
 
 
+def first_repeat(values):
+    """The first item of ``values`` that an earlier one equals (None when all differ): a plane
+    or a distance listed twice would give the same row twice."""
+    return next((v for i, v in enumerate(values) if v in values[:i]), None)
+
+
 def number(text: str, what: str) -> float:
     """A finite float from ``text``; CliError naming ``what`` otherwise."""
     try:
@@ -273,7 +279,7 @@ def resolve_planes(lens, args) -> list:
         raise CliError(f"give the image planes one way, not {flags}")
     if given:  # --gaussian with them adds the Gaussian plane to the list
         ((kind, vals),) = given.items()
-        dup = next((v for i, v in enumerate(vals) if v in vals[:i]), None)
+        dup = first_repeat(vals)
         if dup is not None:
             raise CliError(f"--{kind.replace('_', '-')}: the plane {dup:g} is listed twice")
         gauss = [ImagePlane("gaussian")] if args.gaussian else []
