@@ -497,7 +497,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
                     "nd": g.nd,
                     "vd": g.vd,
                     "availability": g.availability,
-                    "relative_price": None if g.price != g.price else g.price,
+                    "relative_price": g.price,
                 }
                 for g in res.glasses
             ],

@@ -90,8 +90,8 @@ def glass_to_dict(g: CatalogGlass, wavelengths, indices) -> dict:
         "dndt": list(g.dndt),
         "source": g.source,
         "note": g.note,
-        "relative_price": g.price if math.isfinite(g.price) else None,
-        "alias_prices": {a: p if math.isfinite(p) else None for a, p in g.alias_prices},
+        "relative_price": g.price,  # NaN (none printed) -> null by report.jsonout
+        "alias_prices": dict(g.alias_prices),
         "printed_indices": [
             {"line": lab, "wavelength_nm": w, "n": n, "decimals": d}
             for lab, w, n, d in g.printed_indices
@@ -145,7 +145,7 @@ def search_to_dict(nd: float, vd: float, matches: list[GlassMatch]) -> dict:
                 "nd": m.glass.nd,
                 "vd": m.glass.vd,
                 "distance": m.distance,
-                "relative_price": None if m.glass.price != m.glass.price else m.glass.price,
+                "relative_price": m.glass.price,
                 "status": m.glass.status,
             }
             for m in matches
