@@ -84,6 +84,26 @@ def evaluate_radial(k0: float, k: Sequence[float], r_mm: np.ndarray) -> np.ndarr
     return r * (k0 + radial_polynomial(tuple(k), r * r))
 
 
+#: the largest r/c of a perspective profile the fits accept: tan 87° (a field angle nearer 90°
+#: means a principal distance or pixel pitch in the wrong unit)
+MAX_RADIUS_RATIO = 19.0
+
+
+def check_profile_units(r_mm: np.ndarray, dr_um: np.ndarray) -> None:
+    """Refuse a profile whose distortion is as large as its radius (|δr| ≥ r: 100 % or more),
+    the mark of radii in metres or of δr in mm labelled µm; the message says so."""
+    r = np.abs(np.asarray(r_mm, dtype=float))
+    d = np.abs(np.asarray(dr_um, dtype=float)) / 1000.0
+    big = np.nonzero((r > 0) & (d >= r))[0]
+    if big.size:
+        i = int(big[0])
+        raise DataError(
+            f"distortion {d[i] * 1000.0:g} µm at r = {r[i]:g} mm is as large as the radius "
+            "itself: radii must be in mm and distortion in µm (radii in metres, or distortion "
+            "in mm under a µm label?)"
+        )
+
+
 def fit_radial(
     r_mm: np.ndarray,
     dr_um: np.ndarray,
@@ -107,6 +127,7 @@ def fit_radial(
         raise DataError("r_mm and dr_um must be 1-D arrays of the same length")
     if not (np.all(np.isfinite(r)) and np.all(np.isfinite(d_um))):
         raise DataError("the profile contains non-finite values")
+    check_profile_units(r, d_um)
     powers = ([1] if form == "balanced" else []) + [2 * i + 1 for i in range(1, n_terms + 1)]
     p = len(powers)
     if r.size < p:
@@ -250,13 +271,23 @@ def opencv_model(
     c = float(principal_distance_mm)
     if not (c > 0 and math.isfinite(c)):
         raise DataError(f"principal distance must be positive, got {c!r}")
-    if pixel_pitch_um is not None and not pixel_pitch_um > 0:
-        raise DataError(f"pixel pitch must be positive, got {pixel_pitch_um!r}")
+    if pixel_pitch_um is not None:
+        from .camera.sensor import parse_pitch_um
+
+        pixel_pitch_um = parse_pitch_um(float(pixel_pitch_um))[0]
     if radius not in _RADIUS:
         raise DataError(f"unknown radius convention {radius!r}")
     r = np.asarray(r_mm, dtype=float)
     d = np.asarray(dr_um, dtype=float)
     notes = []
+    check_profile_units(r, d)
+    ratio = float(np.max(np.abs(r), initial=0.0)) / c
+    if ratio > MAX_RADIUS_RATIO:
+        raise DataError(
+            f"principal distance {c:g} mm is {ratio:.3g} times smaller than the largest radius "
+            f"{ratio * c:g} mm (a field angle of {math.degrees(math.atan(ratio)):.4g}°): is it "
+            "in the wrong unit (metres for mm, or a pixel pitch in mm for µm)?"
+        )
     r_ideal = r - d / 1000.0 if radius == "measured" else r
     if radius == "measured":
         notes.append("measured radii converted to ideal radii r - dr before fitting")

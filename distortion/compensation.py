@@ -134,6 +134,12 @@ def compensate(
             f"compensation ({method}) chooses the magnification itself: magnification= goes "
             "with method 'given'"
         )
+    if magnification is not None and magnification * M2 < 0:
+        raise CalibrationError(
+            f"magnification M = {magnification:g} has the other sign than the printer's "
+            f"M2 = {M2:g}: M is the print's magnification factor (Eq. 16), of the sign of M2 "
+            f"(e.g. {-magnification:g})"
+        )
     idx = match_fields(camera.fields, at or (), f"compensation ({method})") if need else None
     if need and (idx is None or len(idx) != need):
         raise CalibrationError(f"method {method!r} needs {need} field(s) in at=")

@@ -216,6 +216,14 @@ def read_distortion_table(
             f"({sym}·{'tan α' if kind == ANGLE else 'y'} = {K * x[i]:.10g} mm, beyond the "
             "rounding of the printed numbers)"
         )
+    big = np.nonzero(on & (np.abs(D0) >= np.abs(y0p)))[0]
+    if big.size:  # a distortion of 100 % or more: a unit slip, not a lens
+        i = int(big[0])
+        raise DataError(
+            f"{where}:{lines[i]}: D0 = {D0[i]:g} mm is as large as the ideal image height y0' = "
+            f"{y0p[i]:g} mm (a distortion of {100.0 * D0[i] / y0p[i]:.3g} %): is the "
+            f"{header[roles['D0']]!r} column in micrometres? It must be in mm"
+        )
     if "Dr" in roles:
         dr = np.array(data["Dr"])
         with np.errstate(divide="ignore", invalid="ignore"):

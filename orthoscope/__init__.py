@@ -97,6 +97,7 @@ _API: dict[str, str] = {
     "trace_variation": "distortion.variation",
     "analyze_variation": "distortion.variation",
     "analyze_csv": "distortion.variation",
+    "read_profiles_csv": "distortion.variation",
     "Conjugate": "distortion.variation",
     # focus positions / configurations that change thicknesses (Brown's model tested on them)
     "read_configured": "raytrace.files.configurations",
@@ -286,7 +287,13 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         tolerance_monte_carlo,
         tolerance_sensitivity,
     )
-    from distortion.variation import Conjugate, analyze_csv, analyze_variation, trace_variation
+    from distortion.variation import (
+        Conjugate,
+        analyze_csv,
+        analyze_variation,
+        read_profiles_csv,
+        trace_variation,
+    )
     from distortion.variation.focus import (
         FocusStudy,
         focus_configurations,

@@ -189,3 +189,107 @@ def test_coefficients_traced(capsys):
     assert d["gaussian_fit"]["rms_um"] < 1.0
     rc, out, _ = run(capsys, "coefficients", *S65, "--focus", "12x", "--max-field", "40")
     assert rc == 0 and "OpenCV" in out and "K1" in out
+
+
+# --------------------------------------------------------------------------------------------
+# Values in the wrong unit (review 2026-11-27): the Pentax file of Fraser & Shortis (1992,
+# Table 1) with one unit changed; each slip is said, not computed through
+# --------------------------------------------------------------------------------------------
+
+
+def _pentax_variant(tmp_path, name, row=lambda c: c, meta=lambda line: line, sep=","):
+    """A copy of the Pentax file with every data row mapped by ``row`` (a list of the 4 cells)
+    and every metadata line by ``meta``."""
+    out = []
+    for line in PENTAX.read_text(encoding="utf-8").splitlines():
+        if line.startswith("#"):
+            out.append(meta(line))
+        elif line.startswith("r_mm"):
+            out.append(line.replace(",", sep))
+        else:
+            out.append(sep.join(row(line.split(","))))
+    p = tmp_path / name
+    p.write_text("\n".join(out) + "\n", encoding="utf-8")
+    return p
+
+
+def _mm(c):
+    return [c[0], c[1], str(float(c[2]) * 1000), str(float(c[3]) * 1000)]
+
+
+def test_distances_in_mm_in_a_profile_csv_warn(capsys, tmp_path):
+    p = _pentax_variant(tmp_path, "mm.csv", _mm)
+    rc, _, err = run(capsys, "variation", p)
+    assert rc == 0  # metres it says; the warning names the file, line, column and the slip
+    assert f"{p}:11: focus '8000.0' is read as 8000 m" in err and "looks like millimetres" in err
+    assert "object '1500.0' is read as 1500 m" in err
+
+
+@pytest.mark.parametrize(
+    ("name", "variant", "argv", "needle"),
+    [
+        (  # the focal length in metres
+            "fm.csv",
+            {"meta": lambda s: s.replace("focal_length_mm: 45", "focal_length_mm: 0.045")},
+            [],
+            "focal length 0.045 mm is 622 times smaller than the largest radius 28 mm",
+        ),
+        ("f.csv", {}, ["--focal-length", "0.045"], "is it in metres?"),
+        (  # radii in metres: 18.7 µm of distortion at r = 0.008
+            "rm.csv",
+            {"row": lambda c: [str(float(c[0]) / 1000), *c[1:]]},
+            [],
+            ":12: distortion 18.7 µm at r = 0.008 mm is as large as the radius",
+        ),
+        ("semi.csv", {"sep": ";"}, [], "columns separated by ';': separate them with commas"),
+        (  # one plane written two ways: the message names both, not a radius twice
+            "dup.csv",
+            {"row": lambda c: c[:3] + ["1.50" if c[3] == "2.1" else c[3]]},
+            [],
+            "object 1.50 is the same profile as focus 8, object 1.5 on line 11",
+        ),
+        ("r.csv", {}, ["--r-min", "20", "--r-max", "10"], "--r-min 20 must be below --r-max 10"),
+    ],
+)
+def test_profile_csv_unit_slips_refused(capsys, tmp_path, name, variant, argv, needle):
+    p = _pentax_variant(tmp_path, name, **variant)
+    rc, out, err = run(capsys, "variation", p, *argv)
+    assert (rc, out) == (2, "")
+    assert len(err.strip().splitlines()) == 1 and needle in err
+
+
+def test_prescription_mode_refuses_a_plane_twice(capsys):
+    rc, _, err = run(capsys, "variation", *S65, "--focus", "12x", "--objects", "8x,8.0x")
+    assert rc == 2 and "object plane 8.0x is given twice (as 8x)" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (
+            ["--principal-distance-mm", "0.045"],
+            "principal distance 0.045 mm is 622 times smaller than the largest radius 28 mm",
+        ),
+        (
+            ["--focal-length-px", "9000", "--pixel-pitch-um", "0.005"],
+            "pixel pitch 0.005 µm looks like millimetres",
+        ),
+        (["--principal-distance-mm", "45", "--r-max", "-1"], "--r-max must be positive"),
+        (["--principal-distance-mm", "45", "--r-max", "1"], "--r-max 1 mm keeps no point"),
+    ],
+)
+def test_coefficients_unit_slips_refused(capsys, argv, needle):
+    rc, out, err = run(capsys, "coefficients", PENTAX, "--profile", "8,1.5", *argv)
+    assert (rc, out) == (2, "")
+    assert len(err.strip().splitlines()) == 1 and needle in err
+
+
+def test_coefficients_r_max_cuts_a_csv_profile(capsys):
+    # --r-max was applied only to traced profiles; the Pentax 1.5 m profile has 7 radii to 28 mm
+    rc, out, _ = run(capsys, "coefficients", PENTAX, "--profile", "8,1.5", "--json")
+    rc2, out2, _ = run(
+        capsys, "coefficients", PENTAX, "--profile", "8,1.5", "--r-max", "16", "--json"
+    )
+    assert rc == rc2 == 0
+    full, cut = json.loads(out)["profile"]["r_mm"], json.loads(out2)["profile"]["r_mm"]
+    assert max(full) > 16 and cut == [r for r in full if r <= 16]

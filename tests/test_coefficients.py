@@ -141,3 +141,15 @@ def test_opencv_model_bad_input():
         opencv_model(R, _dr_um(0.0, K_TRUE, R))
     with pytest.raises(DataError, match="need at least 4 profile points"):
         fit_radial(R[:3], _dr_um(0.0, K_TRUE, R[:3]), form="balanced")
+
+
+def test_a_profile_with_distortion_as_large_as_its_radius_is_refused():
+    # radii in metres (0.004 .. 0.028) against δr in µm: 100 % distortion and more is a unit slip
+    from distortion.coefficients import fit_radial, opencv_model
+
+    r = np.array([4.0, 8.0, 12.0, 16.0, 20.0, 24.0, 28.0]) / 1000.0
+    dr = np.array([2.4, 18.7, 59.3, 128.5, 219.9, 313.1, 368.8])  # Fraser & Shortis Table 1, 1.5 m
+    with pytest.raises(DataError, match="as large as the radius itself"):
+        fit_radial(r, dr)
+    with pytest.raises(DataError, match="looks like millimetres"):
+        opencv_model(r * 1000, dr, focal_length_px=9000, pixel_pitch_um=0.005)

@@ -137,3 +137,30 @@ def test_flags_a_method_does_not_use_are_refused(capsys):
         rc, _, err = run_cli(["compensate", *argv])
         assert rc == 2 and msg in err, err
     assert run_cli(["compensate", *pair])[0] == 0  # the same pair runs without them
+
+
+def test_magnification_of_the_other_sign_is_refused(camera):
+    # Eq. 16 with M/M2 < 0 prints an inverted picture of the wrong size: a sign slip, refused
+    printer = matched_printer(camera, camera.D0)
+    with pytest.raises(CalibrationError, match=r"M = 2.5 has the other sign than the printer's"):
+        compensate(camera, printer, magnification=2.5)
+
+
+def test_a_table_in_micrometres_under_a_mm_header_is_refused(tmp_path):
+    # Pestrecov's Table I with D0 written in µm under its 'D0_mm' header: 17 µm read as 17 mm is
+    # a distortion of 63 % at 10° (not refused: could be a lens), 272 mm at 45° is 177 %
+    rows = (DATA / "pestrecov_table1.csv").read_text().splitlines()
+    out = []
+    for line in rows:
+        cells = line.split(",")
+        if line.startswith("#") or not cells[0].strip()[0].isdigit():
+            out.append(line)
+            continue
+        d0 = float(cells[2]) * 1000
+        out.append(",".join([cells[0], cells[1], f"{d0:+.0f}"]))  # Dr dropped (it would differ)
+    p = tmp_path / "table1_um.csv"
+    p.write_text("\n".join(out).replace("D0_mm, Dr_pct", "D0_mm") + "\n")
+    with pytest.raises(
+        DataError, match=r"table1_um\.csv:\d+: D0 = \d+ mm is as large as the ideal"
+    ):
+        read_distortion_table(p)

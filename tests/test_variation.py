@@ -402,3 +402,18 @@ def test_profile_set_in_memory_needs_two_profiles():
     p = Profile(Conjugate.scale(12), Conjugate.scale(8), R, _gauss_profile(8))
     with pytest.raises(DataError, match="at least two profiles"):
         analyze_variation(ProfileSet((p,)))
+
+
+def test_analyze_variation_takes_a_path_and_checks_its_options(tmp_path):
+    path = _write_csv(tmp_path / "n120.csv", _synthetic_rows(0.45))
+    a = analyze_variation(str(path), r_min=20.0, r_max=140.0)
+    assert [p.estimate.g for p in a.focus_summaries[0].planes] == pytest.approx([0.45] * 3)
+    with pytest.raises(TypeError, match="a ProfileSet or the path of a profile CSV"):
+        analyze_variation([1, 2])
+    for kw, msg in (
+        ({"r_min": 100.0, "r_max": 20.0}, "r_min=100 must be below r_max=20"),
+        ({"threshold_um": math.nan}, "threshold_um= must be >= 0"),
+        ({"threshold_um": -1.0}, "threshold_um= must be >= 0"),
+    ):
+        with pytest.raises(DataError, match=msg):
+            analyze_variation(path, **kw)

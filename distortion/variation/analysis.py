@@ -48,6 +48,7 @@ profiles given at identical radii are compared at those radii without change.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -400,8 +401,25 @@ def _scale_or_none(c: Conjugate, f: float | None) -> float | None:
     return None if f is None else c.image_scale(f)
 
 
+def check_analysis_options(
+    r_min: float | None, r_max: float | None, threshold_um: float, method: str
+) -> None:
+    """Refuse analysis options that cannot mean anything (DataError naming the keyword): a
+    negative or non-finite radius, r_min not below r_max, a negative or NaN threshold, an
+    unknown g method."""
+    for name, v in (("r_min", r_min), ("r_max", r_max)):
+        if v is not None and not (v >= 0 and math.isfinite(v)):
+            raise DataError(f"{name}= must be a non-negative radius in mm, got {v!r}")
+    if r_min is not None and r_max is not None and not r_min < r_max:
+        raise DataError(f"r_min={r_min:g} must be below r_max={r_max:g} (mm)")
+    if not threshold_um >= 0 or not math.isfinite(threshold_um):
+        raise DataError(f"threshold_um= must be >= 0 (micrometres), got {threshold_um!r}")
+    if method not in ("lsq", "mean"):
+        raise DataError(f"unknown g estimation method {method!r} (expected 'lsq' or 'mean')")
+
+
 def analyze_variation(
-    ps: ProfileSet,
+    ps: ProfileSet | str | os.PathLike,
     *,
     r_min: float | None = None,
     r_max: float | None = None,
@@ -417,8 +435,19 @@ def analyze_variation(
     over planes and its precision (sample SD), and the RMS error of Eq. (6) with that mean g per
     plane. Per focus with ≥ 2 profiles: the within-field variation. For each Gaussian profile
     bracketed by two others: the Eq. (3)–(4) prediction. ``messages`` state what could not be
-    estimated and why.
+    estimated and why. ``ps`` may be the path of a profile CSV
+    (:func:`distortion.variation.profiles.read_profiles_csv` reads it).
     """
+    check_analysis_options(r_min, r_max, threshold_um, method)
+    if isinstance(ps, str | os.PathLike):
+        from .profiles import read_profiles_csv
+
+        ps = read_profiles_csv(ps)
+    elif not isinstance(ps, ProfileSet):
+        raise TypeError(
+            f"analyze_variation takes a ProfileSet or the path of a profile CSV, not "
+            f"{type(ps).__name__}"
+        )
     if len(ps.profiles) < 2:
         raise DataError(
             f"{ps.source or 'profiles'}: a variation analysis needs at least two profiles, "

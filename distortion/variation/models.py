@@ -26,6 +26,10 @@ WEAK_THRESHOLD_UM = 0.5
 """Default threshold (µm) on |δr_s' − δr_s| below which g_ss' is weakly determined (the paper's
 Figs. 5–6 captions: "very small variation of distortion (<0.5 micrometres)")."""
 
+#: a plain distance (metres) this large looks like millimetres (parse_conjugate and the profile
+#: CSV reader warn)
+PLAIN_METRES_WARN = 100.0
+
 INTERPOLATION = (
     "PCHIP (Fritsch-Carlson monotone piecewise cubic) interpolation of the Gaussian profiles "
     "delta_r_s, delta_r_s' onto the radii of the measured delta_r_ss' profile, no extrapolation"

@@ -28,13 +28,15 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataError
+from ..coefficients import MAX_RADIUS_RATIO, check_profile_units
+from ..errors import DataError, UnitWarning
 from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
-from .models import WEAK_THRESHOLD_UM, Conjugate
+from .models import PLAIN_METRES_WARN, WEAK_THRESHOLD_UM, Conjugate
 
 _SCALE_SUFFIXES = ("x", "X", "×")
 
@@ -138,6 +140,13 @@ def read_profiles_csv(
     if o_col is None:
         missing.append("'object'")
     if missing:
+        sep = next((c for c in ";\t|" if any(c in h for h in header)), None)
+        if sep:
+            raise _err(
+                path,
+                header_line,
+                f"columns separated by {sep!r}: separate them with commas (header {header!r})",
+            )
         raise _err(
             path,
             header_line,
@@ -187,7 +196,7 @@ def read_profiles_csv(
         g = groups.setdefault(
             k, {"focus": conj["focus"], "object": conj["object"], "line": lineno, "pts": []}
         )
-        g["pts"].append((r, dr, lineno))
+        g["pts"].append((r, dr, lineno, conj["focus"].text, conj["object"].text))
 
     profiles = []
     for g in groups.values():
@@ -197,9 +206,21 @@ def read_profiles_csv(
         label = f"focus {g['focus'].text}, object {g['object'].text}"
         dup = np.nonzero(np.diff(rr) == 0)[0]
         if dup.size:
-            raise _err(
-                path, pts[dup[0] + 1][2], f"profile ({label}): radius {rr[dup[0]]:g} mm twice"
-            )
+            a, b = pts[dup[0]], pts[dup[0] + 1]
+            if a[3:] != b[3:]:  # one plane written two ways (1.5 and 1.50)
+                raise _err(
+                    path,
+                    b[2],
+                    f"focus {b[3]}, object {b[4]} is the same profile as focus {a[3]}, object "
+                    f"{a[4]} on line {a[2]} (radius {rr[dup[0]]:g} mm in both): write each "
+                    "distance once, one way",
+                )
+            raise _err(path, b[2], f"profile ({label}): radius {rr[dup[0]]:g} mm twice")
+        try:
+            check_profile_units(rr, dd)
+        except DataError as e:
+            i = int(np.nonzero((rr > 0) & (np.abs(dd) / 1000.0 >= rr))[0][0])
+            raise _err(path, pts[i][2], str(e)) from None
         if rr.size < 2:
             raise _err(path, g["line"], f"profile ({label}) has only one point")
         profiles.append(Profile(g["focus"], g["object"], rr, dd, g["line"]))
@@ -213,7 +234,16 @@ def read_profiles_csv(
             f"{len(profiles)} profile(s){only}: a variation analysis needs at least two "
             "profiles (different object planes and/or focus settings)",
         )
+    _warn_plain_metres(profiles, path)
     if f_mm is not None:
+        r_top = max(float(p.r_mm[-1]) for p in profiles)
+        if r_top / f_mm > MAX_RADIUS_RATIO:
+            raise _err(
+                path,
+                None,
+                f"focal length {f_mm:g} mm is {r_top / f_mm:.3g} times smaller than the largest "
+                f"radius {r_top:g} mm: is it in metres? (the focal length is in mm)",
+            )
         for p in profiles:
             for c in (p.focus, p.obj):
                 if c.unit == "m" and not c.value * 1000.0 > f_mm:
@@ -224,6 +254,27 @@ def read_profiles_csv(
     return ProfileSet(
         tuple(profiles), f_mm, str(path), tuple(([f"source: {src}"] if src else []) + notes)
     )
+
+
+def _warn_plain_metres(profiles, path) -> None:
+    """One UnitWarning per column whose distances in metres look like millimetres."""
+    for col in ("focus", "object"):
+        big = [
+            (p.line, c)
+            for p in profiles
+            for c in ([p.focus] if col == "focus" else [p.obj])
+            if c.unit == "m" and math.isfinite(c.value) and c.value >= PLAIN_METRES_WARN
+        ]
+        if big:
+            line, c = min(big, key=lambda lc: lc[0])
+            warnings.warn(
+                UnitWarning(
+                    f"{path}:{line}: {col} {c.text!r} is read as {c.value:g} m from the lens "
+                    "(the column is in metres); it looks like millimetres: give the distances "
+                    "in metres"
+                ),
+                stacklevel=3,
+            )
 
 
 def analyze_csv(

@@ -76,11 +76,15 @@ from raytrace.lens import Lens
 from raytrace.paraxial.orthoscopy import object_distance_for_magnification
 
 from ..errors import DataError, UnitWarning
-from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
-from .models import WEAK_THRESHOLD_UM, Conjugate
+from .analysis import (
+    Profile,
+    ProfileSet,
+    VariationAnalysis,
+    analyze_variation,
+    check_analysis_options,
+)
+from .models import PLAIN_METRES_WARN, WEAK_THRESHOLD_UM, Conjugate
 
-#: a plain distance (metres) this large looks like millimetres (parse_conjugate warns)
-PLAIN_METRES_WARN = 100.0
 DEFAULT_N_FIELDS = 121
 DEFAULT_N_R = 25
 
@@ -392,10 +396,18 @@ def trace_variation(
     """
     from raytrace.paraxial import paraxial
 
+    check_analysis_options(r_min, r_max, threshold_um, method)
     foci = [focus] if isinstance(focus, Conjugate) else list(focus)
     objs = list(objects)
     if not foci:
         raise DataError("give at least one focus setting")
+    for what, cs in (("focus setting", foci), ("object plane", objs)):
+        for i, c in enumerate(cs):
+            twin = next((d for d in cs[:i] if _same(c, d)), None)
+            if twin is not None:
+                raise DataError(
+                    f"{what} {c.text or c.label} is given twice (as {twin.text or twin.label})"
+                )
     if n_r < 2 or n_fields < 8:
         raise DataError("need n_r >= 2 common radii and n_fields >= 8 traced fields")
     efl = paraxial(lens, math.inf, wavelength).efl

@@ -198,6 +198,9 @@ CLI_FLAGS = {
     "pixel_size_mm": "--pitch (or --sensor)",
     "camera_id": "--camera-id",
     "magnification": "--magnification",
+    "r_min": "--r-min",
+    "r_max": "--r-max",
+    "threshold_um": "--threshold-um",
 }
 
 

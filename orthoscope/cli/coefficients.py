@@ -28,7 +28,7 @@ def cmd_coefficients(args) -> int:
 
     if args.profiles and args.lens:
         raise CliError("give either PROFILES.csv or --lens, not both")
-    for name in ("focal_length_px", "pixel_pitch_um", "principal_distance_mm"):
+    for name in ("focal_length_px", "pixel_pitch_um", "principal_distance_mm", "r_max"):
         v = getattr(args, name)
         if v is not None and not (v > 0 and math.isfinite(v)):
             raise CliError(f"--{name.replace('_', '-')} must be positive and finite, got {v}")
@@ -131,7 +131,18 @@ def _csv_profile(args):
             f"FOCUS,OBJECT ({have})"
         )
     p = profs[0]
-    return p.r_mm, p.dr_um, p.label, args.principal_distance_mm, args.profiles
+    r, dr = _cut(p.r_mm, p.dr_um, args.r_max)
+    return r, dr, p.label, args.principal_distance_mm, args.profiles
+
+
+def _cut(r, dr, r_max):
+    """The points of a profile at radii up to --r-max (all without it)."""
+    if r_max is None:
+        return r, dr
+    keep = r <= r_max
+    if not keep.any():
+        raise CliError(f"--r-max {r_max:g} mm keeps no point (the smallest radius is {r.min():g})")
+    return r[keep], dr[keep]
 
 
 def _traced_profile(args):
@@ -159,10 +170,7 @@ def _traced_profile(args):
     import numpy as np
 
     st = trace_setting(lens, focus, obj, np.linspace(0.0, fmax, DEFAULT_N_FIELDS))
-    r, dr = st.valid()
-    if args.r_max is not None:
-        keep = r <= args.r_max
-        r, dr = r[keep], dr[keep]
+    r, dr = _cut(*st.valid(), args.r_max)
     r, dr = r[1:], dr[1:]  # drop the axis point (r = 0)
     if r.size < 5:
         raise CliError("fewer than 5 traced points in the radial range")

@@ -67,16 +67,12 @@ def _focus_list(values: list[str] | None):
 
 # ----------------------------------------------------------------------------- variation
 def cmd_variation(args) -> int:
+    from distortion.variation.analysis import check_analysis_options
     from distortion.variation.traced import parse_conjugates, trace_variation
 
     from ..report.variation import format_traced_variation, traced_variation_to_dict
 
-    for name in ("r_min", "r_max"):
-        v = getattr(args, name)
-        if v is not None and not (v >= 0 and math.isfinite(v)):
-            raise CliError(f"--{name.replace('_', '-')} must be a non-negative radius in mm")
-    if not (args.threshold_um >= 0):
-        raise CliError("--threshold-um must be >= 0 (micrometres)")
+    check_analysis_options(**_analysis_options(args))
     if args.profiles and args.lens:
         raise CliError("give either PROFILES.csv (data mode) or --lens (prescription mode)")
     if not args.profiles and not args.lens:
