@@ -322,3 +322,15 @@ def test_a_height_field_table_has_one_y_column(capsys):
                      "--fields", "-1,-2", "--field-kind", "height")  # fmt: skip
     header = next(x for x in out.splitlines() if "y0' (mm)" in x)
     assert rc == 0 and header.split().count("y") == 1, header
+
+
+def test_ctrl_c_while_the_engine_is_imported_is_one_line(capsys, monkeypatch):
+    # main() imported raytrace before its try: a Ctrl-C in the first ~0.4 s was a traceback
+    import orthoscope.cli as cli
+
+    def interrupted(argv):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_run", interrupted)
+    assert cli.main(["paraxial", "cooke-triplet-f4"]) == 130
+    assert capsys.readouterr().err == "orthoscope: interrupted\n"

@@ -132,6 +132,13 @@ def test_warnings_for_missing_rdm_and_ref():
         ("  DIF", "diffractive"),
         ("  PIK ASP S1 Z1 ASP S2 Z1", "freeze the pickups"),
         ("  PIK THI S2 Z1 THI S1 Z1 -1.0", "differs from the stored"),
+        # the optics changed after the surface lines (review 2026-11-27: were skipped with the
+        # generic "unknown commands" warning, the EFL unchanged)
+        ("THI S3 20.0", "a surface changed by a command is not supported"),
+        ("RDY S1 50", "a surface changed by a command"),
+        ("GLA S1 NSK2_SCHOTT", "a surface changed by a command"),
+        ("  CUX 0.01", "anamorphic surfaces"),
+        ("  RDX 100", "anamorphic surfaces"),
     ],
 )
 def test_unsupported_commands_are_refused(insert, needle):
@@ -185,3 +192,44 @@ def test_a_fractional_ref_is_an_error_not_truncated():
     assert (
         loads_seq(TRIPLET.replace("WL 587.5618", "WL 656.3 587.6 486.1\nREF 2")).wavelength == 587.6
     )
+
+
+def test_a_solve_keeps_its_stored_value_with_a_note():
+    # THI HMY 0 (tests/data/corpus/rayoptics/CODV_35571.seq), CUY UMY -0.1 (opticspy singlet):
+    # CODE V wrote the solved values on the surface lines
+    with pytest.warns(InteropWarning, match=r"line 13: CUY UMY \(a solve\) not re-solved"):
+        lens = loads_seq(TRIPLET.replace("  STO\n", "  STO\n  CUY UMY -0.1\n"))
+    assert lens == loads_seq(TRIPLET)
+
+
+def test_the_image_surface_thickness_is_a_defocus():
+    # rayoptics/ag_dblgauss.seq: PIM, then 'SI 0.0 -0.4002686453541377'. CODE V's image-surface
+    # thickness is a defocus (rayoptics 0.9 reads it as the focus shift, codev/cmdproc.py
+    # post_process_input): the file's image plane is the PIM plane moved by it
+    path = DATA / "corpus" / "rayoptics" / "ag_dblgauss.seq"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lens = read_seq(path)
+    p = paraxial(lens)
+    shift = lens.surfaces[-1].thickness - p.gaussian_image_distance
+    assert shift == pytest.approx(-0.4002686453541377, abs=1e-12)
+    assert lens.image_solve is None  # no longer the Gaussian plane
+    plain = loads_seq(TRIPLET.replace("SI 0 0", "SI 0 0.25"))
+    assert plain.surfaces[-1].thickness == pytest.approx(43.25, abs=1e-12)
+
+
+def test_curvatures_without_rdm_are_refused():
+    # rayoptics/singlet.seq: no RDM line (CODE V's default: radii) and 's 0.1 1 nbk7_schott',
+    # a radius of 0.1 mm beside a 1 mm thick glass; read as curvatures (rayoptics' reading)
+    # it is a 10 mm / -20 mm singlet. The reader asks which was meant
+    path = DATA / "corpus" / "rayoptics" / "singlet.seq"
+    with pytest.raises(PrescriptionError, match="look like curvatures; add 'RDM N'") as e:
+        read_seq(path)
+    assert e.value.line == 4
+    text = path.read_text().replace("dim m", "dim m\nrdm n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lens = loads_seq(text)
+    assert [s.curvature for s in lens.surfaces] == [0.1, -0.05]
+    # a real radius file without RDM stays a radius file (the triplet of this module)
+    assert loads_seq(TRIPLET.replace("RDM Y\n", "")) == loads_seq(TRIPLET)

@@ -208,3 +208,26 @@ def test_fold_mirror_inside_a_prism_reads_and_traces_like_optiland():
         assert abs(x[i] - float(np.ravel(r.x)[0])) <= 1e-9
         assert abs(y[i] - (float(np.ravel(r.z)[0]) - 182.0)) <= 1e-9
         assert abs(float(np.ravel(r.y)[0]) - 100.0) <= 1e-9  # the folded image plane, y = 100
+
+
+def test_the_prism_converts_to_toml_and_back(tmp_path):
+    # the same zospy prism: its mirror in glass with thickness 0 was accepted from the .zmx but
+    # refused from the .toml that `convert` wrote (review 2026-11-27); both readers keep it now
+    from raytrace.files import convert
+    from raytrace.files.native import read_lens
+
+    src = CORPUS / "zospy" / "Prism using total internal reflection.zmx"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lens = convert(src, tmp_path / "prism.toml")
+        back = read_lens(tmp_path / "prism.toml")
+    assert [s.thickness for s in back.surfaces] == [s.thickness for s in lens.surfaces]
+    assert [s.mirror for s in back.surfaces] == [s.mirror for s in lens.surfaces]
+    # a glass of thickness 0 in a centred lens is still refused
+    text = (tmp_path / "prism.toml").read_text()
+    centred = 'surfaces = [\n  { r = 50, t = 0, glass = "N-BK7", stop = true },\n'
+    centred += "  { r = -50, t = 48 },\n]"
+    with pytest.raises(PrescriptionError, match="glass thickness must be positive"):
+        from raytrace.files.native import loads
+
+        loads(text[: text.index("surfaces")] + centred)

@@ -169,6 +169,9 @@ def test_toml_wavelength_errors():
         native.loads(_toml("wavelength = 550\nwavelengths = [550.0]\nreference_wavelength = 560"))
     with pytest.raises(PrescriptionError, match="looks like micrometres"):
         native.loads(_toml("wavelengths = [0.4861, 0.5876]\nreference_wavelength = 0.5876"))
+    # the fix that message gives, written in the file, is read (it was refused: "must be a number")
+    um = native.loads(_toml('wavelengths = ["0.4861um", "587.6nm"]\nwavelength = "0.5876um"'))
+    assert um.wavelengths == pytest.approx((486.1, 587.6)) and um.wavelength == pytest.approx(587.6)
 
 
 def test_gaussian_solve_and_scale_to_efl_use_the_reference_wavelength():

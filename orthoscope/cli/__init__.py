@@ -224,6 +224,15 @@ def cli_words(message: str) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 a run that did not succeed, 2 a
     usage or input error, 130 interrupted)."""
+    try:
+        return _run(argv)
+    except KeyboardInterrupt:  # before the command is known (while the engine is imported)
+        print("orthoscope: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _run(argv: Sequence[str] | None) -> int:
+    """:func:`main` once a Ctrl-C during its first imports is taken care of."""
     import warnings
 
     from raytrace.errors import OrthoscopeError

@@ -14,8 +14,10 @@ Supported commands:
   are refused. Wavelengths: ``WL λ1 λ2 …`` (nm) and ``REF i`` (1-based reference wavelength;
   without ``REF`` the middle one of the list is used and a warning says so).
 * Surfaces: ``SO r t [glass]`` (object: ``t`` is the object distance, ≥ 1e10 = infinity),
-  ``S r t [glass]``, ``STO r t [glass]`` (a surface that is the stop), ``SI r t`` (image: its
-  values are ignored, the last ``S`` thickness is the image distance). After a surface line:
+  ``S r t [glass]``, ``STO r t [glass]`` (a surface that is the stop), ``SI r t`` (image: ``t``
+  is CODE V's defocus, added to the last ``S`` thickness — or to the ``PIM`` solve —; not applied,
+  with a warning, when the image surface is decentered; a curved image surface is read as flat,
+  with a warning). After a surface line:
   ``STO`` (this surface is the stop), ``SLB 'label'``, ``CIR r`` (clear aperture: semi-diameter
   that clips rays; ``CIR EDG`` is mechanical and ignored), ``ASP``/``CON``/``SPH``, ``K`` (conic),
   ``A B C D E F G H J`` (the r⁴ … r²⁰ coefficients: CODE V's asphere is
@@ -47,13 +49,15 @@ Supported commands:
   writes the picked-up values into the surface lines, so a pickup is only checked against them
   (within 1e-9 relative) and refused when they disagree.
 
-Anything that changes the optics and cannot be modelled (diffractive or special surfaces,
-gradient index, other pickups) raises :class:`~raytrace.errors.PrescriptionError` with the file,
-line and what to do; other unknown commands are listed in one
-:class:`~raytrace.zemax.InteropWarning`. Every problem with the input raises PrescriptionError
-(never another exception type). A file cut short is refused, never read as a shorter lens
-(``check_complete``: ``GO``, or without it ``SI``, aperture, field and wavelengths;
-lenses/INTEROP.md, "Truncated files").
+Solves (``THI HMY 0``, ``CUY UMY -0.1``: CODE V wrote their results on the surface lines) keep
+the stored values, with a warning. Anything that changes the optics and cannot be modelled
+(diffractive, special or anamorphic surfaces, gradient index, other pickups, a surface changed
+by a command such as ``THI S5 20`` or ``GLA S1 …``) raises
+:class:`~raytrace.errors.PrescriptionError` with the file, line and what to do; other unknown
+commands are listed in one :class:`~raytrace.zemax.InteropWarning`. Every problem with the
+input raises PrescriptionError (never another exception type). A file cut short is refused,
+never read as a shorter lens (``check_complete``: ``GO``, or without it ``SI``, aperture, field
+and wavelengths; lenses/INTEROP.md, "Truncated files").
 """
 
 from __future__ import annotations
@@ -90,15 +94,29 @@ _DECENTER = {"ADE", "BDE", "CDE", "XDE", "YDE", "ZDE"}
 _DECENTER_TYPES = {"DEC": "basic", "DAR": "dar", "BEN": "bend", "REV": "rev"}
 _APERTURES = {"CIR", "REX", "REY", "ELX", "ELY", "ADX", "ADY"}
 #: commands refused (at their line, naming the surface before them), and why
-_REFUSED = dict.fromkeys(
-    ("RET", "GLB", "TILT"),
+_RELATIVE = (
     "coordinates relative to another surface are not supported; in CODE V convert the decenters "
-    "to DEC/DAR/BEN/REV form (local to each surface) and save the .seq again",
-) | dict.fromkeys(
-    ("DIF", "HOE", "HCO", "HWL", "HOR", "GRT", "SPS", "UDS", "GRIN", "GRD", "ZRN"),
-    "diffractive, gradient-index and special surfaces are not supported; orthoscope reads "
-    "spheres, conics and even aspheres (ASP with K, A, B, C, D ...)",
+    "to DEC/DAR/BEN/REV form (local to each surface) and save the .seq again"
 )
+_SPECIAL = (
+    "diffractive, gradient-index and special surfaces are not supported; orthoscope reads "
+    "spheres, conics and even aspheres (ASP with K, A, B, C, D ...)"
+)
+_ANAMORPHIC = (
+    "anamorphic surfaces (an x curvature, cylinders, toroids) are not supported; orthoscope "
+    "reads rotationally symmetric surfaces"
+)
+_REFUSED = (
+    dict.fromkeys(("RET", "GLB", "TILT"), _RELATIVE)
+    | dict.fromkeys(
+        ("DIF", "HOE", "HCO", "HWL", "HOR", "GRT", "SPS", "UDS", "GRIN", "GRD", "ZRN"), _SPECIAL
+    )
+    | dict.fromkeys(("RDX", "CUX", "CYL", "XTO", "YTO"), _ANAMORPHIC)
+)
+#: commands that set a surface value; with a solve type (``THI HMY 0``, ``CUY UMY -0.1``) they
+#: are solves whose result CODE V wrote on the surface line (kept, with a note); with a surface
+#: (``THI S5 20``) or a value they change the lens after its surface lines (refused)
+_SURFACE_SETTERS = {"THI", "RDY", "CUY", "GLA", "INS", "DEL"}
 
 
 @dataclass
@@ -361,6 +379,8 @@ class _SeqParser(LineParser):
                     cur.dtype = _DECENTER_TYPES[cmd]
             elif cmd in _REFUSED:
                 raise self.err(f"{cmd}: {_REFUSED[cmd]}", line, max(len(surfs) - 1, 0) or None)
+            elif cmd in _SURFACE_SETTERS:
+                self.surface_setter(cmd, args, line, len(surfs) - 1)
             elif cmd in ("REFL", "REFLECT"):
                 if cur is None or cur.kind != "S":
                     raise self.err("REFL must follow a lens surface line (S r t)", line)
@@ -379,8 +399,50 @@ class _SeqParser(LineParser):
                 self.unknown.setdefault(cmd[:20], line)
         self.check_complete(surfs, h, xan, yan, xob, yob, in_prv)
         if not rdm_seen:
+            self.check_radius_mode([s for s in surfs if s.kind == "S"])
             self.warn("no RDM line: surface values are read as radii (RDM Y, CODE V's default)")
         return self.build(surfs, h, xan, yan, xob, yob)
+
+    def check_radius_mode(self, body: list[_CSurf]) -> None:
+        """Without an RDM line the values are radii (CODE V's default); refuse a file whose
+        values, read so, give a radius a fifth or less of the glass or air beside it while read
+        as curvatures they give none (rayoptics writes curvatures without RDM N)."""
+
+        def tiny(radius_of) -> tuple[_CSurf, float, float] | None:
+            for k, srf in enumerate(body):
+                r = radius_of(srf)
+                beside = [abs(t) for t in ([body[k - 1].t] if k else []) + [srf.t]]
+                t = max([x for x in beside if math.isfinite(x)], default=0.0)
+                if r != 0.0 and abs(r) <= t / 5.0:
+                    return srf, r, t
+            return None
+
+        found = tiny(lambda srf: srf.r)
+        if found and not tiny(lambda srf: 1.0 / srf.r if srf.r else 0.0):
+            srf, r, t = found
+            raise self.err(
+                f"no RDM line, so the value {r:g} is a radius (CODE V's default), beside a "
+                f"thickness of {t:g}: the values look like curvatures; add 'RDM N' to the file "
+                "if they are curvatures (or 'RDM Y' if they really are radii)",
+                srf.line,
+            )
+
+    def surface_setter(self, cmd: str, args: list[str], line: int, surface: int) -> None:
+        """THI / RDY / CUY / GLA / INS / DEL: a solve (its stored result is used, said in a
+        warning) or a change of the lens by command (refused)."""
+        first = args[0].upper() if args else ""
+        if first and first.isalpha() and cmd in ("THI", "RDY", "CUY") and first not in ("SO", "SI"):
+            self.warn(
+                f"line {line}: {cmd} {first} (a solve) not re-solved: the value on the surface "
+                "line (CODE V's result when it saved the file) is used"
+            )
+            return
+        raise self.err(
+            f"{cmd} {' '.join(args)}: a surface changed by a command is not supported; write "
+            "the value on the surface line (S r t glass) and save the file again",
+            line,
+            max(surface, 0) or None,
+        )
 
     def check_complete(self, surfs, h, xan, yan, xob, yob, in_prv: bool) -> None:
         """Refuse a truncated file (a cut file must not read as a shorter lens).
@@ -781,6 +843,15 @@ class _SeqParser(LineParser):
                     f"line {pims[-1].pim}: PIM on a decentered or tilted lens: the stored image "
                     "distance is used (paraxial solves need a centred lens)"
                 )
+        if img is not None and img.t != 0.0:  # CODE V: the image surface's thickness defocuses
+            if img.dec:
+                self.warn(
+                    f"line {img.line}: SI thickness {img.t:g} (CODE V's defocus) on a decentered "
+                    "image surface is not applied: the image surface is where the last "
+                    "thickness and the decenter put it"
+                )
+            else:
+                lens = lens.with_image_distance(lens.surfaces[-1].thickness + img.t * scale)
         if image_field is not None:
             lens = self.convert_image_field(lens, image_field, lines)
         return ImportResult(lens, tuple(self.warnings))

@@ -431,7 +431,8 @@ def _wavelengths(src: _Source, data: dict[str, Any]) -> dict[str, Any]:
 
     def nm(value, key):
         line = src.key_line("", key)
-        v = _number(src, value, f"{key} (nm)", line)
+        # a number is nm; a string may carry its unit ("587.6nm", "0.5876um"), as on the CLI
+        v = value if isinstance(value, str) else _number(src, value, f"{key} (nm)", line)
         try:
             return wavelength_nm(v, key)
         except UnitError as e:
@@ -816,7 +817,9 @@ def _surfaces(src: _Source, data: dict[str, Any], object_material: Material = AI
         t = srf.thickness
         if isinstance(t, str) or i == n - 1 or srf.coordinate_break:
             continue
-        if not srf.material.is_air and t * direction <= 0.0:
+        # a glass of thickness 0 before a coordinate break or placed surface (a prism's mirror
+        # face, as .zmx files write it) is kept, as the .zmx reader keeps it
+        if not srf.material.is_air and (t * direction < 0.0 or (t == 0.0 and not placed)):
             if direction > 0:
                 raise src.error(f"glass thickness must be positive, got t = {t!r}", line, no)
             raise src.error(

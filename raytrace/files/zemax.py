@@ -996,8 +996,10 @@ def _glas(m: Material) -> str | None:
     if m.is_air:
         return None
     if m.kind == "catalog":
-        # OpticStudio stores the catalog's nd/vd after a catalog name; readers ignore them
-        return f"GLAS {m.name} 0 0 {_r(m.nd)} {_r(m.vd)} 0 0 0 0 0 0"
+        # OpticStudio stores the catalog's nd/vd after a catalog name; readers ignore them. Its
+        # catalogs spell names without spaces (Ohara's S-LAL 8 is S-LAL8 in OHARA.AGF), and a
+        # space would end the name
+        return f"GLAS {m.name.replace(' ', '')} 0 0 {_r(m.nd)} {_r(m.vd)} 0 0 0 0 0 0"
     vd = 0.0 if m.kind == "index" else m.vd
     return f"GLAS ___BLANK 1 0 {_r(m.nd)} {_r(vd)} 0 0 0 0 0 0"
 
