@@ -660,7 +660,6 @@ def _scaled_placement(p, factor: float):
 
 
 @functools.lru_cache(maxsize=512)
-@functools.lru_cache(maxsize=512)
 def _indices(lens: Lens, wavelengths: tuple[float, ...]) -> np.ndarray:
     """:meth:`Lens.indices` for a tuple of wavelengths (nm), cached per lens (read-only)."""
     from .units import wavelength_nm

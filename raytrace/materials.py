@@ -147,6 +147,17 @@ class Material:
             f"glass {self.name} ({self.catalog}) evaluated at {bad[0]:g} nm, outside its data "
             f"range {lo:g}–{hi:g} nm: the index is extrapolated"
         )
+        for b in bad:  # beyond a pole of the formula the numbers are no index at all
+            edge = lo if b < lo else hi
+            path = np.geomspace(edge, b, 257)
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                n = _catalog_index(self, path)
+            if not (np.all(np.isfinite(n)) and np.all(n >= 1.0)):
+                raise OutOfRangeError(
+                    f"glass {self.name} ({self.catalog}) has no index at {b:g} nm: its dispersion "
+                    f"formula, fitted over {lo:g}–{hi:g} nm, breaks down (a pole or n < 1) "
+                    f"between {edge:g} and {b:g} nm; use a material with data there"
+                )
         if strict:
             raise OutOfRangeError(msg + "; use wavelengths inside the range or another material")
         warnings.warn(msg, OutOfRangeWarning, stacklevel=3)

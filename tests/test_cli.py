@@ -334,3 +334,21 @@ def test_ctrl_c_while_the_engine_is_imported_is_one_line(capsys, monkeypatch):
     monkeypatch.setattr(cli, "_run", interrupted)
     assert cli.main(["paraxial", "cooke-triplet-f4"]) == 130
     assert capsys.readouterr().err == "orthoscope: interrupted\n"
+
+
+def test_strict_refuses_a_glass_outside_its_data_range(capsys):
+    # topogon-like-spherical is in Schott glasses whose data start at 312.566 nm (N-SK11): at
+    # 250 nm the index is an extrapolation (a warning); --strict fails (review 2026-11-27: it
+    # printed four warnings and exit 0), and the filter does not outlive the call
+    argv = ["trace", "topogon-like-spherical", "--fields", "0,10", "--wavelength", "250"]
+    rc, out, err = run(capsys, *argv)
+    assert rc == 0 and "outside its data range" in err
+    from raytrace.lens import _indices
+
+    _indices.cache_clear()  # the indices of a lens are cached per process (a CLI run is fresh)
+    rc, out, err = run(capsys, *argv, "--strict")
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert rc == 2 and out == "" and len(lines) == 1
+    assert "surface 1: glass N-SK11 (Schott) evaluated at 250 nm" in lines[0]
+    assert lines[0].endswith("--strict fails")
+    assert run(capsys, *argv)[0] == 0

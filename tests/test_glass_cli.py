@@ -113,6 +113,31 @@ def test_glass_errors_are_one_line(capsys):
     assert rc == 2 and "needs both nd= and vd=" in err
 
 
+def test_glass_review_refusals(capsys):
+    # review 2026-11-27: an unknown catalog was "not in the Foo catalog (Schott)" for a name and
+    # an empty list (exit 0) for --search; vd 0.6 listed glasses 270 code units away
+    for argv in (["N-BK7", "--catalog", "Foo"], ["--search", "nd=1.62,vd=60", "--catalog", "Foo"]):
+        rc, out, err = run(capsys, "glass", *argv)
+        assert (rc, out) == (2, "") and "unknown catalog 'Foo': the shipped catalogs are" in err
+    with pytest.raises(Exception, match="unknown catalog 'Foo'"):
+        search_glass(1.62, 60.0, catalogs=["Foo"])
+    rc, _, err = run(capsys, "glass", "--search", "nd=1.62,vd=0.6")
+    assert rc == 2 and "vd 0.6 are not glass values" in err
+
+
+def test_no_index_beyond_a_pole_of_the_formula(capsys):
+    # N-BK7's Sellmeier term 3 has its pole at sqrt(103.560653) um = 10.18 um (data sheet
+    # coefficients above): at 10.6 um the formula gives 3.895, at 10 um NaN; neither is an index.
+    # Inside the pole the extrapolation is kept (warned) and flagged in the JSON
+    assert nbk7(10600.0) == pytest.approx(3.895422, abs=1e-6)
+    rc, out, err = run(capsys, "glass", "N-BK7", "--wavelengths", "10.6um")
+    assert (rc, out) == (2, "") and "has no index at 10600 nm" in err
+    rc, out, _ = run(capsys, "glass", "N-BK7", "--wavelengths", "2500,587.5618", "--json")
+    ix = json.loads(out)["indices"]
+    assert rc == 0 and [i["extrapolated"] for i in ix] == [True, False]
+    assert ix[0]["n"] == pytest.approx(nbk7(2500.0), abs=1e-12)
+
+
 def test_spline_formula_matches_scipy_cubic():
     interpolate = pytest.importorskip("scipy.interpolate")
     x = np.array([0.4, 0.4047, 0.44, 0.48, 0.4861, 0.5461, 0.5876, 0.65, 0.7, 0.8, 1.0, 1.6])

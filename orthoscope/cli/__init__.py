@@ -264,7 +264,10 @@ def _run(argv: Sequence[str] | None) -> int:
         if args.command not in NO_KERNELS:
             _numba_without_blas_probe()
             _compile_notice()
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            if getattr(args, "strict", False):  # a glass evaluated outside its data range fails
+                warnings.filterwarnings("error", message=r".*outside its data range")
+            return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print(f"{command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -272,6 +275,9 @@ def _run(argv: Sequence[str] | None) -> int:
         if debug:
             raise
         print(f"{command}: error: {cli_words(str(e))}", file=sys.stderr)
+        return EXIT_USAGE
+    except UserWarning as e:  # a warning that --strict turned into an error
+        print(f"{command}: error: {e}; --strict fails", file=sys.stderr)
         return EXIT_USAGE
     except BrokenPipeError:
         _silence_stdout()

@@ -395,8 +395,9 @@ def refuse_flags(message: str, flags) -> None:
 JSON_HELP = "Print JSON (keys carry units; README)."
 FORCE_HELP = "Replace existing output files (never an input)."
 STRICT_HELP = (
-    "Exit with status 2 when a field cannot be traced, or when the lens file names a glass read "
-    "only as a substitute (an N- successor, a parent glass, a model of nd/vd)."
+    "Exit with status 2 when a field cannot be traced, when the lens file names a glass read "
+    "only as a substitute (an N- successor, a parent glass, a model of nd/vd), or when a glass "
+    "is evaluated outside its catalog data range."
 )
 TABLE_LAYOUT_HELP = (
     "Table orientation: 'rows' (one row per field; default) or 'paper' (fields across, as "

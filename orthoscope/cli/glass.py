@@ -76,15 +76,22 @@ def cmd_glass(args) -> int:
 
     if (args.name is None) == (args.search is None):
         raise CliError("give a glass NAME or --search nd=...,vd=... (one of them)")
+    cats = None
+    if args.catalog:
+        from raytrace.glass.catalog import require_catalog
+
+        cats = [require_catalog(c.strip()) for c in args.catalog.split(",")]
     if args.search is not None:
         if args.wavelengths is not None:
             raise CliError("--wavelengths goes with a glass NAME, not with --search")
         nd, vd = args.search
-        if not (1.0 <= nd < 5.0 and 0.0 < vd < 200.0):
-            raise CliError(f"--search: nd {nd:g} / vd {vd:g} are not glass values")
+        if not (1.0 <= nd < 5.0 and 10.0 <= vd <= 120.0):
+            raise CliError(
+                f"--search: nd {nd:g} / vd {vd:g} are not glass values (optical glasses have "
+                "nd 1.4-2.1 and Abbe numbers vd 17-95)"
+            )
         if args.count < 1:
             raise CliError("--count must be at least 1")
-        cats = [c.strip() for c in args.catalog.split(",")] if args.catalog else None
         limit = math.inf if args.max_price is None else args.max_price
         matches = search_glass(
             nd, vd, args.count, catalogs=cats, include_retired=args.include_retired,
@@ -98,10 +105,8 @@ def cmd_glass(args) -> int:
         return 0
     if args.max_price is not None:
         raise CliError("--max-price goes with --search, not with a glass NAME")
-    g = lookup_glass(
-        args.name, [args.catalog] if args.catalog else None, first_catalog_wins=bool(args.catalog)
-    )
-    if args.catalog and g.catalog.lower() != args.catalog.strip().lower():
+    g = lookup_glass(args.name, cats, first_catalog_wins=bool(cats))
+    if cats and g.catalog not in cats:
         raise CliError(f"glass {args.name} is not in the {args.catalog} catalog ({g.catalog})")
     wls = args.wavelengths
     if wls is None or wls == "lens":

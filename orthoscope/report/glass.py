@@ -97,7 +97,12 @@ def glass_to_dict(g: CatalogGlass, wavelengths, indices) -> dict:
             for lab, w, n, d in g.printed_indices
         ],
         "indices": [
-            {"wavelength_nm": float(w), "line": line_name(float(w)), "n": float(n)}
+            {
+                "wavelength_nm": float(w),
+                "line": line_name(float(w)),
+                "n": float(n),
+                "extrapolated": not g.material.in_range(float(w)),
+            }
             for w, n in zip(wavelengths, np.atleast_1d(indices), strict=True)
         ],
     }

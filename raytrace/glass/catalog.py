@@ -264,6 +264,17 @@ def canonical_catalog(name: str) -> str | None:
     return None
 
 
+def require_catalog(name: str) -> str:
+    """:func:`canonical_catalog`, refusing a name that is no shipped catalog (PrescriptionError
+    listing them)."""
+    c = canonical_catalog(name)
+    if c is None:
+        raise PrescriptionError(
+            f"unknown catalog {name!r}: the shipped catalogs are {', '.join(CATALOGS)}"
+        )
+    return c
+
+
 def find_glass(
     name: str, catalogs: tuple[str, ...] | list[str] | None = None
 ) -> list[CatalogGlass]:
@@ -451,9 +462,7 @@ def search_glass(
     """
     cats = CATALOGS
     if catalogs:
-        cats = tuple(
-            dict.fromkeys(c for c in (canonical_catalog(x) for x in catalogs) if c is not None)
-        )
+        cats = tuple(dict.fromkeys(require_catalog(x) for x in catalogs))
     scored = []
     for c in cats:
         for i, row in enumerate(_index()[c]):
