@@ -92,12 +92,15 @@ def length_mm(
 
 
 def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
-    """A wavelength in nm from a number (nm) or a string with a unit (nm, um, µm).
+    """A wavelength in nm from a number (nm), a string with a unit (nm, um, µm) or a
+    spectral-line letter (:data:`SPECTRAL_LINES`: ``"d"``, ``"F'"``).
 
     Refuses NaN, inf, zero and negative values, and values outside
     :data:`WAVELENGTH_RANGE_NM`; a bare number below 100 looks like µm and the message says so
     (``0.5876`` → "write 0.5876um or 587.6nm")."""
     unit = "nm"
+    if isinstance(value, str) and value.strip() in SPECTRAL_LINES:
+        return SPECTRAL_LINES[value.strip()]
     if isinstance(value, str):
         v, unit = split_unit(value)
         unit = unit or "nm"
@@ -173,10 +176,4 @@ def wavelengths_nm(values, what: str = "wavelengths") -> tuple[float, ...]:
             items = [values]
     if not items:
         raise UnitError(f"{what}: give at least one wavelength (nm)")
-    out = []
-    for v in items:
-        if isinstance(v, str) and v.strip() in SPECTRAL_LINES:
-            out.append(SPECTRAL_LINES[v.strip()])
-        else:
-            out.append(wavelength_nm(v, what))
-    return tuple(out)
+    return tuple(wavelength_nm(v, what) for v in items)

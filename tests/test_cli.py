@@ -352,3 +352,21 @@ def test_strict_refuses_a_glass_outside_its_data_range(capsys):
     assert "surface 1: glass N-SK11 (Schott) evaluated at 250 nm" in lines[0]
     assert lines[0].endswith("--strict fails")
     assert run(capsys, *argv)[0] == 0
+
+
+def test_review_of_the_analysis_commands(capsys):
+    # review 2026-11-27: each of these was silently ignored, misleading or refused
+    rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", "--sensor-metrics")
+    assert (rc, out) == (2, "") and "--sensor-metrics needs --sensor WxH" in err
+    # a headline over the traced fields only (80 deg does not trace in the Cooke triplet)
+    rc, out, _ = run(capsys, "pupils", "cooke-triplet-f4", "--fields", "0,80")
+    assert rc == 0 and "(0 = telecentric in image space); over the traced fields only" in out
+    # a line letter where one wavelength is asked, as where several are
+    rc, out, _ = run(capsys, "pupils", "cooke-triplet-f4", "--wavelength", "d", "--json")
+    assert rc == 0 and json.loads(out)["pupils"]["wavelength_nm"] == 587.5618
+    # fan status words, as trace's (20 deg: the Cooke triplet's rim rays run backward)
+    rc, out, _ = run(capsys, "fan", "cooke-triplet-f4", "--field", "20", "--n", "5", "--json")
+    assert json.loads(out)["fans"][0]["status"] == ["backward", "ok", "ok", "ok", "backward"]
+    # a finite object's nominal angles are named so in the CSV (as distortion --csv does)
+    rc, out, _ = run(capsys, "pupils", "twinplex-like-55-525", "--csv")
+    assert rc == 0 and out.startswith("nominal_angle_deg,cra_deg,")

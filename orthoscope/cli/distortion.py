@@ -321,7 +321,8 @@ def _add_grid_args(q: argparse.ArgumentParser) -> None:
 
 
 def _grid_mode(args) -> bool:
-    return any(getattr(args, k, None) for k in ("grid", "sensor", "plot_grid", "plot_vectors"))
+    keys = ("grid", "sensor", "plot_grid", "plot_vectors", "sensor_metrics")
+    return any(getattr(args, k, None) for k in keys)
 
 
 def _grid_size(text: str | None) -> tuple[int, int]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from raytrace.trace import RayFan, SpotDiagram
+from raytrace.trace.results import status_name
 
 from .text import csv_text
 
@@ -29,7 +30,7 @@ def fan_to_dict(f: RayFan) -> dict:
         "pupil": f.pupil.tolist(),
         "eps_x_mm": f.ex.tolist(),
         "eps_y_mm": f.ey.tolist(),
-        "status": f.status.tolist(),
+        "status": [status_name(c) for c in f.status],
     }
 
 
@@ -43,14 +44,16 @@ def format_fans(fans: list[RayFan]) -> str:
         )
         out.append(f"{'pupil':>8} {'eps (um)':>12}")
         for p, e, s in zip(f.pupil, f.aberration, f.status, strict=True):
-            out.append(f"{p:8.3f} {1000 * e:12.4f}" if s == 0 else f"{p:8.3f} {'-':>12}")
+            out.append(
+                f"{p:8.3f} {1000 * e:12.4f}" if s == 0 else f"{p:8.3f} {'-':>12}  {status_name(s)}"
+            )
         out.append("")
     return "\n".join(out).rstrip()
 
 
 def fans_csv(fans: list[RayFan]) -> str:
     rows = [
-        [("y" if f.axis == "y" else "x"), f.field, p, ex, ey, int(s)]
+        [("y" if f.axis == "y" else "x"), f.field, p, ex, ey, status_name(s)]
         for f in fans
         for p, ex, ey, s in zip(f.pupil, f.ex, f.ey, f.status, strict=True)
     ]

@@ -37,7 +37,8 @@ def format_pupils(pa: PupilAnalysis, *, decimals: int = 4, layout: str = "rows")
         f"{pa.name} — chief-ray angles, pupils and distortion slope; {obj}; {pa.wavelength:g} nm",
         f"paraxial E0 at z = {_z(par.z_E0)}, E0' at z = {_z(par.z_E0p)}, m_e = {par.m_e:.6g}; "
         f"d{sym}/ds' = {pa.constant_slope:.6g}{unit}",
-        f"max |CRA| = {pa.max_abs_cra_deg:.6g} deg (0 = telecentric in image space)",
+        f"max |CRA| = {pa.max_abs_cra_deg:.6g} deg (0 = telecentric in image space)"
+        + ("; over the traced fields only" if np.any(pa.status != 0) else ""),
         "",
         "Image side: CRA = angle of the real chief ray after the last surface; exit pupil = "
         "where it crosses the axis;",
@@ -124,7 +125,9 @@ def pupils_csv(pa: PupilAnalysis) -> str:
         "height_at_E0_mm",
         "viewpoint_offset_mm",
     ]
-    fname = "object_height_mm" if pa.field_kind == HEIGHT else "angle_deg"
+    fname = {ANGLE: "angle_deg", HEIGHT: "object_height_mm", NOMINAL_ANGLE: "nominal_angle_deg"}[
+        pa.field_kind
+    ]
     rows = [
         [float(pa.fields[i])] + [d[c][i] for c in cols] + [d["status"][i]]
         for i in range(pa.fields.size)
