@@ -201,6 +201,7 @@ def rayoptics_grid(path, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray
     stop = sm.stop_surface if sm.stop_surface is not None else 1
     last = len(sm.ifcs) - 1
     image_tab = Path(path).suffix.lower() == ".zmx" and lens.image_placement is not None
+    focus_shift = float(opm["optical_spec"]["focus"].focus_shift)
     out = np.empty(X.shape + (2,))
     worst = 0.0
     for i in np.ndindex(X.shape):
@@ -237,7 +238,14 @@ def rayoptics_grid(path, lens, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray
             d = R @ ray[k][mc.d]
             out[i] = _to_image_frame(lens, p, d)
         else:
-            out[i] = np.asarray(ray[-1][mc.p][:2], dtype=float) * scale
+            # the referee's focus shift (a CODE V image-surface thickness: our image plane is
+            # moved by it, ray-optics keeps its image surface and defocuses by it; on a
+            # decentered image surface our reader does not apply it, and says so)
+            p = np.asarray(ray[-1][mc.p], dtype=float)
+            d = np.asarray(ray[-1][mc.d], dtype=float)
+            if focus_shift and lens.image_placement is None:
+                p = p + d * (focus_shift / d[2])
+            out[i] = p[:2] * scale
     return out, worst
 
 

@@ -4,8 +4,9 @@
 One row per surface: number, radius (mm, ``inf`` for a plane), thickness to the next vertex (mm),
 the medium after the surface, semi-diameter (mm, ``-`` when not limited), conic, aspheric terms
 (a Q-type surface: its form, ρ_max and a_m, on the base radius and conic of the row), stop mark
-and label; then the first-order summary (EFL, BFL, EPD, f-number, pupils, m_e) at the
-lens's wavelength. Plain floats, units in the headers.
+and notes (label, mirror, coordinate break, decenter / tilt, extra clear aperture); a decentered
+image surface under the table; then the first-order summary (EFL, BFL, EPD, f-number, pupils,
+m_e) at the lens's wavelength. Plain floats, units in the headers.
 """
 
 from __future__ import annotations
@@ -45,9 +46,33 @@ def surface_rows(lens: Lens) -> list[list[str]]:
                 _g(s.conic) if s.conic else "",
                 asph,
             ]
-            + ([s.label] if s.label else [])
+            + ([note] if (note := "; ".join(surface_notes(s))) else [])
         )
     return rows
+
+
+def surface_notes(s) -> list[str]:
+    """What the columns do not show of a surface: its label, a mirror, a coordinate break, its
+    placement and the frame after it (:mod:`raytrace.frames`), an extra clear aperture."""
+    from .frames import Placement
+
+    out = [s.label] if s.label else []
+    if s.mirror:
+        out.append("MIRROR")
+    if s.coordinate_break:
+        out.append("coordinate break")
+    if isinstance(s.placement, Placement) and not s.placement.is_identity:
+        out.append(s.placement.describe())
+    if isinstance(s.after, Placement):
+        out.append(f"after: {s.after.describe()}")
+    elif s.after != "stay":
+        out.append(f"after: {s.after}")
+    a = s.aperture
+    if a is not None:
+        size = f"{a.half_x:g}" if a.shape == "circle" else f"{a.half_x:g} x {a.half_y:g}"
+        at = f" at ({a.x0:g}, {a.y0:g})" if (a.x0 or a.y0) else ""
+        out.append(f"aperture {a.shape} {size}{at}")
+    return out
 
 
 def summary_lines(lens: Lens) -> list[str]:
@@ -87,12 +112,15 @@ def format_prescription(lens: Lens, *, summary: bool = True) -> str:
         f"{lens.name}",
         f"aperture {lens.aperture.describe()}; field {lens.field.describe()}",
         "  ".join(c.rjust(w) for c, w in zip(COLUMNS, widths, strict=True))
-        + ("  label" if any(len(r) > ncol for r in rows) else ""),
+        + ("  notes" if any(len(r) > ncol for r in rows) else ""),
         "  ".join("-" * w for w in widths),
     ]
     for r in rows:
         line = "  ".join(c.rjust(w) for c, w in zip(r[:ncol], widths, strict=True))
         out.append((line + (f"  {r[ncol]}" if len(r) > ncol else "")).rstrip())
+    ip = lens.image_placement
+    if ip is not None and not isinstance(ip, str) and not ip.is_identity:
+        out.append(f"image surface: {ip.describe()}")
     if summary:
         out += summary_lines(lens)
     return "\n".join(out)
@@ -101,7 +129,7 @@ def format_prescription(lens: Lens, *, summary: bool = True) -> str:
 def html_prescription(lens: Lens) -> str:
     """The same table as HTML (Jupyter's rich display)."""
     esc = html.escape
-    head = "".join(f"<th>{esc(c)}</th>" for c in COLUMNS) + "<th>label</th>"
+    head = "".join(f"<th>{esc(c)}</th>" for c in COLUMNS) + "<th>notes</th>"
     body = "".join(
         "<tr>"
         + "".join(f"<td>{esc(c)}</td>" for c in r[: len(COLUMNS)])

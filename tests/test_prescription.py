@@ -457,3 +457,32 @@ def test_catalog_glasses_round_trip_by_name(tmp_path: Path) -> None:
     assert 'glass = "N-SK16"' in text and 'catalog = "Schott"' in text
     assert loads(text) == lens
     assert loads_zmx(dumps_zmx(lens)) == lens
+
+
+def test_listing_and_json_show_mirrors_placements_and_apertures() -> None:
+    # ray-optics' threemir.seq (tests/data/corpus/SOURCES.md): three tilted, decentered mirrors
+    # with rectangular off-axis apertures and a decentered image surface. The listing showed a
+    # plain stack of surfaces (review 2026-11-27); now the notes column and the JSON say it
+    import json
+    import warnings
+
+    from orthoscope.report.prescription import prescription_to_dict
+    from raytrace.files import read_lens_file
+    from raytrace.listing import format_prescription
+
+    root = Path(__file__).resolve().parents[1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lens = read_lens_file(root / "tests/data/corpus/rayoptics/threemir.seq")
+    text = format_prescription(lens, summary=False)
+    row2 = text.splitlines()[5]  # the primary mirror (after title, aperture, header, rule, row 1)
+    assert row2.lstrip().startswith("2 ") and "MIRROR" in row2
+    assert "dec (0, 48.6953, 0) tilt (-8.43864, 0, 0); after: return" in row2  # YDE, ADE (-α)
+    assert "aperture rectangle 75.7342 x 78.5387 at (0, 99.6024)" in row2  # REX, REY, ADY
+    assert "image surface: dec (0, -47.6813, 0)" in text
+    d = json.loads(json.dumps(prescription_to_dict(lens)))
+    s2 = d["surfaces"][1]
+    assert s2["mirror"] and s2["after"] == "return"
+    assert s2["placement"]["decenter_mm"] == [0.0, 48.695345, 0.0]
+    assert s2["clear_aperture"]["shape"] == "rectangle"
+    assert d["image_placement"]["decenter_mm"][1] == -47.681342

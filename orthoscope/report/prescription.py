@@ -36,6 +36,11 @@ def prescription_to_dict(lens: Lens) -> dict:
                 "aspheric": list(s.aspheric),
                 "stop": s.stop,
                 "label": s.label,
+                "mirror": s.mirror,
+                "coordinate_break": s.coordinate_break,
+                "placement": _placement(s.placement),
+                "after": s.after if isinstance(s.after, str) else _placement(s.after),
+                "clear_aperture": None if s.aperture is None else asdict(s.aperture),
             }
         )
     return {
@@ -48,5 +53,15 @@ def prescription_to_dict(lens: Lens) -> dict:
         "aperture": asdict(lens.aperture),
         "field": asdict(lens.field),
         "image_solve": lens.image_solve,
+        "image_placement": _placement(lens.image_placement),
         "surfaces": surfaces,
     }
+
+
+def _placement(p) -> dict | None:
+    """A surface's placement (decenter mm, tilt deg, order) or None when it has none."""
+    from raytrace.frames import Placement
+
+    if not isinstance(p, Placement) or p.is_identity:
+        return None
+    return {"decenter_mm": list(p.decenter), "tilt_deg": list(p.tilt), "order": p.order}
