@@ -233,3 +233,11 @@ def test_curvatures_without_rdm_are_refused():
     assert [s.curvature for s in lens.surfaces] == [0.1, -0.05]
     # a real radius file without RDM stays a radius file (the triplet of this module)
     assert loads_seq(TRIPLET.replace("RDM Y\n", "")) == loads_seq(TRIPLET)
+
+
+def test_pim_on_a_middle_surface_is_refused_even_with_one_on_the_last():
+    # it was ignored when the last surface had its own PIM (review 2026-11-27)
+    text = TRIPLET.replace("  STO\n", "  STO\n  PIM\n").replace("SI 0 0", "  PIM\nSI 0 0")
+    with pytest.raises(PrescriptionError, match="PIM .* only on the last surface") as e:
+        loads_seq(text)
+    assert e.value.line == 13

@@ -316,3 +316,24 @@ def test_a_writer_text_that_would_not_read_back_is_not_written(tmp_path, monkeyp
     with pytest.raises(LensError, match=r"x\.toml: not written: the file would not read back"):
         save_lens(load_lens("cooke-triplet-f4"), out)
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("src", "name", "needle"),
+    [
+        ("cooke-triplet-f4.zmx", "x.seq", "looks like a Zemax .zmx file: give it the suffix .zmx"),
+        ("cooke-triplet-f4.seq", "y.zmx", "looks like a CODE V .seq file: give it the suffix .seq"),
+        ("cooke-triplet-f4.zmx", "z.txt", "looks like a Zemax .zmx file"),
+        ("cooke-triplet-f4.seq", "noext", "looks like a CODE V .seq file"),
+        ("corpus/optiland/test_petzval.len", "p.toml", "looks like an OSLO .len file"),
+    ],
+)
+def test_a_file_with_the_wrong_suffix_is_named(tmp_path, src, name, needle):
+    # the readers' own errors were about their syntax ("STO must follow a surface line", "TOML
+    # syntax error"); the hint names the format the content looks like (review 2026-11-27)
+    from raytrace.files import read_lens_file
+
+    p = tmp_path / name
+    p.write_bytes((Path(__file__).parent / "data" / src).read_bytes())
+    with pytest.raises(PrescriptionError, match=needle):
+        read_lens_file(p)

@@ -28,6 +28,55 @@ def read_lens_file(path: str | Path, *, strict: bool = False) -> Lens:
         with strict_glasses():
             return read_lens_file(path)
     suffix = Path(path).suffix.lower()
+    try:
+        return _read_by_suffix(path, suffix)
+    except PrescriptionError as e:
+        kind = _sniff(path)
+        if kind is None or kind == (suffix if suffix in READ_SUFFIXES else ".toml"):
+            raise
+        raise PrescriptionError(
+            f"{e.reason} (the file looks like {_FORMATS[kind]}: give it the suffix {kind})",
+            path=e.path,
+            line=e.line,
+            surface=e.surface,
+        ) from None
+
+
+_FORMATS = {
+    ".zmx": "a Zemax .zmx file",
+    ".seq": "a CODE V .seq file",
+    ".len": "an OSLO .len file",
+    ".toml": "an orthoscope .toml file",
+}
+
+
+def _sniff(path: str | Path) -> str | None:
+    """The suffix of the format the start of the file looks like, or None (unreadable, unclear).
+    Only used to explain a failed read, never to choose a reader."""
+    import re
+
+    try:
+        raw = Path(path).read_bytes()[:4096]
+    except OSError:
+        return None
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or raw[1:2] == b"\x00":
+        text = raw.decode("utf-16", errors="ignore")
+    else:
+        text = raw.decode("utf-8", errors="ignore")
+    lines = [ln.strip() for ln in re.split(r"[\r\n]+", text) if ln.strip()]
+    heads = {ln.split()[0].upper() for ln in lines if ln.split()}
+    if {"SURF", "VERS", "MODE", "UNIT"} & heads and "SURF" in heads:
+        return ".zmx"
+    if "SO" in heads and ("SI" in heads or "GO" in heads or "S" in heads):
+        return ".seq"
+    if "LEN" in heads and ("END" in heads or "UNI" in heads) and "DES" in heads:
+        return ".len"
+    if any(ln.startswith("surfaces") and "=" in ln for ln in lines):
+        return ".toml"
+    return None
+
+
+def _read_by_suffix(path: str | Path, suffix: str) -> Lens:
     if suffix == ".zmx":
         from .zemax import read_zmx
 

@@ -727,8 +727,9 @@ class _SeqParser(LineParser):
             self.warn(f"line {img.pim}: PIM on the image surface (SI) ignored")
         self.check_pickups(surfs, scale, radius_mode)
         pims = [s for s in body if s.pim is not None]
-        if pims and pims[-1] is not body[-1]:
-            raise self.err("PIM (paraxial image solve) only on the last surface", pims[-1].pim)
+        early = [s for s in pims if s is not body[-1]]
+        if early:
+            raise self.err("PIM (paraxial image solve) only on the last surface", early[0].pim)
         # wavelengths (nm), weights, reference
         if "WL" in h:
             wls, wl_line = h["WL"]
