@@ -16,7 +16,10 @@ The format
     lens's field (semi-diagonals at 45°, 135°, 225°, 315°). Coordinates on the certificate are in
     mm in the photogrammetric image frame: x right, y up, looking from the image toward the lens
     (the lens frame of :mod:`distortion.grid.field`), origin at the sensor centre (with a sensor)
-    or on the lens axis.
+    or on the lens axis. A format whose corner chief rays do not trace is refused, with the
+    largest field out to which they do: the calibrated focal length is balanced over the
+    format the page states, never over a smaller traced part of it. (Fields inside the format
+    that fail are left empty and counted in a note.)
 
 Radial distortion (µm, + outward = pincushion)
     Along the semi-diagonal of azimuth φ, for the field θ (``tan θ = |t|``, t the normalised ideal
@@ -256,14 +259,15 @@ def _format(lens: Lens, par, c0: float, sensor, max_field_deg):
     """(corners (4, 2) in the lens frame or None, extent function φ → tan θ_max, offset (2,),
     label)."""
     if sensor is not None:
-        from .camera.sensor import Sensor, parse_size_mm
+        from .camera.sensor import Sensor
+        from .grid.field import sensor_size
 
-        s = sensor if isinstance(sensor, Sensor) else None
-        if s is not None:
+        s = sensor_size(sensor)  # positive, finite width and height
+        if isinstance(s, Sensor):
             w, h = s.width_mm, s.height_mm
             off = np.asarray(s.principal_point_offset_mm, dtype=float)
         else:
-            w, h = parse_size_mm(sensor)
+            w, h = s
             off = np.zeros(2)
         # the sensor in the lens frame: the axis lies at ``off`` from its centre
         xlo, xhi = -w / 2 - off[0], w / 2 - off[0]
@@ -298,6 +302,60 @@ def _format(lens: Lens, par, c0: float, sensor, max_field_deg):
     a = np.radians([45.0, 135.0, 225.0, 315.0])
     corners = rho * np.column_stack([np.cos(a), np.sin(a)])
     return corners, extent_circle, np.zeros(2), f"lens field {float(max_field_deg):g} deg"
+
+
+def _check_corners(lens, par, clip, ok, az, th_max, dense, nt, fmt, c0, is_sensor) -> None:
+    """Refuse a format whose corner chief rays do not trace: the calibrated focal length would
+    be balanced over a smaller field than the page states. ``ok`` (4, nt + nd + 4): the trace
+    status of the tabulated, dense and corner fields of each semi-diagonal. The message gives
+    the largest field out to which every chief ray of that semi-diagonal traces (to 0.1°)."""
+    nd = dense.size
+    failed = [i for i in range(az.size) if not ok[i, nt + nd + i]]
+    if not failed:
+        return
+    limits = {i: _traceable_limit(lens, par, clip, az[i], ok[i, nt : nt + nd], dense, th_max[i])
+              for i in failed}  # fmt: skip
+    i = min(limits, key=limits.get)
+    lim = math.floor(limits[i] * 10.0) / 10.0
+    c, s = math.cos(az[i]), math.sin(az[i])
+    label = f"{'+' if c >= 0 else '-'}x {'+' if s >= 0 else '-'}y"
+    if lim > 0:
+        reach = f"chief rays trace only to {lim:.1f} deg along it"
+        fix = f"give a format within {lim:.1f} deg"
+        if is_sensor:
+            fix += f" (a sensor whose corners lie within {c0 * math.tan(math.radians(lim)):.1f} mm"
+            fix += " of the lens axis)"
+        else:
+            fix += " (a smaller max field)"
+    else:
+        reach = "no chief ray off the axis traces along it"
+        fix = "check the lens's apertures (semi-diameters) and the object"
+    raise DataError(
+        f"the format ({fmt}) reaches {th_max[i]:.4g} deg at its {label} corner, but {reach}: {fix}"
+    )
+
+
+def _traceable_limit(lens, par, clip, azimuth, ok_dense, dense, theta_corner) -> float:
+    """The largest field (deg) along ``azimuth`` out to which every chief ray traces: the first
+    dense field that fails (or the corner) bracketed, then traced on 64 steps between."""
+    from raytrace.trace.chief2d import aim_2d
+
+    inside = dense <= theta_corner * (1 + 1e-12)
+    bad = np.flatnonzero(inside & ~ok_dense)
+    if bad.size:
+        j = int(bad[0])
+        if j == 0:
+            return 0.0
+        lo, hi = float(dense[j - 1]), float(dense[j])
+    else:
+        lo, hi = float(dense[inside][-1]), float(theta_corner)
+    f = np.linspace(lo, hi, 65)
+    T = np.tan(np.radians(f))
+    FX = np.degrees(np.arctan(T * math.cos(azimuth)))
+    FY = np.degrees(np.arctan(T * math.sin(azimuth)))
+    cr = aim_2d(lens, FX, FY, "angle", par.object_distance, par.wavelength, clip)
+    miss = np.flatnonzero(~np.asarray(cr.ok))
+    return float(f[miss[0] - 1]) if miss.size and miss[0] > 0 else lo
 
 
 def _table_fields(theta_max: float, step: float) -> np.ndarray:
@@ -420,7 +478,23 @@ def calibration_certificate(
     if np.any(th_max >= 89.0):
         raise DataError("the format reaches 89 degrees or more; the certificate needs less")
 
-    # 1. the format's polar grid: PPBS, PPA, axial and the decomposition
+    # 1. the semi-diagonals: tabulated and dense fields and the four corners in one trace (a
+    # format whose corners do not trace is refused first)
+    fields = _table_fields(float(np.max(th_max)), step)
+    dense = np.linspace(0.0, float(np.max(th_max)), DENSE_FIELDS)
+    allf = np.concatenate([fields, dense, th_max])
+    Ta = np.tan(np.radians(allf))
+    FX = np.degrees(np.arctan(Ta[None, :] * np.cos(az)[:, None]))
+    FY = np.degrees(np.arctan(Ta[None, :] * np.sin(az)[:, None]))
+    kw = dict(plane=planes, clip=clip)
+    diag = grid_from_fields(lens, FX, FY, "angle", par, **kw)
+    nt, nd = fields.size, dense.size
+    _check_corners(lens, par, clip, diag.ok, az, th_max, dense, nt, fmt, c0, sensor is not None)
+    allf, Ta = allf[: nt + nd], Ta[: nt + nd]
+    diag_ok = diag.ok[:, : nt + nd]
+    diag_actual = diag.actual[:, :, : nt + nd]
+
+    # 2. the format's polar grid: PPBS, PPA, axial and the decomposition
     pa = np.radians(np.arange(0.0, 360.0, POLAR_AZIMUTH_STEP_DEG))
     pa = np.unique(np.round(np.mod(np.concatenate([pa, az, az + np.pi]), 2 * np.pi), 12))
     frac = np.linspace(0.0, 1.0, POLAR_FIELDS + 1)[1:]
@@ -429,7 +503,6 @@ def calibration_certificate(
     Tp = np.minimum(extent(pa), extent(pa + np.pi))[:, None] * frac[None, :]
     tx = np.concatenate([[0.0], (Tp * np.cos(pa)[:, None]).ravel()])
     ty = np.concatenate([[0.0], (Tp * np.sin(pa)[:, None]).ravel()])
-    kw = dict(plane=planes, clip=clip)
     polar = grid_from_fields(
         lens, np.degrees(np.arctan(tx)), np.degrees(np.arctan(ty)), "angle", par, **kw
     )
@@ -437,23 +510,14 @@ def calibration_certificate(
     if not np.all(np.isfinite(R)):
         raise DataError(f"the {reference_point} point could not be traced")
 
-    # 2. the semi-diagonals: tabulated and dense fields in one trace
-    fields = _table_fields(float(np.max(th_max)), step)
-    dense = np.linspace(0.0, float(np.max(th_max)), DENSE_FIELDS)
-    allf = np.concatenate([fields, dense])
-    Ta = np.tan(np.radians(allf))
-    FX = np.degrees(np.arctan(Ta[None, :] * np.cos(az)[:, None]))
-    FY = np.degrees(np.arctan(Ta[None, :] * np.sin(az)[:, None]))
-    diag = grid_from_fields(lens, FX, FY, "angle", par, **kw)
     ex = np.cos(az)[:, None]
     ey = np.sin(az)[:, None]
-    rel = diag.actual[0] - R  # (4, N, 2)
+    rel = diag_actual[0] - R  # (4, N, 2)
     r_act = rel[..., 0] * ex + rel[..., 1] * ey
     t_act = -rel[..., 0] * ey + rel[..., 1] * ex
     beyond = allf[None, :] > th_max[:, None] * (1 + 1e-12)
     r_act = np.where(beyond, np.nan, r_act)
     t_act = np.where(beyond, np.nan, t_act)
-    nt = fields.size
     with warnings.catch_warnings():  # all-NaN columns (no semi-diagonal traced) give NaN
         warnings.simplefilter("ignore", RuntimeWarning)
         mean_r_dense = np.nanmean(r_act[:, nt:], axis=0)
@@ -493,7 +557,7 @@ def calibration_certificate(
     k = sol / rs ** (2 * np.arange(4) + 1)
     rms = float(np.sqrt(np.mean((A @ sol - yy) ** 2))) * 1000.0
 
-    bad = int(np.count_nonzero(~(polar.ok))) + int(np.count_nonzero(~diag.ok & ~beyond))
+    bad = int(np.count_nonzero(~(polar.ok))) + int(np.count_nonzero(~diag_ok & ~beyond))
     if bad:
         notes.append(f"{bad} field(s) could not be traced; their entries are empty")
     frame_off = off  # certificate frame = lens frame + offset (origin at the sensor centre)

@@ -83,6 +83,9 @@ def parse_size_mm(size: str | Sequence[float]) -> tuple[float, float]:
         if len(vals) != 2:
             raise DataError(f"sensor size {size!r}: give (width, height) in mm")
         w, h = float(vals[0]), float(vals[1])
+    if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
+        label = size.strip() if isinstance(size, str) else f"{w:g}x{h:g}"
+        raise DataError(f"sensor {label}: width and height must be positive (mm)")
     return w, h
 
 

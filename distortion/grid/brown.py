@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError
-from .decompose import point_pairs
+from .decompose import RANK_RCOND, point_pairs, radial_shortfall, rank_shortfall
 
 #: |b|·r_max (mm) above which b1 / b2 are reported as a warning
 AFFINITY_WARNING_MM = 1e-6
@@ -69,6 +69,10 @@ class BrownConradyFit:
         The same camera in OpenCV's model (k1, k2, p1, p2, k3; a refit by
         :func:`distortion.camera.convert_camera_model` with its residual), when asked for.
     warnings : tuple of str
+    not_determined : str
+        "" for a fitted model; else why the points do not determine it (too few distinct field
+        radii or traced points, a rank-deficient Jacobian): then ``camera``, ``fit`` and
+        ``opencv`` are None, every value is NaN and ``std_errors`` and ``free`` are empty.
     """
 
     plane: int
@@ -84,6 +88,12 @@ class BrownConradyFit:
     pixel_mm: float
     opencv: object = None
     warnings: tuple[str, ...] = ()
+    not_determined: str = ""
+
+    @property
+    def determined(self) -> bool:
+        """Whether the points determined the model (else ``not_determined`` says why)."""
+        return not self.not_determined
 
     @property
     def opencv_coefficients(self) -> dict:
@@ -98,6 +108,8 @@ class BrownConradyFit:
 
     def __repr__(self) -> str:
         v = self.values
+        if not self.determined:
+            return f"BrownConradyFit(plane {self.plane}: not determined: {self.not_determined})"
         return (
             f"BrownConradyFit(plane {self.plane}: c = {v['c']:.6f} mm, xp = {v['xp']:.3g}, "
             f"yp = {v['yp']:.3g} mm, K1 = {v['K1']:.4g}, P1 = {v['P1']:.3g}, P2 = {v['P2']:.3g}, "
@@ -142,16 +154,28 @@ def fit_brown_conrady_points(
     Returns
     -------
     BrownConradyFit
+        When the points cannot determine the model (fewer distinct field radii than the four
+        radial unknowns c, K1, K2, K3, e.g. a 3x3 grid; too few points; a rank-deficient
+        Jacobian) it is returned with ``not_determined`` saying why and NaN values.
     """
     from ..camera import CameraModel, convert_camera_model, fit_camera_model
 
     t, img, good = point_pairs(t, image_mm, "image_mm")
     t, img = t[good], img[good]
-    n_free = 10 if affinity else 8
-    if t.shape[0] * 2 <= n_free:
-        raise DataError(f"{n_free} parameters need more than {n_free // 2} traced points")
-    photo = img + np.asarray(offset_mm, dtype=float)
+    free = BROWN_PARAMS if affinity else BROWN_PARAMS[:8]
+    n_free = len(free)
     p = float(pixel_mm)
+    if t.shape[0] * 2 <= n_free:
+        return _undetermined(
+            plane,
+            p,
+            f"{n_free} parameters need more than {n_free // 2} traced points, there are "
+            f"{t.shape[0]}: use a grid with more fields (5x5 or more)",
+        )
+    why = radial_shortfall(t, ("c", "K1", "K2", "K3"))
+    if why:
+        return _undetermined(plane, p, why)
+    photo = img + np.asarray(offset_mm, dtype=float)
     w = 2 * math.ceil(float(np.max(np.abs(photo[:, 0]))) / p) + 3
     h = 2 * math.ceil(float(np.max(np.abs(photo[:, 1]))) / p) + 3
     if camera_constant is None:
@@ -161,12 +185,22 @@ def fit_brown_conrady_points(
         camera_constant = num / den if den > 0 else 1.0
     if not camera_constant > 0:
         raise DataError("the image does not grow with the field: no positive camera constant")
+    why = rank_shortfall(_linear_design(t, float(camera_constant), free), free)
+    if why:
+        return _undetermined(plane, p, why)
     start = CameraModel.create(
         "australis", w, h, pixel_size_mm=(p, p), c=float(camera_constant), xp=0.0, yp=0.0
     )
     ideal = np.column_stack([t[:, 0], -t[:, 1]])
-    free = BROWN_PARAMS if affinity else BROWN_PARAMS[:8]
     fit = fit_camera_model(ideal, photo, start, free=free, pixels="photo_mm")
+    if fit.condition * RANK_RCOND > 1.0:  # the Jacobian at the solution: a safety net
+        return _undetermined(
+            plane,
+            p,
+            f"the traced fields do not separate the model's parameters (condition number "
+            f"{fit.condition:.3g} of the fit's Jacobian): use a grid with more fields "
+            "(5x5 or more)",
+        )
     cam = fit.camera
     values = cam.as_dict()
     values = {k: float(values[k]) for k in BROWN_PARAMS}
@@ -197,6 +231,51 @@ def fit_brown_conrady_points(
         pixel_mm=p,
         opencv=conv,
         warnings=tuple(warnings),
+    )
+
+
+def _linear_design(t: np.ndarray, c: float, free) -> np.ndarray:
+    """The column-scaled design matrix of Fraser's model linearised at zero distortion, at the
+    ideal points x̄ = c·t (mm): the correction x̄ + Δx = c tx, ȳ + Δy = c ty with
+    Δx = x̄ (K1 r² + K2 r⁴ + K3 r⁶) + P1 (r² + 2x̄²) + 2 P2 x̄ȳ + b1 x̄ + b2 ȳ,
+    Δy = ȳ (K1 r² + ...) + 2 P1 x̄ȳ + P2 (r² + 2ȳ²) (:mod:`distortion.camera.models`), columns
+    in the order of ``free`` (its rank is that of the fit's Jacobian)."""
+    x, y = c * t[:, 0], c * t[:, 1]
+    r2 = x * x + y * y
+    one, zero = np.ones_like(x), np.zeros_like(x)
+    cols = {
+        "c": (t[:, 0], t[:, 1]),
+        "xp": (one, zero),
+        "yp": (zero, one),
+        "K1": (x * r2, y * r2),
+        "K2": (x * r2**2, y * r2**2),
+        "K3": (x * r2**3, y * r2**3),
+        "P1": (r2 + 2 * x * x, 2 * x * y),
+        "P2": (2 * x * y, r2 + 2 * y * y),
+        "b1": (x, zero),
+        "b2": (y, zero),
+    }
+    A = np.stack([np.concatenate(cols[n]) for n in free], axis=1)
+    norm = np.linalg.norm(A, axis=0)
+    return A / np.where(norm > 0, norm, 1.0)
+
+
+def _undetermined(plane: int, pixel_mm: float, why: str) -> BrownConradyFit:
+    """A :class:`BrownConradyFit` the points do not determine: NaN values, no fit."""
+    return BrownConradyFit(
+        plane=int(plane),
+        camera=None,
+        fit=None,
+        values={k: math.nan for k in BROWN_PARAMS},
+        std_errors={},
+        free=(),
+        correlation=np.zeros((0, 0)),
+        rms_mm=math.nan,
+        max_mm=math.nan,
+        r_max_mm=math.nan,
+        pixel_mm=pixel_mm,
+        opencv=None,
+        not_determined=why,
     )
 
 

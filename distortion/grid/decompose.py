@@ -74,6 +74,74 @@ from ..errors import DataError
 #: the principal-point choices: fitted, or held at a named reference point
 PRINCIPAL_POINTS = ("fit", "axial", "ppa", "ppbs")
 CAMERA_CONSTANTS = ("fit", "characteristic")
+#: singular values of the column-scaled design matrix below this fraction of the largest count
+#: as zero: a parameter combination that weak moves with the float64 round-off of the traced
+#: points (~1e-16 relative) by more than 1e-6 of its scale, so the points do not determine it.
+#: (Measured on the Cooke triplet: determined grids from 2x9 up give 1/cond >= 5e-4, grids with
+#: too few distinct radii ~1e-17: a regression pin of the gap, not a reference value.)
+RANK_RCOND = 1e-10
+#: relative tolerance (of the largest radius) within which two field radii count as one
+RADIUS_RTOL = 1e-9
+
+
+class UndeterminedFit(DataError):
+    """The points cannot determine the model's parameters: fewer distinct field radii than
+    radial unknowns, fewer equations than unknowns, or a rank-deficient design matrix. The
+    message says which and what to change."""
+
+
+def distinct_radii(t: npt.ArrayLike) -> int:
+    """The number of distinct nonzero radii |t| among the finite rows of ``t`` (N, 2); radii
+    within ``RADIUS_RTOL`` of the largest count as one.
+
+    A radial profile r·(c + a1 r² + a2 r⁴ + ...) with k unknowns is sampled only at these
+    radii (its values at the points follow from them), so it is determined only when there are
+    at least k of them: a 3x3 grid on a square sensor has two (the edge centres and the corners)
+    and cannot give c, K1, K2, K3."""
+    t = np.asarray(t, dtype=float).reshape(-1, 2)
+    r = np.hypot(t[:, 0], t[:, 1])
+    r = r[np.isfinite(r)]
+    if r.size == 0 or not float(r.max()) > 0:
+        return 0
+    tol = RADIUS_RTOL * float(r.max())
+    r = np.sort(r[r > tol])
+    return int(r.size > 0) + int(np.count_nonzero(np.diff(r) > tol))
+
+
+def radial_shortfall(t: npt.ArrayLike, radial_names: tuple[str, ...]) -> str:
+    """Why the points ``t`` cannot determine the radial unknowns ``radial_names`` (the camera
+    constant when free, and K1..Kn): too few distinct nonzero radii (:func:`distinct_radii`);
+    "" when they can."""
+    n = distinct_radii(t)
+    if n >= len(radial_names):
+        return ""
+    return (
+        f"the traced fields lie at {n} distinct nonzero field radii, fewer than the "
+        f"{len(radial_names)} radial unknowns ({', '.join(radial_names)}) they must determine: "
+        "use a grid with more fields (5x5 or more)"
+    )
+
+
+def rank_shortfall(As: np.ndarray, names: tuple[str, ...]) -> str:
+    """Why the column-scaled design matrix ``As`` (columns ``names``) does not determine its
+    parameters: singular values below ``RANK_RCOND`` of the largest, naming the parameters of
+    the undetermined combinations; "" when it has full column rank."""
+    if As.shape[0] < As.shape[1]:
+        return (
+            f"{As.shape[0]} equations for {As.shape[1]} unknowns: use a grid with more fields "
+            "(5x5 or more)"
+        )
+    _, sv, vt = np.linalg.svd(As, full_matrices=False)
+    small = ~(sv > RANK_RCOND * sv[0])
+    if not small.any():
+        return ""
+    weight = np.max(np.abs(vt[small]), axis=0)
+    involved = [n for n, w in zip(names, weight, strict=True) if w > 0.1]
+    return (
+        f"the traced fields do not separate {', '.join(involved)} (design matrix rank "
+        f"{int(np.count_nonzero(~small))} of {len(names)}): use a grid with more fields "
+        "(5x5 or more)"
+    )
 
 
 def point_pairs(
@@ -167,7 +235,16 @@ def solve_linear(
     """Least-squares solution of the module's model for points ``t`` (N, 2) (normalised ideal
     coordinates) and ``image`` (N, 2) (mm). ``principal_point`` / ``camera_constant`` given:
     held at those values; None: fitted. ``asymmetric=False``: radial terms only (no P, S).
-    Non-finite points are left out."""
+    Non-finite points are left out.
+
+    Raises
+    ------
+    UndeterminedFit
+        The points do not determine the free parameters: too few points, fewer distinct
+        nonzero radii than radial unknowns (:func:`distinct_radii`), or a design matrix of
+        lower rank than the free parameters (``RANK_RCOND``). No values are made up then.
+    DataError
+        Bad shapes, or a fitted camera constant that is not positive."""
     t, img, good = point_pairs(t, image)
     if radial_terms < 0:
         raise DataError("radial_terms must be 0 or more")
@@ -187,14 +264,23 @@ def solve_linear(
     names = tuple(n for n, _, _ in free_cols)
     m = 2 * tx.size
     if m < len(names) + 1:
-        raise DataError(f"{len(names)} free parameters need more than {len(names) // 2} points")
+        raise UndeterminedFit(
+            f"{len(names)} free parameters need more than {len(names) // 2} traced points, "
+            f"there are {tx.size}: use a grid with more fields (5x5 or more)"
+        )
+    why = radial_shortfall(t[good], tuple(n for n in names if n == "c" or n[0] == "K"))
+    if why:
+        raise UndeterminedFit(why)
     A = np.stack([np.concatenate([cx, cy]) for _, cx, cy in free_cols], axis=1)
     b = np.concatenate([bx, by])
     scale = np.linalg.norm(A, axis=0)
     if np.any(scale == 0.0):
         zero = [n for n, s in zip(names, scale, strict=True) if s == 0.0]
-        raise DataError(f"the points do not determine {', '.join(zero)} (all zero)")
+        raise UndeterminedFit(f"the points do not determine {', '.join(zero)} (all zero)")
     As = A / scale
+    why = rank_shortfall(As, names)
+    if why:
+        raise UndeterminedFit(why)
     sol, *_ = np.linalg.lstsq(As, b, rcond=None)
     # one step of iterative refinement against round-off in the normal equations
     sol += np.linalg.lstsq(As, b - As @ sol, rcond=None)[0]
@@ -313,6 +399,10 @@ class GridDecomposition:
         RMS and maximum length of the residual vectors.
     condition : float
         Condition number of the column-scaled design matrix.
+    not_determined : str
+        "" for a solved decomposition; else why the grid does not determine it (too few
+        distinct field radii or traced points, a rank-deficient design): then every value not
+        held is NaN, ``std_errors`` and ``free`` are empty and the components are NaN.
     """
 
     plane: int
@@ -328,6 +418,12 @@ class GridDecomposition:
     rms_mm: float
     max_mm: float
     condition: float
+    not_determined: str = ""
+
+    @property
+    def determined(self) -> bool:
+        """Whether the grid determined the decomposition (else ``not_determined`` says why)."""
+        return not self.not_determined
 
     @property
     def decentering(self) -> tuple[float, float]:
@@ -346,6 +442,11 @@ class GridDecomposition:
 
     def __repr__(self) -> str:
         v = self.values
+        if not self.determined:
+            return (
+                f"GridDecomposition(plane {self.plane}, principal point {self.principal_point}: "
+                f"not determined: {self.not_determined})"
+            )
         terms = ", ".join(f"{k} = {v[k]:.4g}" for k in ("K1", "P1", "P2", "S1", "S2") if k in v)
         return (
             f"GridDecomposition(plane {self.plane}, principal point {self.principal_point}: "
@@ -381,6 +482,9 @@ def decompose_distortion(
     Returns
     -------
     GridDecomposition
+        When the grid cannot determine the model (fewer distinct field radii than radial
+        unknowns, e.g. a 3x3 grid; too few traced fields; a rank-deficient design) it is
+        returned with ``not_determined`` saying why and NaN values: no numbers are made up.
     """
     if principal_point not in PRINCIPAL_POINTS:
         raise DataError(
@@ -399,10 +503,16 @@ def decompose_distortion(
     cc = None if camera_constant == "fit" else float(grid.camera_constant[p])
     t = np.stack([grid.tx.ravel(), grid.ty.ravel()], axis=1)
     img = grid.actual[p].reshape(-1, 2)
-    fit = solve_linear(t, img, radial_terms=radial_terms, principal_point=pp, camera_constant=cc)
     shape = grid.shape + (2,)
     D = grid.D[p]
     ref = grid.reference_xy[p]
+    try:
+        fit = solve_linear(
+            t, img, radial_terms=radial_terms, principal_point=pp, camera_constant=cc
+        )
+    except UndeterminedFit as e:
+        return _undetermined(p, principal_point, camera_constant, ref, D, radial_terms, pp, cc,
+                             str(e))  # fmt: skip
     c0 = float(grid.camera_constant[p])
     off = np.array([fit.values["x0"] - ref[0], fit.values["y0"] - ref[1]])
     comps = {
@@ -428,4 +538,34 @@ def decompose_distortion(
         rms_mm=fit.rms_mm,
         max_mm=fit.max_mm,
         condition=fit.condition,
+    )
+
+
+def _undetermined(p, principal_point, camera_constant, ref, D, radial_terms, pp, cc, why):
+    """A :class:`GridDecomposition` the grid does not determine: held values kept, the rest
+    NaN, no standard errors, NaN components."""
+    nan = math.nan
+    values = {"c": nan if cc is None else cc, "x0": nan, "y0": nan}
+    if pp is not None:
+        values["x0"], values["y0"] = (float(v) for v in pp)
+    values.update({f"K{i}": nan for i in range(1, radial_terms + 1)})
+    values.update({k: nan for k in ("P1", "P2", "S1", "S2")})
+    blank = np.full(D.shape, nan)
+    comps = {k: blank.copy() for k in ("offset", "scale", "radial", "decentering", "thin_prism",
+                                      "residual")}  # fmt: skip
+    return GridDecomposition(
+        plane=p,
+        principal_point=principal_point,
+        camera_constant=camera_constant,
+        reference_xy=(float(ref[0]), float(ref[1])),
+        values=values,
+        std_errors={},
+        free=(),
+        correlation=np.zeros((0, 0)),
+        D=D,
+        components=comps,
+        rms_mm=nan,
+        max_mm=nan,
+        condition=math.inf,
+        not_determined=why,
     )

@@ -69,14 +69,19 @@ import numpy.typing as npt
 
 from raytrace.errors import TraceError
 from raytrace.lens import Lens
+from raytrace.limits import MAX_FIELDS
 from raytrace.paraxial import ImagePlane, ParaxialResult
 
 from ..curve import FieldKindMixin, curve_field_kind, plane_label, requested_fields
 from ..errors import DataError
-from .decompose import solve_linear
+from .decompose import UndeterminedFit, distinct_radii, solve_linear
 
 REFERENCE_POINTS = ("axial", "ppa", "ppbs")
 DEFAULT_GRID = (21, 21)
+#: fields a grid may have without ``allow_large=True``: the command line's limit
+#: (:data:`raytrace.limits.MAX_FIELDS`, lifted there by --allow-large); a field costs about
+#: 400 bytes of arrays per image plane
+MAX_GRID_FIELDS = MAX_FIELDS
 #: radial terms of the radially symmetric fit that defines the PPBS
 PPBS_RADIAL_TERMS = 3
 
@@ -255,6 +260,7 @@ def distortion_grid(
     reference_point: str = "axial",
     wavelength: float | str | None = None,
     clip: bool = True,
+    allow_large: bool = False,
 ) -> DistortionGrid:
     """The 2-D distortion field of ``lens`` on a grid of fields, in one or more image planes.
 
@@ -270,10 +276,11 @@ def distortion_grid(
     grid : int or (nx, ny), optional
         With no fields and no sensor: an nx × ny grid (default 21 × 21) equally spaced in
         tan α (or object coordinate) whose corners lie at the lens's field (a square inscribed in
-        the field circle).
+        the field circle). Whole numbers of at least 2.
     sensor : Sensor, str or (w, h), optional
         Fill a sensor: the grid of fields whose ideal images span it corner to corner (module
-        docstring); ``grid`` sets the number of points (default 21 × 21).
+        docstring); ``grid`` sets the number of points (default 21 × 21). Width and height are
+        positive, finite mm.
     plane, s_prime, from_last_vertex, defocus
         The image plane(s) (docs/design.md, "Vocabulary"); default the Gaussian plane. All planes
         come from one trace.
@@ -285,6 +292,9 @@ def distortion_grid(
         nm; default the lens's reference wavelength.
     clip : bool
         Apply the lens's semi-diameters to the chief rays.
+    allow_large : bool
+        Allow more than ``MAX_GRID_FIELDS`` fields (the command line's ``--allow-large``); a
+        larger grid is refused before anything is allocated.
 
     Returns
     -------
@@ -297,18 +307,24 @@ def distortion_grid(
         raise TraceError(
             f"reference_point={reference_point!r}; use one of {', '.join(REFERENCE_POINTS)}"
         )
-    # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
-    # centred lens (raytrace.paraxial refuses a lens that is not centred)
-    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength, nominal=True)
+    nx, ny = _grid_size(grid)
+    s = sensor_size(sensor) if sensor is not None else None
     given = requested_fields_2d(fields_x_deg, fields_y_deg, object_x_mm, object_y_mm)
     if given is not None and sensor is not None:
         raise TraceError("give fields or a sensor, not both")
-    nx, ny = _grid_size(grid)
     if given is not None:
         kind, ax, ay = given
-        FX, FY = np.meshgrid(np.atleast_1d(ax).ravel(), np.atleast_1d(ay).ravel())
+        ax, ay = np.atleast_1d(ax).ravel(), np.atleast_1d(ay).ravel()
+        _check_count(ax.size, ay.size, allow_large, "the fields")
     else:
-        FX, FY, kind = _default_fields(lens, par, nx, ny, sensor)
+        _check_count(nx, ny, allow_large, f"grid={grid!r}" if grid is not None else "the grid")
+    # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
+    # centred lens (raytrace.paraxial refuses a lens that is not centred)
+    par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength, nominal=True)
+    if given is not None:
+        FX, FY = np.meshgrid(ax, ay)
+    else:
+        FX, FY, kind = _default_fields(lens, par, nx, ny, s)
     return grid_from_fields(
         lens,
         FX,
@@ -321,40 +337,73 @@ def distortion_grid(
         defocus=defocus,
         reference_point=reference_point,
         clip=clip,
-        sensor=_sensor(sensor) if sensor is not None else None,
+        sensor=s,
     )
 
 
+def _is_whole(v) -> bool:
+    return isinstance(v, int | np.integer) and not isinstance(v, bool | np.bool_)
+
+
 def _grid_size(grid) -> tuple[int, int]:
+    """(nx, ny) of ``grid`` (n or (nx, ny), whole numbers >= 2); DataError naming the fix."""
     if grid is None:
         return DEFAULT_GRID
-    if isinstance(grid, int | np.integer):
-        vals = (int(grid), int(grid))
+    fix = "give n or (nx, ny) as whole numbers of points, at least 2 each, e.g. grid=(21, 21)"
+    if _is_whole(grid):
+        vals = (grid, grid)
+    elif isinstance(grid, str | bytes) or not hasattr(grid, "__len__"):
+        raise DataError(f"grid={grid!r}: {fix}")
     else:
-        vals = tuple(int(v) for v in grid)
-        if len(vals) != 2:
-            raise TraceError(f"grid={grid!r}: give n or (nx, ny)")
+        vals = tuple(grid)
+        if len(vals) != 2 or not all(_is_whole(v) for v in vals):
+            raise DataError(f"grid={grid!r}: {fix}")
     if min(vals) < 2:
-        raise TraceError(f"grid={grid!r}: at least 2 points along each axis")
-    return vals
+        raise DataError(f"grid={grid!r}: at least 2 points along each axis, e.g. grid=(21, 21)")
+    return int(vals[0]), int(vals[1])
 
 
-def _sensor(sensor):
-    """A Sensor, or (width, height) mm parsed from a size."""
+def _check_count(nx: int, ny: int, allow_large: bool, what: str) -> None:
+    """Refuse more than ``MAX_GRID_FIELDS`` fields without ``allow_large``, before any work."""
+    n = int(nx) * int(ny)
+    if n > MAX_GRID_FIELDS and not allow_large:
+        raise DataError(
+            f"{what}: {n} fields, more than {MAX_GRID_FIELDS} (about {n * 400 / 1e9:.3g} GB per "
+            "image plane and a long run); give allow_large=True to run it anyway"
+        )
+
+
+def sensor_size(sensor):
+    """The sensor of a grid or certificate, checked where it enters: a
+    :class:`~distortion.camera.Sensor` as it is, or (width, height) in mm from a size "36x24" or
+    (36, 24). DataError, naming the sensor, for a width or height that is not a positive finite
+    number of mm (a negative width would mirror the grid; a zero one make no grid)."""
     from ..camera.sensor import Sensor, parse_size_mm
 
     if isinstance(sensor, Sensor):
         return sensor
-    return parse_size_mm(sensor)
+    if isinstance(sensor, bool | np.bool_) or not (
+        isinstance(sensor, str) or hasattr(sensor, "__len__")
+    ):
+        raise DataError(f"sensor={sensor!r}: give a Sensor, a size 'WxH' in mm or (w, h) in mm")
+    try:
+        return parse_size_mm(sensor)  # refuses a width or height that is not positive
+    except (TypeError, ValueError) as e:
+        if isinstance(e, DataError):
+            raise
+        raise DataError(
+            f"sensor={sensor!r}: give a Sensor, a size 'WxH' in mm or (w, h) in mm"
+        ) from None
 
 
 def _default_fields(lens, par, nx, ny, sensor):
-    """(FX, FY, kind) of the default grid: the lens's field square, or a sensor's fill."""
+    """(FX, FY, kind) of the default grid: the lens's field square, or a sensor's fill
+    (``sensor`` checked by :func:`sensor_size`)."""
     finite = not par.infinite
     if sensor is not None:
         from ..camera.sensor import Sensor
 
-        s = _sensor(sensor)
+        s = sensor
         if isinstance(s, Sensor):
             w, h = s.width_mm, s.height_mm
             dx, dy = s.principal_point_offset_mm
@@ -443,11 +492,7 @@ def grid_from_fields(
     t = np.stack([tx.ravel(), ty.ravel()], axis=1)
     ppbs_xy = np.full((z.size, 2), np.nan)
     for i in range(z.size):
-        img = P[i].reshape(-1, 2)
-        nok = int(np.count_nonzero(np.all(np.isfinite(img), axis=1)))
-        if nok >= PPBS_RADIAL_TERMS + 3:
-            fit = solve_linear(t, img, radial_terms=PPBS_RADIAL_TERMS, asymmetric=False)
-            ppbs_xy[i] = fit.values["x0"], fit.values["y0"]
+        ppbs_xy[i] = _ppbs(t, P[i].reshape(-1, 2))
     ref = {"axial": axial_xy, "ppa": ppa_xy, "ppbs": ppbs_xy}[reference_point]
     XY = np.stack([X, Y], axis=-1)
     extra = (1,) * X.ndim
@@ -481,6 +526,21 @@ def grid_from_fields(
         wavelength=float(wl),
         sensor=sensor,
     )
+
+
+def _ppbs(t: np.ndarray, img: np.ndarray) -> tuple[float, float]:
+    """The PPBS (module docstring) of the points ``img`` (N, 2) at ``t``: the principal point of
+    the radial fit with ``PPBS_RADIAL_TERMS`` terms, or as many as the distinct field radii of
+    the traced points determine (c takes one); NaN where the points do not determine it."""
+    ok = np.all(np.isfinite(img), axis=1) & np.all(np.isfinite(t), axis=1)
+    terms = min(PPBS_RADIAL_TERMS, distinct_radii(t[ok]) - 1)
+    if terms < 0:
+        return math.nan, math.nan
+    try:
+        fit = solve_linear(t, img, radial_terms=terms, asymmetric=False)
+    except (UndeterminedFit, DataError):
+        return math.nan, math.nan
+    return fit.values["x0"], fit.values["y0"]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -545,6 +605,7 @@ def radial_by_azimuth(
     reference_point: str = "axial",
     wavelength: float | str | None = None,
     clip: bool = True,
+    allow_large: bool = False,
 ) -> RadialByAzimuth:
     """Radial and tangential distortion along rays of azimuth φ from the reference point: the
     fields whose ideal image points lie at azimuth φ, (tan αx, tan αy) = tan θ (cos φ, sin φ)
@@ -562,8 +623,8 @@ def radial_by_azimuth(
     object_radii_mm : array_like, optional
         Object radii (mm, finite object) instead.
     plane, s_prime, from_last_vertex, defocus, object_distance, object_s, object_scale,
-    reference_point, wavelength, clip
-        As :func:`distortion_grid`.
+    reference_point, wavelength, clip, allow_large
+        As :func:`distortion_grid` (the limit is on azimuths × fields).
 
     Returns
     -------
@@ -582,6 +643,7 @@ def radial_by_azimuth(
     if np.any(r < 0):
         raise TraceError("radial fields are total field angles or radii: give values >= 0")
     az = np.atleast_1d(np.asarray(azimuths_deg, dtype=float)).ravel()
+    _check_count(az.size, r.size, allow_large, "azimuths x fields")
     phi = np.radians(az)[:, None]
     if kind == "angle":
         T = np.tan(np.radians(r))[None, :]

@@ -319,10 +319,10 @@ def add_field_args(p: argparse.ArgumentParser) -> None:
     )
 
 
-#: Work limits of one command (fields, radii, rays). Beyond them a command refuses before
-#: allocating anything and names the flag that lifts the limit (--allow-large).
-MAX_FIELDS = 100_000
-MAX_SAMPLES = 1_000_000
+#: Work limits of one command (fields, radii, rays; raytrace.limits, shared with the API).
+#: Beyond them a command refuses before allocating anything and names the flag that lifts the
+#: limit (--allow-large).
+from raytrace.limits import MAX_FIELDS, MAX_SAMPLES  # noqa: E402, F401
 
 
 def check_size(value: int, limit: int, what: str, args, per_item_bytes: int = 200) -> int:

@@ -396,13 +396,13 @@ def _grid(args, lens) -> int:
         plane=planes,
         reference_point=args.reference_point,
         wavelength=args.wavelength,
+        allow_large=getattr(args, "allow_large", False),
         **kw,
     )
     decs, fits = [], []
-    for p in range(g.n_planes):
-        if np.count_nonzero(g.ok) >= 8:
-            decs.append(decompose_distortion(g, p))
-            fits.append(fit_brown_conrady(g, p))
+    for p in range(g.n_planes):  # a fit the grid cannot determine says why (not_determined)
+        decs.append(decompose_distortion(g, p))
+        fits.append(fit_brown_conrady(g, p))
     metrics = _sensor_metrics(args, g)
     print_result(
         args,

@@ -71,6 +71,17 @@ def _dense(d: dict):
     return f, arr(dn["radial_um"]), arr(dn["mean_radial_um"]), arr(dn["decentering_profile_um"])
 
 
+#: room beyond the format's edge on the field axis (fraction of it), so that the tabulated
+#: points at the edge are drawn whole, not cut by the axes' border
+FIELD_MARGIN = 0.04
+
+
+def _field_xlim(ax, f: np.ndarray) -> None:
+    """The field axis from 0 to the format's edge, with ``FIELD_MARGIN`` beyond the edge."""
+    edge = max(float(f[-1]), 1e-9)
+    ax.set_xlim(0.0, edge * (1.0 + FIELD_MARGIN))
+
+
 def _style(ax, xlabel: str | None, ylabel: str | None, fontsize: float = 7.0) -> None:
     ax.grid(True, **GRID)
     ax.axhline(0.0, **ZERO)
@@ -94,7 +105,7 @@ def plot_certificate_radial(cert, index: int, *, ax=None, title: str | None = No
     tf = np.asarray(d["fields_deg"], dtype=float)
     tv = np.array([np.nan if v is None else v for v in sd["radial_um"]], dtype=float)
     ax.plot(tf, tv, "o", ms=3, color=COLOURS[index % 4])
-    ax.set_xlim(0.0, max(float(f[-1]), 1e-9))
+    _field_xlim(ax, f)
     _style(ax, "field angle \u03b8 (\u00b0)", "radial distortion (\u00b5m)")
     ax.set_title(
         title or f"semi-diagonal {sd['label']} (azimuth {sd['azimuth_deg']:.2f} deg)", fontsize=8
@@ -111,7 +122,7 @@ def plot_certificate_decentering(cert, *, ax=None, title: str | None = None):
     tf = np.asarray(d["fields_deg"], dtype=float)
     tv = np.array([np.nan if v is None else v for v in d["decentering"]["profile_um"]], dtype=float)
     ax.plot(tf, tv, "o", ms=3, color="C4")
-    ax.set_xlim(0.0, max(float(f[-1]), 1e-9))
+    _field_xlim(ax, f)
     top = float(np.nanmax(np.abs(prof))) if np.isfinite(prof).any() else 0.0
     if top < 1e-3:  # a centred design: keep the axis readable around zero
         ax.set_ylim(-1.0, 1.0)
@@ -358,7 +369,7 @@ def plot_certificate_all(cert, *, ax=None, title: str | None = None):
     for i, sd in enumerate(d["semi_diagonals"]):
         ax.plot(f, rad[i], color=COLOURS[i % 4], lw=1.0, label=sd["label"])
     ax.plot(f, mean, color="black", lw=1.0, ls="--", label="mean")
-    ax.set_xlim(0.0, max(float(f[-1]), 1e-9))
+    _field_xlim(ax, f)
     _style(ax, "field angle \u03b8 (\u00b0)", "dr (\u00b5m)")
     ax.legend(fontsize=5.5, frameon=False, ncol=2, loc="best")
     ax.set_title(title or "all semi-diagonals and their mean", fontsize=8)

@@ -128,6 +128,11 @@ def plot_distortion_vectors(
             raise DataError(f"component={component!r} needs decomposition= (decompose_distortion)")
         if decomposition.plane != p:
             raise DataError(f"the decomposition is of plane {decomposition.plane}, not plane {p}")
+        if not decomposition.determined:
+            raise DataError(
+                f"the decomposition is not determined ({decomposition.not_determined}): it has "
+                "no parts to draw"
+            )
         vec = decomposition.components[component]
         what = f"{component.replace('_', ' ')} part"
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE_SQUARE)
@@ -159,7 +164,9 @@ def arrow_field(ax, pos, vec, color, key_label, span: float | None = None):
     """Arrows ``vec`` at the points ``pos`` (both (N, 2), in the axes' data units; rows with a
     NaN are dropped), scaled so that the longest spans about 1.5 steps of a square grid of
     width ``span`` (default: the x extent of ``pos``), with a 1-2-5 key (:func:`key_length`)
-    labelled ``key_label(key)``.
+    labelled ``key_label(key)``. The arrow tips count in the axes' data limits, so that no
+    arrow leaves the axes (limits set afterwards take over); the key sits above the axes at
+    their left, its tail at 0.16 of the axes' width (label to its left), pointing right.
 
     Returns
     -------
@@ -181,8 +188,18 @@ def arrow_field(ax, pos, vec, color, key_label, span: float | None = None):
             pos[:, 0], pos[:, 1], vec[:, 0], vec[:, 1], angles="xy", scale_units="xy",
             scale=scale, color=color, width=0.004, zorder=2,
         )  # fmt: skip
+        # quiver does not count its arrows in the data limits: add the tips (and a margin of
+        # a quarter of the longest arrow for the heads), then let autoscaling apply
+        tips = pos + vec / scale
+        pad = 0.25 * vmax / scale
+        lo = np.minimum(pos, tips).min(axis=0) - pad
+        hi = np.maximum(pos, tips).max(axis=0) + pad
+        ax.update_datalim(np.vstack([lo, hi]))
+        ax.autoscale_view()
         key = key_length(vmax)
-        ax.quiverkey(q, 0.97, 1.015, key, key_label(key), labelpos="W", coordinates="axes")
+        # labelpos "W": the arrow's tail at X, pointing right (at most ~0.6 of the axes: the
+        # key is <= 0.75 of the longest arrow, itself <= 0.75 of the width), its label left
+        ax.quiverkey(q, 0.16, 1.02, key, key_label(key), labelpos="W", coordinates="axes")
     return pos, vmax
 
 

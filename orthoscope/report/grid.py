@@ -103,6 +103,12 @@ def format_grid(
         for d in decompositions:
             if d.plane != p:
                 continue
+            if not d.determined:
+                lines.append(
+                    f"  Decomposition (principal point {d.principal_point}, camera constant "
+                    f"{d.camera_constant}): not determined - {d.not_determined}"
+                )
+                continue
             lines.append(
                 f"  Decomposition (distortion form; principal point {d.principal_point}, camera "
                 f"constant {d.camera_constant}): residual RMS {_g(d.rms_mm * 1000, 4)} um, max "
@@ -120,6 +126,11 @@ def format_grid(
             lines += _corr_lines(d.free, d.correlation)
         for b in brown:
             if b.plane != p:
+                continue
+            if not b.determined:
+                lines.append(
+                    f"  Brown-Conrady, Fraser 1997 model: not determined - {b.not_determined}"
+                )
                 continue
             lines.append(
                 f"  Brown-Conrady, Fraser 1997 {len(b.free)}-parameter model (Australis: a "
@@ -150,8 +161,12 @@ def _named(grid: DistortionGrid) -> dict:
 
 
 def decomposition_to_dict(d: GridDecomposition) -> dict:
+    """JSON-ready dict; ``determined`` false (with ``not_determined``, the reason) when the grid
+    does not determine the decomposition: its values are then null."""
     return {
         "plane": d.plane,
+        "determined": d.determined,
+        "not_determined": d.not_determined or None,
         "principal_point": d.principal_point,
         "camera_constant": d.camera_constant,
         "values": dict(d.values),
@@ -169,8 +184,12 @@ def decomposition_to_dict(d: GridDecomposition) -> dict:
 
 
 def brown_to_dict(b: BrownConradyFit) -> dict:
+    """JSON-ready dict; ``determined`` false (with ``not_determined``, the reason) when the
+    points do not determine the model: its values are then null and there is no OpenCV refit."""
     out = {
         "plane": b.plane,
+        "determined": b.determined,
+        "not_determined": b.not_determined or None,
         "model": "australis (Fraser 1997, correction at the measured radius)",
         "values": dict(b.values),
         "std_errors": dict(b.std_errors),

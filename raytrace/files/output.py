@@ -53,6 +53,9 @@ def check_output(
         raise OutputError(f"{p}: the file exists; give {flag} to replace it")
     parent = p.resolve().parent
     if not parent.is_dir():
+        blocker = next((a for a in (parent, *parent.parents) if a.exists()), None)
+        if blocker is not None and not blocker.is_dir():
+            raise OutputError(f"{p}: {blocker} is a file, not a folder")
         raise OutputError(f"{p}: the folder {parent} does not exist")
     if not os.access(parent, os.W_OK):
         raise OutputError(f"{p}: the folder {parent} is not writable")
