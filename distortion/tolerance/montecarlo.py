@@ -26,8 +26,10 @@ import io
 import json
 import math
 import time
+import warnings
+import zipfile
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +38,7 @@ from raytrace.errors import OutputError
 from raytrace.executors import dask_client
 from raytrace.files.output import write_atomic
 from raytrace.lens import Lens
+from raytrace.limits import MAX_INSTANCES as _MAX_INSTANCES
 from raytrace.tolerance import (
     GENERATOR,
     ToleranceSpec,
@@ -44,7 +47,10 @@ from raytrace.tolerance import (
     pack_instances,
 )
 
+from .checks import ToleranceInputError as ToleranceInputError
+from .checks import check_yield_limit, split_where, warn_units, where_of, whole
 from .outputs import (
+    CURVES,
     DEFAULT_AZIMUTHS,
     DEFAULT_RINGS,
     SCALARS,
@@ -69,6 +75,26 @@ DEFAULT_CHUNK = 256
 #: ``summary="auto"`` gathers the instances (exact summary) up to this many, streams above
 EXACT_MAX_INSTANCES = 100_000
 SUMMARY_METHODS = ("auto", "exact", "streaming")
+#: instances of one run without ``allow_large=True``: :data:`raytrace.limits.MAX_INSTANCES`,
+#: the command line's limit (lifted there by --allow-large)
+MAX_INSTANCES = _MAX_INSTANCES
+#: bytes per instance of an exact summary's gathered outputs (F = 50 fields; docs/tolerance.md)
+BYTES_PER_INSTANCE = 1200
+#: a run where more than this fraction of the instances cannot be traced warns
+FAIL_WARN_FRACTION = 0.10
+#: the manifest keys, in words (a folder that holds another run says which differ)
+_MANIFEST_WORDS = {
+    "format": "file format",
+    "lens": "lens name",
+    "lens_hash": "lens (surfaces, glasses or wavelength)",
+    "spec_hash": "tolerance spec (its items, compensator or test wavelength)",
+    "settings_hash": "settings (fields, object distance, wavelength, fit grid or g)",
+    "seed": "seed",
+    "n": "number of instances",
+    "chunk_size": "chunk size",
+    "generator": "random generator",
+    "compensator": "compensator",
+}
 
 
 # ------------------------------------------------------------------------------ one chunk
@@ -103,7 +129,15 @@ def lens_hash(lens: Lens, spec: ToleranceSpec, wavelength: float) -> str:
 
 
 def spec_hash(spec: ToleranceSpec) -> str:
-    """Hash of what a spec changes (items in order, compensator, test wavelength)."""
+    """Hash of what a spec changes (items in order, compensator, test wavelength): its content,
+    not where it was read from (a copy of the spec at another path has the same hash)."""
+    items = tuple(replace(it, where="") for it in spec.items)
+    return _hash(items, spec.compensator, spec.test_wavelength)
+
+
+def legacy_spec_hash(spec: ToleranceSpec) -> str:
+    """The spec hash of runs written before :func:`spec_hash` left out the items' ``where``
+    (the spec file's path): such a run resumes when the spec is read from the same path."""
     return _hash(spec.items, spec.compensator, spec.test_wavelength)
 
 
@@ -120,10 +154,11 @@ def _settings_hash(setup: ToleranceSetup) -> str:
 class _Store:
     """Chunk files and the manifest in ``out_dir`` (module docstring)."""
 
-    def __init__(self, out_dir, manifest: dict, resume: bool, overwrite: bool):
+    def __init__(self, out_dir, manifest: dict, resume: bool, overwrite: bool,
+                 legacy_spec_hash: str | None = None):  # fmt: skip
         self.dir = Path(out_dir)
         if self.dir.exists() and not self.dir.is_dir():
-            raise OutputError(f"{self.dir}: exists and is not a folder; choose another -o")
+            raise OutputError(f"{self.dir}: exists and is not a folder; give another out_dir")
         self.dir.mkdir(parents=True, exist_ok=True)
         self.mpath = self.dir / "manifest.json"
         self.manifest = manifest
@@ -131,27 +166,49 @@ class _Store:
         if self.mpath.exists():
             try:
                 old = json.loads(self.mpath.read_text())
-            except (OSError, ValueError) as e:
-                raise OutputError(f"{self.mpath}: unreadable manifest ({e}); use a new folder "
-                                  "or overwrite=True (--force)") from None  # fmt: skip
-            same = all(old.get(k) == manifest[k] for k in manifest if k != "done")
-            if not same and not overwrite:
-                diff = [k for k in manifest if k != "done" and old.get(k) != manifest[k]]
-                raise OutputError(
-                    f"{self.dir}: holds another run (different {', '.join(diff)}); use a new "
-                    "folder or overwrite=True (--force) to replace it"
-                )
-            if same and resume:
-                self.done = {int(k) for k in old.get("done", []) if self.path(int(k)).exists()}
-            elif not same or not resume:
-                if not overwrite and old.get("done"):
+                if not isinstance(old, dict):
+                    raise ValueError("not a JSON object")
+                done = [int(k) for k in old.get("done", [])]
+            except (OSError, ValueError, TypeError) as e:
+                if not overwrite:
                     raise OutputError(
-                        f"{self.dir}: holds a run; pass resume=True to continue it or "
-                        "overwrite=True (--force) to start again"
+                        f"{self.mpath}: unreadable run manifest ({e}); give a new out_dir, or "
+                        "overwrite=True to replace the run there"
+                    ) from None
+                old, done = {}, []
+            if legacy_spec_hash is not None and old.get("spec_hash") == legacy_spec_hash:
+                old["spec_hash"] = manifest["spec_hash"]  # same spec, hashed with its path
+            diff = [k for k in manifest if k != "done" and old.get(k) != manifest[k]]
+            if diff and not overwrite:
+                what = _differences(diff, old, manifest)
+                raise OutputError(
+                    f"{self.dir}: holds another run (a different {what}); give a new out_dir, "
+                    "or overwrite=True to replace it"
+                )
+            if not diff and resume:
+                self.done = {k for k in done if self.path(k).exists()}
+            else:
+                if not overwrite and done:
+                    raise OutputError(
+                        f"{self.dir}: holds this run already; pass resume=True to continue it or "
+                        "overwrite=True to start again"
                     )
-                for f in self.dir.glob("chunk-*.npz"):
-                    f.unlink()
+                self._remove_chunks()
+        else:
+            others = sorted(p.name for p in self.dir.iterdir())
+            if others and not overwrite:
+                shown = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
+                raise OutputError(
+                    f"{self.dir}: is not empty ({shown}) and holds no run (no manifest.json); "
+                    "give a new or empty out_dir, or overwrite=True to use it anyway (its chunk "
+                    "files are replaced)"
+                )
+            self._remove_chunks()
         self._write_manifest()
+
+    def _remove_chunks(self) -> None:
+        for f in self.dir.glob("chunk-*.npz"):
+            f.unlink()
 
     def path(self, k: int) -> Path:
         return self.dir / f"chunk-{k:05d}.npz"
@@ -168,9 +225,39 @@ class _Store:
         self.done.add(k)
         self._write_manifest()
 
-    def load(self, k: int) -> dict:
-        with np.load(self.path(k)) as z:
-            return {key: z[key] for key in z.files}
+    def load(self, k: int, count: int, n_fields: int) -> dict:
+        """Chunk ``k``'s arrays, checked: ``count`` instances, ``n_fields`` curve fields; a file
+        that cannot be read as that is damaged (OutputError, one line)."""
+        p = self.path(k)
+        fix = "delete it and run again: the run recomputes it"
+        try:
+            with np.load(p) as z:
+                d = {key: z[key] for key in z.files}
+        except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as e:
+            raise OutputError(f"{p}: damaged chunk file ({type(e).__name__}); {fix}") from None
+        need = ("values", "ok", "efl", "D_um", "D_cal_um", "K")
+        missing = [key for key in need if key not in d]
+        if missing:
+            raise OutputError(f"{p}: damaged chunk file (no {', '.join(missing)}); {fix}")
+        for key, v in d.items():
+            bad_curve = key in CURVES and (v.ndim != 2 or v.shape[1] != n_fields)
+            if v.ndim == 0 or v.shape[0] != count or bad_curve:
+                raise OutputError(
+                    f"{p}: damaged chunk file ({key} has shape {v.shape}, this run's chunk "
+                    f"holds {count} instances of {n_fields} fields); {fix}"
+                )
+        return d
+
+
+def _differences(keys: list, old: dict, new: dict) -> str:
+    """The manifest keys that differ, in words, with the values of the small ones."""
+    out = []
+    for k in keys:
+        w = _MANIFEST_WORDS.get(k, k)
+        if k in ("seed", "n", "chunk_size", "compensator", "lens") and k in old:
+            w += f": {old[k]} there, {new[k]} here"
+        out.append(w)
+    return "; ".join(out)
 
 
 # ------------------------------------------------------------------------------ the result
@@ -240,7 +327,16 @@ class MonteCarloResult:
         """Fraction of all instances with |D| < ``limit_um`` at ``field_deg`` (each instance's
         curve interpolated linearly; failed instances count as out of limit). ``calibrated``:
         D_cal_um instead of the raw D_um. A streamed run answers the limits it counted
-        (``limits=`` of :func:`monte_carlo`) and raises ValueError for any other."""
+        (``limits=`` of :func:`monte_carlo`) and raises ValueError for any other. A limit ≤ 0 or a
+        negative field raises :class:`ToleranceInputError` (a ValueError); a limit below 0.1 µm
+        warns that it looks like millimetres (once, with ``limits=``, when the run starts)."""
+        counted = (
+            (float(limit_um), float(field_deg)) in self.limits
+            if _is_real(limit_um, field_deg)
+            else False
+        )
+        limit_um, field_deg = check_yield_limit(limit_um, field_deg, "yield_fraction limit",
+                                                warn=not counted)  # fmt: skip
         j, w = interpolation_weights(self.fields_deg, field_deg)
         if self.outputs is None:
             key = (float(limit_um), float(field_deg))
@@ -362,6 +458,13 @@ class MonteCarloResult:
         )
 
 
+def _is_real(*v) -> bool:
+    try:
+        return all(math.isfinite(float(x)) for x in v)
+    except (TypeError, ValueError):
+        return False
+
+
 def _stats(v: np.ndarray) -> dict:
     v = v[np.isfinite(v)]
     if v.size == 0:
@@ -409,13 +512,15 @@ def monte_carlo(
     summary_block: int = SUMMARY_BLOCK,
     summary_bins: int = SUMMARY_BINS,
     setup: ToleranceSetup | None = None,
+    allow_large: bool = False,
 ) -> MonteCarloResult:
     """Monte Carlo of ``n`` instances of ``lens`` under ``spec`` (module docstring).
 
     Parameters
     ----------
     n, seed, chunk_size : int
-        Default: the spec's ``[monte_carlo]`` samples / seed / chunk, else 1000 / 0 / 256.
+        Default: the spec's ``[monte_carlo]`` samples / seed / chunk, else 1000 / 0 / 256. Whole
+        numbers (an int, not a float or a bool): n, chunk_size ≥ 1, seed ≥ 0.
     fields_deg : array, degrees
         Curve fields along +y (default 50 from 0 to the lens's max field).
     object_distance : float, mm (positive magnitude; inf), default the lens's.
@@ -439,7 +544,8 @@ def monte_carlo(
         by its compensator; :mod:`distortion.tolerance.gfactor`); None takes the spec's
         ``[outputs] g_object_distance``; without either, g is not computed (NaN).
     limits : ((limit µm, field deg), ...)
-        Yields counted during the run (a streamed run can answer only these).
+        Yields counted during the run (a streamed run can answer only these); a limit > 0 µm
+        (below 0.1 µm it warns: it looks like millimetres), a field ≥ 0.
     summary : "auto" | "exact" | "streaming"
         ``"exact"`` gathers every instance (``outputs``) and takes exact statistics;
         ``"streaming"`` summarises chunk by chunk and never holds all instances
@@ -449,17 +555,26 @@ def monte_carlo(
         choice depends on n only, never on the chunking.
     summary_block, summary_bins : the streamed summary's block of instances and histogram bins.
     setup : a :class:`ToleranceSetup` to reuse (then the field / object / fit arguments are its).
+    allow_large : bool
+        Run more than :data:`MAX_INSTANCES` instances (the command line's ``--allow-large``).
 
-    A ``KeyboardInterrupt`` propagates after the finished chunks are on disk.
+    A ``KeyboardInterrupt`` propagates after the finished chunks are on disk. Warns
+    (RuntimeWarning, one line) when more than :data:`FAIL_WARN_FRACTION` of the instances
+    cannot be traced (they count as out of every yield limit), naming the items that lie
+    furthest out in them; and (:class:`UnitWarning`) for item limits that look like another
+    unit (:func:`distortion.tolerance.checks.unit_hint`).
     """
     t_start = time.perf_counter()
     mc = spec.monte_carlo
-    n = int(mc.get("samples", 1000) if n is None else n)
-    seed = int(mc.get("seed", 0) if seed is None else seed)
-    cs = int(mc.get("chunk", DEFAULT_CHUNK) if chunk_size is None else chunk_size)
-    if n < 1 or cs < 1 or seed < 0:
-        raise ToleranceSpecError(
-            f"samples {n}, chunk {cs}, seed {seed}: give samples and chunk ≥ 1 and a seed ≥ 0"
+    n = whole(mc.get("samples", 1000) if n is None else n, "n (instances)", 1)
+    seed = whole(mc.get("seed", 0) if seed is None else seed, "seed", 0)
+    cs = whole(mc.get("chunk", DEFAULT_CHUNK) if chunk_size is None else chunk_size,
+               "chunk_size", 1)  # fmt: skip
+    if n > MAX_INSTANCES and not allow_large:
+        raise ToleranceInputError(
+            f"n {n}: more than {MAX_INSTANCES} instances (a long run, and about "
+            f"{n * BYTES_PER_INSTANCE / 1e9:.3g} GB in memory unless the summary is streamed); "
+            "pass allow_large=True to run it anyway"
         )
     if summary not in SUMMARY_METHODS:
         raise ToleranceSpecError(f"summary {summary!r}: use one of {', '.join(SUMMARY_METHODS)}")
@@ -468,9 +583,10 @@ def monte_carlo(
                           wavelength=wavelength, grid_rings=grid_rings,
                           grid_azimuths=grid_azimuths, radial_terms=radial_terms,
                           g_object_distance=g_object_distance)  # fmt: skip
-    lims = tuple((float(a), float(b)) for a, b in limits)
+    lims = tuple(check_yield_limit(a, b, "limits") for a, b in limits)
     for _, deg in lims:
         interpolation_weights(st.fields_deg, deg)  # ValueError now, not after the run
+    warn_units(spec)
     lh = lens_hash(lens, spec, st.wavelength)
     sh = spec_hash(spec)
     chunks = [(k, k * cs, min(n, (k + 1) * cs)) for k in range(math.ceil(n / cs))]
@@ -486,15 +602,24 @@ def monte_carlo(
                     "settings_hash": _settings_hash(st), "seed": seed, "n": n,
                     "chunk_size": cs, "generator": GENERATOR,
                     "compensator": spec.compensator.type}  # fmt: skip
-        store = _Store(out_dir, manifest, resume, overwrite)
+        store = _Store(out_dir, manifest, resume, overwrite, legacy_spec_hash(spec))
         on_disk = set(store.done)
     resumed = len(on_disk)
     done_count = sum(b - a for k, a, b in chunks if k in on_disk)
     if progress is not None and done_count:
         progress(done_count, n)
 
+    half = np.array([max(abs(it.min), abs(it.max)) for it in spec.items])
+    failed = {"n": 0, "bad": np.zeros(spec.n_items), "good": np.zeros(spec.n_items)}
+
     def feed(k: int, a: int, d: dict) -> None:
         """A chunk's arrays into the summary (streaming) or the gathered results (exact)."""
+        bad = ~np.asarray(d["ok"], dtype=bool)
+        if bad.any():  # how far out each item lies in the failed instances, and in the others
+            r = np.abs(np.asarray(d["values"], dtype=float)) / half
+            failed["n"] += int(np.count_nonzero(bad))
+            failed["bad"] += r[bad].sum(axis=0)
+            failed["good"] += r[~bad].sum(axis=0)
         if acc is not None:
             acc.add(a, d)
         else:
@@ -517,7 +642,7 @@ def monte_carlo(
     if executor is None:
         for k, a, b in first + rest:
             if k in on_disk:
-                feed(k, a, store.load(k))
+                feed(k, a, store.load(k, b - a, st.n_curve))
             else:
                 finish(k, a, b, run_chunk(st, seed, a, b, parallel=True))
     else:
@@ -530,15 +655,16 @@ def monte_carlo(
             # release of that key then deleted the second run's data ("lost dependencies")
             shared = client.scatter(st, broadcast=True, hash=False) if client is not None else None
             for group in (first, rest):
-                for k, a, _ in group:
+                for k, a, b in group:
                     if k in on_disk:
-                        feed(k, a, store.load(k))
+                        feed(k, a, store.load(k, b - a, st.n_curve))
                 todo = [c for c in group if c[0] not in on_disk]
                 if todo:
                     _run_dask(client, shared, seed, todo, finish)
         finally:
             if close is not None:
                 close()
+    _warn_failed(spec, failed, n, half)
     nom = evaluate(st, np.zeros((1, spec.n_items)), parallel=False)
     q = np.asarray(percentiles, dtype=float)
     has_g = st.g is not None
@@ -597,6 +723,31 @@ def monte_carlo(
         write_atomic(store.dir / "summary.json", json.dumps(res.summary(), indent=1) + "\n",
                      overwrite=True)  # fmt: skip
     return res
+
+
+def _warn_failed(spec: ToleranceSpec, failed: dict, n: int, half: np.ndarray) -> None:
+    """One RuntimeWarning when more than :data:`FAIL_WARN_FRACTION` of the ``n`` instances could
+    not be traced: how many, and the items whose draws lie furthest out (in units of their
+    limit) in the failed instances compared with the others."""
+    nf = failed["n"]
+    if nf <= FAIL_WARN_FRACTION * n:
+        return
+    mb = failed["bad"] / nf
+    mg = failed["good"] / max(n - nf, 1)
+    excess = mb - mg if n > nf else mb
+    order = [k for k in np.argsort(-excess, kind="stable") if excess[k] > 0.05][:3]
+    f = split_where(where_of(spec, 0))[0]
+    named = ", ".join(f"{spec.items[k].name} ({split_where(where_of(spec, k))[1]})"
+                      for k in order)  # fmt: skip
+    most = f"; the failed lenses lie furthest out in {named}" if named else ""
+    warnings.warn(
+        f"{nf} of {n} lenses ({100 * nf / n:.1f} %) cannot be traced (chief rays or image plane "
+        f"fail); they count as out of every yield limit and are left out of the statistics"
+        f"{most}; check {'those' if named else 'the'} limits{f' in {f}' if f else ''} (units: "
+        "mm, degrees, fringes)",
+        RuntimeWarning,
+        stacklevel=3,
+    )
 
 
 #: chunks in flight per Dask worker (a sliding window: results are taken and released as they

@@ -49,6 +49,7 @@ from raytrace.tolerance import (
 
 from ..errors import DataError
 from ..grid.decompose import basis_columns
+from .checks import check_spec
 from .compensators import image_planes, pupil_bundle
 from .gfactor import GSetup, instance_g, prepare_g, resolve_g_distance
 
@@ -238,9 +239,15 @@ def prepare(
     that does not fit the lens, TraceError when a nominal chief ray fails, DataError when g
     cannot be defined (:func:`distortion.tolerance.gfactor.prepare_g`)."""
     check_against_lens(spec, lens)
+    check_spec(spec)
     fd = default_fields(lens) if fields_deg is None else np.asarray(fields_deg, dtype=float).ravel()
     if fd.size == 0 or not np.all(np.isfinite(fd)) or np.any(np.abs(fd) >= 90.0):
         raise TraceError("fields_deg must be finite angles strictly between -90 and 90 degrees")
+    if np.any(fd < 0.0):
+        raise TraceError(
+            f"fields_deg {float(np.min(fd)):g}: the curve is traced along +y; give angles >= 0 "
+            "(degrees)"
+        )
     od = float(lens.object_distance if object_distance is None else object_distance)
     wl = float(lens.wavelength if wavelength is None else wavelength)
     rings = tuple(float(r) for r in grid_rings)
@@ -296,6 +303,13 @@ def evaluate(
     """The outputs of the instances ``values`` (I, n_items) (module docstring). ``parallel``:
     numba threads over instances (False: the calling thread, as on a Dask worker); both give
     bit-identical numbers."""
+    # an instance that does not trace is NaN and ok False (the callers report it): numpy's
+    # warnings about its NaN are not for the person
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        return _evaluate(setup, values, parallel)
+
+
+def _evaluate(setup: ToleranceSetup, values, parallel: bool) -> ToleranceOutputs:
     spec = setup.spec
     values = np.atleast_2d(np.asarray(values, dtype=float))
     arr = pack_instances(setup.lens, spec, values, setup.wavelength)

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from raytrace.lens import Lens
-from raytrace.tolerance import ToleranceSpec, one_at_a_time
+from raytrace.tolerance import ToleranceSpec, ToleranceSpecError, one_at_a_time
 
+from .checks import split_where, unit_hint, warn_units, where_of
 from .outputs import CURVES, DEFAULT_AZIMUTHS, DEFAULT_RINGS, ToleranceOutputs, evaluate, prepare
 
 
@@ -99,7 +100,7 @@ class SensitivityResult:
                     max=float(self.max[k]),
                     delta_min=float(d[k, 0]),
                     delta_max=float(d[k, 1]),
-                    worst_abs=float(np.nanmax(np.abs(d[k]))),
+                    worst_abs=_largest_abs(d[k]),
                     share=float(s[k] ** 2 / tot) if tot > 0 else float("nan"),
                 )
             )
@@ -111,6 +112,36 @@ class SensitivityResult:
             f"SensitivityResult({self.lens_name}: {len(self.names)} items, "
             f"{self.fields_deg.size} fields, compensator {self.compensator})"
         )
+
+
+def _largest_abs(v) -> float:
+    """The largest finite |v| (NaN when none is finite; no All-NaN warning)."""
+    a = np.abs(np.asarray(v, dtype=float))
+    a = a[np.isfinite(a)]
+    return float(a.max()) if a.size else float("nan")
+
+
+def _refuse_untraceable(spec: ToleranceSpec, vals: np.ndarray, ok: np.ndarray) -> None:
+    """ToleranceSpecError (one line) naming the first item whose min or max makes the lens
+    untraceable (row 2k at min, 2k + 1 at max), with the unit hint
+    (:func:`.checks.unit_hint`) and the number of other such items."""
+    bad = [k for k in range(spec.n_items) if not (ok[2 * k] and ok[2 * k + 1])]
+    if not bad:
+        return
+    k = bad[0]
+    it = spec.items[k]
+    at = [lab for lab, r in (("min", 2 * k), ("max", 2 * k + 1)) if not ok[r]]
+    vals_s = " and ".join(f"{lab} {vals[2 * k + (lab == 'max'), k]:g}" for lab in at)
+    unit = f" {it.unit}" if it.unit else ""
+    hint = unit_hint(spec, k)
+    more = ""
+    if len(bad) > 1:
+        others = ", ".join(split_where(where_of(spec, j))[1] for j in bad[1:4])
+        more = f"; {others}{', ...' if len(bad) > 4 else ''} fail too"
+    raise ToleranceSpecError(
+        f"{where_of(spec, k)}: {it.name} at its {vals_s}{unit}: the lens cannot be traced "
+        f"(chief rays or image plane fail){more}; {hint or 'give a limit the lens can take'}"
+    )
 
 
 def sensitivity(
@@ -128,7 +159,12 @@ def sensitivity(
     setup=None,
 ) -> SensitivityResult:
     """Each item of ``spec`` alone at its min and at its max (module docstring). Arguments as
-    :func:`distortion.tolerance.monte_carlo`; ``setup`` a :class:`ToleranceSetup` to reuse."""
+    :func:`distortion.tolerance.monte_carlo`; ``setup`` a :class:`ToleranceSetup` to reuse.
+
+    Raises ToleranceSpecError (one line, naming the item) when an item at one of its limits
+    makes the lens untraceable, saying so when the limit looks like another unit
+    (:func:`distortion.tolerance.checks.unit_hint`); warns (:class:`UnitWarning`) for such a
+    limit that still traces."""
     st = setup or prepare(lens, spec, fields_deg=fields_deg, object_distance=object_distance,
                           wavelength=wavelength, grid_rings=grid_rings,
                           grid_azimuths=grid_azimuths, radial_terms=radial_terms,
@@ -136,6 +172,8 @@ def sensitivity(
     vals, _ = one_at_a_time(spec, which)
     nom = evaluate(st, np.zeros((1, spec.n_items)), parallel=False)
     out = evaluate(st, vals, parallel=False)
+    _refuse_untraceable(spec, vals, np.asarray(out.ok, dtype=bool))
+    warn_units(spec)
     return SensitivityResult(
         names=spec.names(),
         units=[it.unit for it in spec.items],

@@ -25,8 +25,19 @@ from .common import (
 #: raytrace.tolerance.COMPENSATORS, spelled here so that building the parser imports no kernels
 #: (tests/test_tolerance_cli.py checks they are equal)
 COMPENSATORS = ("paraxial-refocus", "best-focus", "fixed-sensor")
-#: instances held in memory without --allow-large (outputs ~ 8 bytes x (3 fields + 30) each)
-MAX_INSTANCES = 1_000_000
+#: instances held in memory without --allow-large (outputs ~ 8 bytes x (3 fields + 30) each);
+#: the API's allow_large limit, the same number (raytrace.limits)
+from raytrace.limits import MAX_INSTANCES  # noqa: E402
+
+#: the API's keywords in its messages, as this command says them (orthoscope.cli.CLI_FLAGS
+#: translates only ``key=NUMBER`` and a bare ``key=``)
+_API_WORDS = (
+    ("overwrite=True", "--force"),
+    ("allow_large=True", "--allow-large (before the command)"),
+    ("a new out_dir", "a new -o folder"),
+    ("a new or empty out_dir", "a new or empty -o folder"),
+    ("another out_dir", "another -o folder"),
+)
 _LIMIT = re.compile(r"^\s*([0-9.eE+-]+)\s*(um|µm|μm)?\s*@\s*([0-9.eE+-]+)\s*(deg|°)?\s*$")
 
 
@@ -178,6 +189,11 @@ def cmd_tolerance(args) -> int:
     run_mc = not args.sensitivity or args.samples is not None
     if run_mc:
         _run_size(args, spec)
+    else:  # the Monte Carlo run checks its limits (and says when one looks like mm)
+        from distortion.tolerance.checks import check_yield_limit
+
+        for lim, deg in limits:
+            check_yield_limit(lim, deg, "--limit")
     sens = None
     if args.sensitivity or args.plot is not None:
         from distortion.tolerance import sensitivity
@@ -240,8 +256,16 @@ def _run_size(args, spec) -> tuple[int, int]:
     return n, args.chunk or int(spec.monte_carlo.get("chunk", 256))
 
 
+def command_words(message: str) -> str:
+    """An error of the Monte Carlo API (its folder of chunks) in this command's words."""
+    for api, cli in _API_WORDS:
+        message = message.replace(api, cli)
+    return message
+
+
 def _monte_carlo(args, lens, spec, kw, limits):
     from distortion.tolerance import monte_carlo
+    from raytrace.errors import OutputError
 
     n, chunk = _run_size(args, spec)
     prog = Progress(args.quiet or args.json)
@@ -259,8 +283,11 @@ def _monte_carlo(args, lens, spec, kw, limits):
             progress=prog,
             limits=limits,
             summary=args.summary,
+            allow_large=bool(getattr(args, "allow_large", False)),
             **kw,
         )
+    except OutputError as e:
+        raise OutputError(command_words(str(e))) from None
     except KeyboardInterrupt:
         prog.close()
         kept = (
@@ -380,6 +407,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_output_args(q, csv=False, json_help="Print JSON (keys carry units).")
     q.add_argument("--quiet", action="store_true", help="No progress display.")
     add_force_arg(
-        q, help="Replace an existing plot, and a chunk folder that holds a different run."
+        q,
+        help="Replace an existing plot, and a chunk folder (-o) that holds a different run; use "
+        "a non-empty -o folder that holds no run (its chunk files are replaced).",
     )
     q.set_defaults(func=cmd_tolerance)

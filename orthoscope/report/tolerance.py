@@ -56,9 +56,22 @@ def _cell(v, dec: int = 3, width: int = 10) -> str:
     return f"{float(v):>+{width}.{dec}f}"
 
 
-def _worst(row: dict) -> float:
-    a, b = float(row["delta_min"]), float(row["delta_max"])
-    return a if abs(a) >= abs(b) else b
+def _num(v, dec: int = 3) -> str:
+    """A signed change with ``dec`` decimals ("0.000" for what rounds to zero, "-" for NaN)."""
+    if v is None or not math.isfinite(float(v)):
+        return "-"
+    if round(float(v), dec) == 0.0:
+        return f"{0.0:.{dec}f}"
+    return f"{float(v):+.{dec}f}"
+
+
+def _pair(row: dict | None, fac: float) -> str:
+    """The change at the item's min and at its max, ``"at min/at max"`` (both signs shown: a
+    change that is odd in the item has opposite signs, an even one the same)."""
+    if row is None:
+        return "-/-"
+    a, b = _num(row["delta_min"] * fac), _num(row["delta_max"] * fac)
+    return "0" if a == b == _num(0.0) else f"{a}/{b}"
 
 
 def rank_key(sens) -> tuple[str, float]:
@@ -121,17 +134,17 @@ def _has_g(sens) -> bool:
 def format_sensitivity(sens) -> str:
     """The ranked sensitivity table: each item alone at its limits (compensator applied), the
     change of the distortion at the largest field (calibrated and raw), of Fc, x0, y0, P1, P2
-    (the signed change of larger size of the two limits), and each item's share of the RSS of
-    the calibrated distortion there."""
+    — each cell the signed change with the item at its min, then at its max — and each item's
+    share of the RSS of the calibrated distortion there."""
     key, fmax = rank_key(sens)
     rows = sens.table(key, fmax)
     cols = [
         (name, fmax if at_field else None, lab.format(f=f"{fmax:g}"), fac)
         for name, at_field, lab, fac in SENS_COLUMNS + ((G_COLUMN,) if _has_g(sens) else ())
     ]
-    worst = {
-        name: {r["name"]: _worst(r) for r in sens.table(name, field)} for name, field, _, _ in cols
-    }
+    by_name = {name: {r["name"]: r for r in sens.table(name, field)} for name, field, _, _ in cols}
+    cells = [[_pair(by_name[name].get(r["name"]), fac) for name, _, _, fac in cols] for r in rows]
+    widths = [max([len(lab)] + [len(c[i]) for c in cells]) for i, (_, _, lab, _) in enumerate(cols)]
     nw = max([len("item")] + [len(r["name"]) for r in rows])
     gnote = ""
     if _has_g(sens):
@@ -144,21 +157,19 @@ def format_sensitivity(sens) -> str:
     lines = [
         f"Sensitivity of {sens.lens_name}: each tolerance alone at its min and max, compensator "
         f"{sens.compensator}; ranked by the calibrated distortion D_c at {fmax:g}°{gnote}",
-        f"{'item':<{nw}} {'min':>9} {'max':>9} "
-        + " ".join(f"{lab:>13}" for _, _, lab, _ in cols)
-        + f" {'share':>7}",
+        "each cell: the change with the item at its min / at its max",
+        f"{'item':<{nw}} {'min':>9} {'max':>9}  "
+        + "  ".join(f"{lab:>{w}}" for (_, _, lab, _), w in zip(cols, widths, strict=True))
+        + f"  {'share':>7}",
     ]
     lines.append("-" * len(lines[-1]))
-    for r in rows:
-        cells = [
-            _cell(worst[name].get(r["name"], float("nan")) * fac, 3, 13) for name, _, _, fac in cols
-        ]
+    for r, row_cells in zip(rows, cells, strict=True):
         share = r["share"]
         share_s = f"{100 * share:6.1f}%" if math.isfinite(share) else "      -"
         lines.append(
-            f"{r['name']:<{nw}} {r['min']:>9.3g} {r['max']:>9.3g} "
-            + " ".join(cells)
-            + f" {share_s}"
+            f"{r['name']:<{nw}} {r['min']:>9.3g} {r['max']:>9.3g}  "
+            + "  ".join(f"{c:>{w}}" for c, w in zip(row_cells, widths, strict=True))
+            + f"  {share_s:>7}"
         )
     rss = [f"{lab.lstrip('Δ')} {_rss(sens, n, f) * fac:.3g}" for n, f, lab, fac in cols]
     lines.append(

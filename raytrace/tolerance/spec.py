@@ -379,6 +379,14 @@ def _item_from_table(d: Any, where: str, dist: str, sigma: float) -> ToleranceIt
         if not (isinstance(s, list) and len(s) == 2):
             raise ToleranceSpecError(f"{where}: surfaces must be [first, last], got {s!r}")
         surfaces = (s[0], s[1])
+    adj = d.get("adjust", 0)
+    if t == "TTHI" and adj and not isinstance(adj, bool) and adj == d.get("surface"):
+        # make_item reads adjust == surface as "no adjust" (as .zmx TTHI lines may write it); a
+        # spec that writes it asks for something it would not get
+        raise ToleranceSpecError(
+            f"{where}: adjust = {adj} is the TTHI's own surface; adjust must name another surface "
+            "(the thickness that takes the opposite change), or leave adjust out"
+        )
     return make_item(
         t,
         where=where,
@@ -472,7 +480,7 @@ def resolve_spec_path(path: str | Path) -> Path:
     p = Path(path)
     if p.exists() or p.suffix:
         return p
-    bundled = bundled_spec_dir() / f"{p.name}.toml"
+    bundled = bundled_spec_dir() / f"{p.name.strip().lower()}.toml"  # names are lower case
     return bundled if bundled.is_file() else p
 
 
