@@ -29,11 +29,14 @@ Methods (criteria, ``METHODS``):
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from raytrace.units import is_whole
 
 from .curve import DistortionCurve, require_choice
 from .errors import CalibrationError
@@ -317,6 +320,8 @@ def calibrate(
         ) from None
     curve = _as_curve(distortion, plane, at_t)
     require_choice(method, METHODS, "calibration method", CalibrationError)
+    if isinstance(k, bool) or not (isinstance(k, numbers.Real) and k > 0 and math.isfinite(k)):
+        raise CalibrationError(f"k={k!r}: the plot exaggeration of Eq. 14 is a positive number")
     if curve.fields.size < 2:
         raise CalibrationError(f"{what}: a curve needs at least two field points")
     need = {"two-point": 2, "zero-at": 1}.get(method, 0)
@@ -358,6 +363,8 @@ def _as_curve(d, plane: int, at=None) -> DistortionCurve:
     if isinstance(d, DistortionCurve):
         return d
     if hasattr(d, "curve") and hasattr(d, "n_planes"):
+        if not is_whole(plane):
+            raise CalibrationError(f"plane={plane!r}: the image plane's number (0-based), an int")
         if not 0 <= int(plane) < d.n_planes:
             raise CalibrationError(
                 f"plane={plane}: the result has {d.n_planes} image plane(s) (0-based index)"
@@ -373,6 +380,12 @@ def _as_curve(d, plane: int, at=None) -> DistortionCurve:
                     "the lens passes"
                 )
         return d.curve(int(plane))
+    hint = (
+        ": pick one wavelength, e.g. result.at(587.5618) (nm; or result[0], in the order of its "
+        "wavelengths)"
+        if hasattr(d, "n_wavelengths")
+        else ""
+    )
     raise CalibrationError(
-        f"expected a DistortionCurve or a CharacteristicDistortion, got {type(d).__name__}"
+        f"expected a DistortionCurve or a CharacteristicDistortion, got {type(d).__name__}{hint}"
     )

@@ -48,7 +48,7 @@ import numpy as np
 import numpy.typing as npt
 
 from raytrace.errors import TraceError
-from raytrace.lens import Lens
+from raytrace.lens import Lens, require_lens
 from raytrace.paraxial import (
     ImagePlane,
     ParaxialResult,
@@ -253,6 +253,7 @@ def characteristic_distortion(
         For impossible requests (a plane before the last vertex, heights with an object at
         infinity, an unknown reference, ...).
     """
+    require_lens(lens)
     from raytrace.paraxial import (
         checked_wavelength,
         image_planes,

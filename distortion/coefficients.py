@@ -89,16 +89,20 @@ def evaluate_radial(k0: float, k: Sequence[float], r_mm: np.ndarray) -> np.ndarr
 MAX_RADIUS_RATIO = 19.0
 
 
-def check_profile_units(r_mm: np.ndarray, dr_um: np.ndarray) -> None:
+def check_profile_units(
+    r_mm: np.ndarray, dr_um: np.ndarray, where: Sequence[str] | None = None
+) -> None:
     """Refuse a profile whose distortion is as large as its radius (|δr| ≥ r: 100 % or more),
-    the mark of radii in metres or of δr in mm labelled µm; the message says so."""
+    the mark of radii in metres or of δr in mm labelled µm; the message says so, after
+    ``where[i]`` (e.g. ``"file.csv:12: "``) of the first such point when given."""
     r = np.abs(np.asarray(r_mm, dtype=float))
     d = np.abs(np.asarray(dr_um, dtype=float)) / 1000.0
     big = np.nonzero((r > 0) & (d >= r))[0]
     if big.size:
         i = int(big[0])
         raise DataError(
-            f"distortion {d[i] * 1000.0:g} µm at r = {r[i]:g} mm is as large as the radius "
+            ("" if where is None else where[i])
+            + f"distortion {d[i] * 1000.0:g} µm at r = {r[i]:g} mm is as large as the radius "
             "itself: radii must be in mm and distortion in µm (radii in metres, or distortion "
             "in mm under a µm label?)"
         )

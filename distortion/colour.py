@@ -111,7 +111,7 @@ def lateral_colour(
     lens: Lens,
     fields_deg: npt.ArrayLike | None = None,
     *,
-    wavelengths: Sequence[float] | None = None,
+    wavelengths: Sequence[float | str] | str | None = None,
     object_heights_mm: npt.ArrayLike | None = None,
     plane=None,
     s_prime: npt.ArrayLike | None = None,
@@ -132,7 +132,7 @@ def lateral_colour(
         Fields as in :func:`~distortion.characteristic.characteristic_distortion` (default: 11
         fields from 0 to the lens's field).
     wavelengths : (λ1, λ2), optional
-        nm; default :func:`default_pair`.
+        nm (or strings with a unit, line letters, ``"F,C"``); default :func:`default_pair`.
     plane, s_prime, from_last_vertex, defocus
         Image plane(s) as in ``characteristic_distortion``, resolved at the reference wavelength
         (default: its Gaussian plane of the object).
@@ -145,7 +145,15 @@ def lateral_colour(
     -------
     LateralColour
     """
-    pair = default_pair(lens) if wavelengths is None else tuple(wavelengths)
+    if wavelengths is None:
+        pair = default_pair(lens)
+    else:  # numbers, strings with units, line letters, or one string "F,C" (the one parser)
+        from raytrace.units import UnitError, wavelengths_nm
+
+        try:
+            pair = wavelengths_nm(wavelengths)
+        except UnitError as e:
+            raise TraceError(str(e)) from None
     if len(pair) != 2:
         raise TraceError(f"lateral colour compares two wavelengths, got {len(pair)}")
     ref = float(lens.wavelength)

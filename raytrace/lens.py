@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
@@ -657,6 +658,19 @@ def _scaled_placement(p, factor: float):
     if not isinstance(p, Placement):
         return p
     return replace(p, decenter=tuple(v * factor for v in p.decenter))
+
+
+def require_lens(lens, what: str = "lens") -> Lens:
+    """``lens`` when it is a :class:`Lens`; else a TypeError naming ``what`` and how to get one
+    (a name or path is loaded with ``load_lens``, not passed as it is)."""
+    if isinstance(lens, Lens):
+        return lens
+    hint = (
+        f": load it first, e.g. {what} = osc.load_lens({lens!r})"
+        if isinstance(lens, str | os.PathLike)
+        else ""
+    )
+    raise TypeError(f"{what} must be a Lens, not {type(lens).__name__}{hint}")
 
 
 @functools.lru_cache(maxsize=512)

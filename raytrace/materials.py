@@ -39,6 +39,7 @@ two Buchdahl models are what two open tools do, named as such).
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass
@@ -149,10 +150,7 @@ class Material:
         )
         for b in bad:  # beyond a pole of the formula the numbers are no index at all
             edge = lo if b < lo else hi
-            path = np.geomspace(edge, b, 257)
-            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-                n = _catalog_index(self, path)
-            if not (np.all(np.isfinite(n)) and np.all(n >= 1.0)):
+            if not _formula_holds(self, float(b)):
                 raise OutOfRangeError(
                     f"glass {self.name} ({self.catalog}) has no index at {b:g} nm: its dispersion "
                     f"formula, fitted over {lo:g}–{hi:g} nm, breaks down (a pole or n < 1) "
@@ -190,6 +188,17 @@ class Material:
             return f"{self.name} ({self.catalog})"
         law = "" if self.model == "cauchy2" else f" [{self.model}]"
         return f"{self.nd:g}/{self.vd:g}{law}"
+
+
+@functools.lru_cache(maxsize=1024)
+def _formula_holds(m: Material, wavelength_nm: float) -> bool:
+    """Whether the dispersion formula of ``m`` stays an index (finite, ≥ 1) all the way from
+    the nearest end of its data range to ``wavelength_nm`` (no pole crossed): 257 points."""
+    lo, hi = m.wavelength_range_nm
+    path = np.geomspace(lo if wavelength_nm < lo else hi, wavelength_nm, 257)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        n = _catalog_index(m, path)
+    return bool(np.all(np.isfinite(n)) and np.all(n >= 1.0))
 
 
 def _catalog_index(m: Material, wavelength_nm: np.ndarray) -> np.ndarray:

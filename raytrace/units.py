@@ -34,6 +34,14 @@ _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _RE = re.compile(rf"^\s*({_NUM}|[-+]?inf(?:inity)?)\s*([a-zA-Zµ×]*)\s*$")
 
 
+def is_whole(value) -> bool:
+    """Whether ``value`` is a whole number as a count or an index must be: an int or a numpy
+    integer, not a bool (nor a float that happens to be whole)."""
+    import numbers
+
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+
+
 def split_unit(text: str) -> tuple[float, str]:
     """``"1.5m"`` → (1.5, "m"); ``"12x"`` → (12.0, "x"); ``"inf"`` → (inf, ""). UnitError when the
     text is not a number with an optional unit word."""
@@ -117,6 +125,12 @@ def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
     if v <= 0:
         raise UnitError(f"{what}: a wavelength must be positive, got {value!r}")
     lo, hi = WAVELENGTH_RANGE_NM
+    for factor, name in ((1e9, "metres"), (1e6, "millimetres")):
+        if v < lo and unit == "nm" and v * 1000.0 < lo and lo <= v * factor <= hi:
+            raise UnitError(
+                f"{what} {value!r} nm looks like {name}: write {v * factor:g}nm (wavelengths "
+                "are in nm)"
+            )
     if v < lo and unit == "nm":
         raise UnitError(
             f"{what} {value!r} nm looks like micrometres: write {value}um or "

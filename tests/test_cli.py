@@ -350,7 +350,9 @@ def test_strict_refuses_a_glass_outside_its_data_range(capsys):
     lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
     assert rc == 2 and out == "" and len(lines) == 1
     assert "surface 1: glass N-SK11 (Schott) evaluated at 250 nm" in lines[0]
-    assert lines[0].endswith("--strict fails")
+    assert lines[0].endswith(
+        "--strict fails: use wavelengths inside the data range (or leave out --strict)"
+    )
     assert run(capsys, *argv)[0] == 0
 
 

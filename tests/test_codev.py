@@ -216,6 +216,8 @@ def test_the_image_surface_thickness_is_a_defocus():
     assert lens.image_solve is None  # no longer the Gaussian plane
     plain = loads_seq(TRIPLET.replace("SI 0 0", "SI 0 0.25"))
     assert plain.surfaces[-1].thickness == pytest.approx(43.25, abs=1e-12)
+    # 'THI SI 0.25', CODE V's usual way to set it, says the same
+    assert loads_seq(TRIPLET.replace("SI 0 0", "SI 0 0\nTHI SI 0.25")) == plain
 
 
 def test_curvatures_without_rdm_are_refused():

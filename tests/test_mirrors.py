@@ -231,3 +231,17 @@ def test_the_prism_converts_to_toml_and_back(tmp_path):
         from raytrace.files.native import loads
 
         loads(text[: text.index("surfaces")] + centred)
+
+
+def test_a_glass_of_thickness_0_needs_the_fold_right_after_it(tmp_path):
+    # one placed surface elsewhere in the lens does not excuse a typed t = 0 (review 2026-11-27)
+    from raytrace.files.native import loads
+
+    text = (
+        'name = "t"\naperture = { epd = 10 }\nfield = { angle = 5 }\nsurfaces = [\n'
+        '  { r = 50, t = 0, glass = "N-BK7", stop = true },\n'
+        "  { r = -50, t = 10 },\n"
+        '  { r = "inf", t = 40, decenter = [0, 0.1] },\n]\n'
+    )
+    with pytest.raises(PrescriptionError, match="glass thickness must be positive"):
+        loads(text)

@@ -305,3 +305,19 @@ def test_a_bundled_spec_name_is_found_as_typed():
         read_tolerance_spec(" Cooke-Triplet-F4 ").items
         == read_tolerance_spec("cooke-triplet-f4").items
     )
+
+
+@pytest.mark.parametrize(
+    "name",
+    sorted(p.stem for p in (Path(__file__).parents[1] / "lenses" / "tolerances").glob("*.toml")),
+)
+def test_every_bundled_spec_gives_a_sensitivity_table(name):
+    # the Topogon patent spec let a glass thickness push its neighbour through the 0.02 mm air
+    # gap (adjust = the gap): every bundled example must run as the README shows it
+    from distortion.tolerance import tolerance_sensitivity
+    from raytrace.files.library import load_lens
+    from raytrace.tolerance.spec import read_tolerance_spec
+
+    spec = read_tolerance_spec(name)
+    res = tolerance_sensitivity(load_lens(spec.lens), spec)
+    assert len(res.names) == spec.n_items

@@ -363,9 +363,13 @@ def resolve_setup(lens, setup: CameraSetup) -> CameraGeometry:
         flv = par_ref.gaussian_image_distance
         what = "focused on the object"
     if not (math.isfinite(flv) and flv > 0):
+        hint = ""
+        f = setup.focus
+        if focus_od is not None and isinstance(f, int | float) and not isinstance(f, bool):
+            hint = f" (focus={f:g} is mm from the first vertex: for metres write focus='{f:g}m')"
         raise DataError(
             f"{lens.name} {what}: the sensor plane would lie {flv:g} mm from the last vertex; it "
-            "must be a finite distance behind the lens (a real image)"
+            f"must be a finite distance behind the lens (a real image){hint}"
         )
     z = par_ref.z_from_last_vertex(flv)
     par = par_ref if wl == wl_ref else paraxial(lens, od, wl)

@@ -68,9 +68,10 @@ import numpy as np
 import numpy.typing as npt
 
 from raytrace.errors import TraceError
-from raytrace.lens import Lens
+from raytrace.lens import Lens, require_lens
 from raytrace.limits import MAX_FIELDS
 from raytrace.paraxial import ImagePlane, ParaxialResult
+from raytrace.units import is_whole
 
 from ..curve import FieldKindMixin, curve_field_kind, plane_label, requested_fields
 from ..errors import DataError
@@ -300,6 +301,7 @@ def distortion_grid(
     -------
     DistortionGrid
     """
+    require_lens(lens)
     from raytrace.paraxial import resolve_paraxial
     from raytrace.trace.chief2d import requested_fields_2d
 
@@ -341,22 +343,18 @@ def distortion_grid(
     )
 
 
-def _is_whole(v) -> bool:
-    return isinstance(v, int | np.integer) and not isinstance(v, bool | np.bool_)
-
-
 def _grid_size(grid) -> tuple[int, int]:
     """(nx, ny) of ``grid`` (n or (nx, ny), whole numbers >= 2); DataError naming the fix."""
     if grid is None:
         return DEFAULT_GRID
     fix = "give n or (nx, ny) as whole numbers of points, at least 2 each, e.g. grid=(21, 21)"
-    if _is_whole(grid):
+    if is_whole(grid):
         vals = (grid, grid)
     elif isinstance(grid, str | bytes) or not hasattr(grid, "__len__"):
         raise DataError(f"grid={grid!r}: {fix}")
     else:
         vals = tuple(grid)
-        if len(vals) != 2 or not all(_is_whole(v) for v in vals):
+        if len(vals) != 2 or not all(is_whole(v) for v in vals):
             raise DataError(f"grid={grid!r}: {fix}")
     if min(vals) < 2:
         raise DataError(f"grid={grid!r}: at least 2 points along each axis, e.g. grid=(21, 21)")
@@ -632,6 +630,7 @@ def radial_by_azimuth(
         For a centred lens and ``reference_point="axial"`` its radial curves equal the 1-D
         characteristic distortion D0 at the same fields (tangential zero).
     """
+    require_lens(lens)
     from raytrace.paraxial import resolve_paraxial
 
     # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its

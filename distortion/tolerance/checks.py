@@ -21,12 +21,10 @@ lens traces; a sensitivity run whose item makes the lens untraceable is refused 
 from __future__ import annotations
 
 import math
-import numbers
 import warnings
 
-import numpy as np
-
 from raytrace.tolerance import ToleranceSpec, ToleranceSpecError
+from raytrace.units import is_whole
 
 from ..errors import UnitWarning
 
@@ -150,7 +148,7 @@ def check_spec(spec: ToleranceSpec) -> None:
 def whole(value, name: str, minimum: int) -> int:
     """``value`` as an int when it is a whole number (an int or numpy integer, not a bool)
     ≥ ``minimum``; else :class:`ToleranceInputError` naming ``name``."""
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
+    if not is_whole(value):
         raise ToleranceInputError(
             f"{name} must be a whole number ≥ {minimum} (an int), got {value!r}"
         )

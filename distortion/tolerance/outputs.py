@@ -224,8 +224,8 @@ def prepare(
     spec: ToleranceSpec,
     *,
     fields_deg=None,
-    object_distance: float | None = None,
-    wavelength: float | None = None,
+    object_distance: float | str | None = None,
+    wavelength: float | str | None = None,
     grid_rings=DEFAULT_RINGS,
     grid_azimuths: int = DEFAULT_AZIMUTHS,
     radial_terms: int = 3,
@@ -238,6 +238,15 @@ def prepare(
     g_object_distance``, and without one g is not computed. Raises ToleranceSpecError for a spec
     that does not fit the lens, TraceError when a nominal chief ray fails, DataError when g
     cannot be defined (:func:`distortion.tolerance.gfactor.prepare_g`)."""
+    from raytrace.lens import require_lens
+    from raytrace.paraxial.conjugates import checked_wavelength, resolve_object_distance
+
+    require_lens(lens)
+    if not isinstance(spec, ToleranceSpec):
+        raise TypeError(
+            f"spec must be a ToleranceSpec, not {type(spec).__name__}: read it first, e.g. "
+            "spec = osc.read_tolerance_spec('cooke-triplet-f4')"
+        )
     check_against_lens(spec, lens)
     check_spec(spec)
     fd = default_fields(lens) if fields_deg is None else np.asarray(fields_deg, dtype=float).ravel()
@@ -248,8 +257,8 @@ def prepare(
             f"fields_deg {float(np.min(fd)):g}: the curve is traced along +y; give angles >= 0 "
             "(degrees)"
         )
-    od = float(lens.object_distance if object_distance is None else object_distance)
-    wl = float(lens.wavelength if wavelength is None else wavelength)
+    wl = checked_wavelength(wavelength) or float(lens.wavelength)  # nm, "0.55um", "d"
+    od = resolve_object_distance(lens, object_distance=object_distance, wavelength=wl)
     rings = tuple(float(r) for r in grid_rings)
     amax = float(np.max(np.abs(fd)))
     pts = [np.column_stack([np.zeros_like(fd), fd])]

@@ -380,6 +380,19 @@ class VariationAnalysis:
     interpolation: str = INTERPOLATION
     messages: tuple[str, ...] = field(default_factory=tuple)
 
+    def __repr__(self) -> str:
+        gs = "; ".join(
+            f"focus {fs.focus.label}: mean g {fs.summary.mean:.3f} ± {fs.summary.precision:.3f}"
+            if fs.summary.n
+            else f"focus {fs.focus.label}: no g"
+            for fs in self.focus_summaries
+        )
+        return (
+            f"VariationAnalysis({self.source or 'profiles'}: {len(self.profiles)} profiles"
+            + (f", {gs}" if gs else "")
+            + ")"
+        )
+
 
 def _keyer(ps: ProfileSet):
     """Key function identifying equal distances, across units when the focal length is known."""

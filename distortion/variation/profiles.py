@@ -216,11 +216,7 @@ def read_profiles_csv(
                     "distance once, one way",
                 )
             raise _err(path, b[2], f"profile ({label}): radius {rr[dup[0]]:g} mm twice")
-        try:
-            check_profile_units(rr, dd)
-        except DataError as e:
-            i = int(np.nonzero((rr > 0) & (np.abs(dd) / 1000.0 >= rr))[0][0])
-            raise _err(path, pts[i][2], str(e)) from None
+        check_profile_units(rr, dd, [f"{path}:{q[2]}: " for q in pts])
         if rr.size < 2:
             raise _err(path, g["line"], f"profile ({label}) has only one point")
         profiles.append(Profile(g["focus"], g["object"], rr, dd, g["line"]))

@@ -153,6 +153,33 @@ def parse_conjugate(text: str) -> Conjugate:
     return Conjugate(v, "m", t)
 
 
+def as_conjugates(value, what: str) -> list[Conjugate]:
+    """One or more focus / object distances as the API takes them: :class:`Conjugate` objects,
+    strings as :func:`parse_conjugate` reads them (``"12x"``, ``"1.5m"``, ``"1500mm"``,
+    ``"8x,16x"``) or plain numbers (metres, Fraser & Shortis's unit, as a plain typed number)."""
+    items = [value] if isinstance(value, Conjugate | str | int | float) else value
+    try:
+        items = list(items)
+    except TypeError:
+        raise TypeError(
+            f"{what}: give a distance ('12x', '1.5m', 1.5) or a list of them, not "
+            f"{type(value).__name__}"
+        ) from None
+    out: list[Conjugate] = []
+    for c in items:
+        if isinstance(c, Conjugate):
+            out.append(c)
+        elif isinstance(c, str):
+            out.extend(parse_conjugates(c))
+        elif isinstance(c, int | float) and not isinstance(c, bool):
+            out.append(parse_conjugate(repr(float(c))))
+        else:
+            raise TypeError(
+                f"{what}: {c!r} is not a distance (give '12x', '1.5m', 1.5 or a Conjugate)"
+            )
+    return out
+
+
 def parse_conjugates(text: str) -> list[Conjugate]:
     """Comma-separated :func:`parse_conjugate` values (``"8x,16x,20x"``)."""
     parts = [p for p in (q.strip() for q in str(text).split(",")) if p]
@@ -342,6 +369,12 @@ class TracedVariation:
     analysis: VariationAnalysis
     notes: tuple[str, ...]
 
+    def __repr__(self) -> str:
+        return (
+            f"TracedVariation({self.lens_name}, f = {self.efl_mm:.4f} mm, "
+            f"{len(self.settings)} traced settings, analysis={self.analysis!r})"
+        )
+
 
 def _field_limit(lens: Lens, max_field_deg: float | None) -> float:
     if max_field_deg is not None:
@@ -372,8 +405,8 @@ def resample_spline(r: np.ndarray, dr: np.ndarray, grid: np.ndarray, label: str)
 
 def trace_variation(
     lens: Lens,
-    focus: Conjugate | Sequence[Conjugate],
-    objects: Sequence[Conjugate],
+    focus: Conjugate | str | float | Sequence[Conjugate | str | float],
+    objects: Conjugate | str | float | Sequence[Conjugate | str | float],
     *,
     r_min: float | None = None,
     r_max: float | None = None,
@@ -385,20 +418,42 @@ def trace_variation(
     reference: str = "characteristic",
     wavelength: float | None = None,
 ) -> TracedVariation:
-    """Trace δr_s, δr_s', δr_ss' for ``lens`` (module docstring) and analyse them.
+    """Trace δr_s, δr_s', δr_ss' for ``lens`` (module docstring) and analyse them (Fraser &
+    Shortis 1992, Eqs. 1–6).
 
-    focus: one or more focus settings; objects: object planes (a plane equal to a focus setting
-    adds nothing for that focus). Every focus setting and every object plane also gets its
-    Gaussian profile. r_min, r_max (mm): the common radial grid (defaults: ``r_hi/n_r`` and the
-    largest radius all profiles reach); n_r radii; n_fields traced nominal angles from 0 to
-    ``max_field_deg`` (default the lens's field). threshold_um, method: as
-    :func:`distortion.variation.analyze_variation`. Raises DataError for impossible requests.
+    Parameters
+    ----------
+    lens : Lens
+        The prescription; unit focusing (the whole lens moves) is assumed (``FOCUSING``).
+    focus, objects : distance or list of distances
+        Focus settings and object planes: ``"12x"`` (image scale N, Gaussian magnification
+        −1/N), ``"1.5m"`` / ``"1500mm"`` or a plain number (metres from the first principal
+        point H, positive), ``"8x,16x"``, or :class:`Conjugate` objects (:func:`as_conjugates`).
+        A plane equal to a focus setting adds nothing for that focus; every focus setting and
+        every object plane also gets its Gaussian profile. A distance given twice is refused.
+    r_min, r_max : float, optional
+        The common radial grid in the image, mm (defaults ``r_hi/n_r`` and the largest radius
+        all profiles reach).
+    n_r, n_fields : int
+        Radii of the common grid; traced nominal field angles from 0 to ``max_field_deg``
+        (degrees; default the lens's field).
+    threshold_um, method
+        As :func:`distortion.variation.analyze_variation` (µm; ``"lsq"`` or ``"mean"``).
+    reference : str
+        The distortion definition (:mod:`distortion.characteristic`; default Pestrecov's
+        characteristic D0). wavelength: nm (default the lens's).
+
+    Returns
+    -------
+    TracedVariation
+        ``analysis`` holds γ, g per plane and the mean g; δr positive outward (µm).
+
+    Raises DataError for impossible requests.
     """
     from raytrace.paraxial import paraxial
 
     check_analysis_options(r_min, r_max, threshold_um, method)
-    foci = [focus] if isinstance(focus, Conjugate) else list(focus)
-    objs = list(objects)
+    foci, objs = as_conjugates(focus, "focus"), as_conjugates(objects, "objects")
     if not foci:
         raise DataError("give at least one focus setting")
     for what, cs in (("focus setting", foci), ("object plane", objs)):

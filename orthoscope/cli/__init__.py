@@ -277,7 +277,11 @@ def _run(argv: Sequence[str] | None) -> int:
         print(f"{command}: error: {cli_words(str(e))}", file=sys.stderr)
         return EXIT_USAGE
     except UserWarning as e:  # a warning that --strict turned into an error
-        print(f"{command}: error: {e}; --strict fails", file=sys.stderr)
+        print(
+            f"{command}: error: {e}; --strict fails: use wavelengths inside the data range (or "
+            "leave out --strict)",
+            file=sys.stderr,
+        )
         return EXIT_USAGE
     except BrokenPipeError:
         _silence_stdout()

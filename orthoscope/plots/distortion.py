@@ -378,10 +378,47 @@ def plot_distortion(
     ``fig, (a, b) = plt.subplots(1, 2); osc.plot_distortion(d, ax=a)``. Returns the Figure.
     """
     if calibration is not None:
+        _check_same_curve(distortion, calibration)
         return plot_calibrated(calibration, ax=ax, title=title)
     if isinstance(distortion, CharacteristicDistortion) and distortion.n_planes > 1:
         return plot_planes(distortion, ax=ax, title=title)
     return plot_characteristic(distortion, ax=ax, title=title)
+
+
+def _check_same_curve(distortion, calibration) -> None:
+    """Refuse a calibration of another curve than ``distortion`` (the figure draws the
+    calibration's own curve: ``distortion`` would be ignored)."""
+    if not isinstance(calibration, CalibrationResult):
+        raise TypeError(
+            f"calibration must be a CalibrationResult (osc.calibrate(...)), not "
+            f"{type(calibration).__name__}"
+        )
+    c = calibration.curve
+    if isinstance(distortion, CharacteristicDistortion):
+        curves = [distortion.curve(i) for i in range(distortion.n_planes)]
+    elif isinstance(distortion, DistortionCurve):
+        curves = [distortion]
+    else:
+        raise TypeError(
+            f"distortion must be a CharacteristicDistortion or a DistortionCurve, not "
+            f"{type(distortion).__name__} (a ChromaticDistortion: pick one wavelength, "
+            "result.at(nm))"
+        )
+
+    def same(a) -> bool:
+        return (
+            a.field_kind == c.field_kind
+            and a.constant == c.constant
+            and np.array_equal(a.fields, c.fields)
+            and np.array_equal(a.D0, c.D0, equal_nan=True)
+        )
+
+    if not any(same(a) for a in curves):
+        raise DataError(
+            f"the calibration is of another curve ({c.name or 'unnamed'}, {c.plane or 'its plane'}"
+            f", {c.fields.size} fields) than the distortion given: pass the result it came from, "
+            "or calibrate this one (osc.calibrate(distortion))"
+        )
 
 
 def png_bytes(fig, dpi: int = 100) -> bytes:

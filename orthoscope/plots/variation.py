@@ -56,6 +56,16 @@ def _finish(ax, ylabel: str, title: str, handles: list, labels: list[str], key: 
         legend(ax, handles, labels, title=key, fontsize=8, title_fontsize=8)
 
 
+def _analysis(a) -> VariationAnalysis:
+    """The analysis of a :class:`VariationAnalysis` or of a ``trace_variation`` result."""
+    a = getattr(a, "analysis", a)
+    if not isinstance(a, VariationAnalysis):
+        raise TypeError(
+            f"expected a VariationAnalysis or a trace_variation result, not {type(a).__name__}"
+        )
+    return a
+
+
 def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
     """Radial distortion profiles i×(j×) of an analysis (Fraser & Shortis Figs. 1–4 style):
     δr (µm) against the radial distance r (mm); Gaussian profiles (object plane = plane of
@@ -63,8 +73,8 @@ def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
 
     Parameters
     ----------
-    a : VariationAnalysis
-        From :func:`distortion.variation.analyze_variation` or ``trace_variation(...).analysis``.
+    a : VariationAnalysis or TracedVariation
+        From :func:`distortion.variation.analyze_variation` or :func:`trace_variation`.
     ax : matplotlib.axes.Axes, optional
         Draw here; default a new pyplot figure.
     title : str, optional
@@ -74,6 +84,7 @@ def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
     -------
     matplotlib.figure.Figure
     """
+    a = _analysis(a)
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
     colours = _colours()
     handles, labels = [], []
@@ -116,6 +127,7 @@ def plot_g(a: VariationAnalysis, *, ax=None, title: str | None = None):
     (Figs. 5–7 style). Radii of weak determination (|δr_s' − δr_s| below the analysis threshold)
     are open markers on a dashed line; the estimated g of each plane is a thin horizontal line.
     ``ax``, ``title``: as :func:`plot_profiles`. Returns the Figure."""
+    a = _analysis(a)
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
     colours = _colours()
     k = 0

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import PrescriptionError
-from ..lens import Lens
+from ..lens import Lens, require_lens
 
 READ_SUFFIXES = (".toml", ".zmx", ".seq", ".len")
 WRITE_SUFFIXES = (".toml", ".zmx")
@@ -139,10 +139,11 @@ def _check_reads_back(lens: Lens, path: str | Path) -> None:
         from .zemax import loads_zmx as loads
     else:
         from .native import dumps, loads
+    text = dumps(lens)  # what the format cannot hold is the writer's own refusal, raised as is
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            loads(dumps(lens))
+            loads(text)
     except OrthoscopeError as e:
         raise LensError(
             f"{path}: not written: the file would not read back ({e}); please report it"
@@ -153,6 +154,9 @@ def save_lens(lens: Lens, path: str | Path, *, overwrite: bool = False) -> None:
     """Save ``lens`` to ``path``: native TOML (``.toml``, full precision, so reading it back gives
     the same lens) or Zemax ``.zmx``, chosen by the suffix. Written atomically; an existing file
     is replaced only with ``overwrite=True``, and never when it is the lens's own source file."""
+    if isinstance(path, Lens) and not isinstance(lens, Lens):
+        raise TypeError("save_lens(lens, path): the lens first, then the path (they are swapped)")
+    require_lens(lens)
     inputs = [lens.path] if lens.path else []
     write_lens_file(lens, path, overwrite=overwrite, inputs=inputs)
 
@@ -160,16 +164,18 @@ def save_lens(lens: Lens, path: str | Path, *, overwrite: bool = False) -> None:
 def convert(
     in_path: str | Path, out_path: str | Path, *, overwrite: bool = False, **options
 ) -> Lens:
-    """Convert a lens file: IN (.toml, .zmx or .seq) to OUT (.toml or .zmx), formats chosen by
-    the suffixes. Zemax .zmx files may be ASCII or UTF-16 (written: UTF-16, as OpticStudio
-    does); numbers are written at full double precision, so .toml -> .zmx -> .toml reproduces
-    the lens exactly. Commands that cannot be converted stop the conversion with a message naming
-    the file and line; skipped non-optical ones are listed in a warning. OUT is never the same
-    file as IN, and an existing OUT is replaced only with ``overwrite``.
-    Returns the lens that was written."""
+    """Convert a lens file: IN (.toml, .zmx or .seq, or a bundled lens name) to OUT (.toml or
+    .zmx), formats chosen by the suffixes. Zemax .zmx files may be ASCII or UTF-16 (written:
+    UTF-16, as OpticStudio does); numbers are written at full double precision, so .toml ->
+    .zmx -> .toml reproduces the lens exactly. Commands that cannot be converted stop the
+    conversion with a message naming the file and line; skipped non-optical ones are listed in
+    a warning. OUT is never the same file as IN, and an existing OUT is replaced only with
+    ``overwrite``. Returns the lens that was written."""
+    from .library import resolve_lens_path
     from .output import check_output
 
     _check_suffix(out_path)
+    in_path = resolve_lens_path(in_path)  # a file, or a bundled lens name (as load_lens)
     check_output(out_path, inputs=[in_path], overwrite=overwrite, **options)
     lens = read_lens_file(in_path)
     write_lens_file(lens, out_path, inputs=[in_path], overwrite=overwrite, **options)

@@ -233,6 +233,7 @@ class _SeqParser(LineParser):
         prv_wl: tuple[list[float], int] | None = None
         self.private: dict[str, Material] = {}
         self.pickups: list[tuple[list[str], int]] = []
+        self.si_thickness: tuple[float, int] | None = None  # THI SI v (a defocus)
         rdm_seen = False
         self.go_line = 0
         for line, toks in _logical_lines(self.text):
@@ -431,6 +432,9 @@ class _SeqParser(LineParser):
         """THI / RDY / CUY / GLA / INS / DEL: a solve (its stored result is used, said in a
         warning) or a change of the lens by command (refused)."""
         first = args[0].upper() if args else ""
+        if cmd == "THI" and first == "SI" and len(args) == 2:  # CODE V's usual way to defocus
+            self.si_thickness = (self.num(args, 1, cmd, line), line)
+            return
         if first and first.isalpha() and cmd in ("THI", "RDY", "CUY") and first not in ("SO", "SI"):
             self.warn(
                 f"line {line}: {cmd} {first} (a solve) not re-solved: the value on the surface "
@@ -844,6 +848,8 @@ class _SeqParser(LineParser):
                     f"line {pims[-1].pim}: PIM on a decentered or tilted lens: the stored image "
                     "distance is used (paraxial solves need a centred lens)"
                 )
+        if img is not None and self.si_thickness is not None:
+            img.t = self.si_thickness[0]  # THI SI v: the same as the value on the SI line
         if img is not None and img.t != 0.0:  # CODE V: the image surface's thickness defocuses
             if img.dec:
                 self.warn(

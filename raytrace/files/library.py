@@ -49,6 +49,13 @@ def library_dir() -> Path:
     return Path(str(importlib.resources.files(PACKAGE)))
 
 
+def bundled_file(folder: str, name: str | Path) -> Path | None:
+    """The bundled ``lenses/FOLDER/NAME.toml`` (``specs``, ``tolerances``) for a name as a person
+    types it (spaces around it, capitals), or None when there is none."""
+    p = library_dir() / folder / f"{Path(name).name.strip().lower()}.toml"
+    return p if p.is_file() else None
+
+
 def bundled_names() -> list[str]:
     """Names of the bundled lenses (file stems), sorted."""
     return sorted(p.stem for p in library_dir().glob("*.toml"))

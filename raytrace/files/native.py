@@ -819,7 +819,9 @@ def _surfaces(src: _Source, data: dict[str, Any], object_material: Material = AI
             continue
         # a glass of thickness 0 before a coordinate break or placed surface (a prism's mirror
         # face, as .zmx files write it) is kept, as the .zmx reader keeps it
-        if not srf.material.is_air and (t * direction < 0.0 or (t == 0.0 and not placed)):
+        nxt = out[i + 1]
+        folds = nxt.coordinate_break or nxt.is_placed
+        if not srf.material.is_air and (t * direction < 0.0 or (t == 0.0 and not folds)):
             if direction > 0:
                 raise src.error(f"glass thickness must be positive, got t = {t!r}", line, no)
             raise src.error(

@@ -62,7 +62,7 @@ from .solver import (
     start_values,
     variable_scales,
 )
-from .spec import ASPHERIC_KINDS, DesignSpec, SpecError
+from .spec import ASPHERIC_KINDS, DesignSpec, SpecError, evaluation_limit
 
 #: the trust radius (in units of :func:`step_scales`) below which the run ends
 MIN_RADIUS = 1e-9
@@ -208,7 +208,7 @@ def minimax(
         limit, was stopped, ends above ``spec.merit_goal`` or with a violated bound.
     """
     check_spec(lens, spec)
-    limit = spec.max_evaluations if max_evaluations is None else int(max_evaluations)
+    limit = evaluation_limit(spec, max_evaluations)
     lo, hi = bounds(spec)
     x = start_values(lens, spec)
     sc = step_scales(lens, spec)

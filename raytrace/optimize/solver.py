@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import OrthoscopeError
-from ..lens import Lens
+from ..lens import Lens, require_lens
 from ..materials import Material
 from ..paraxial import gaussian_solved, paraxial
 from .operands import OperandValue, evaluate, merit, operand_lens_problems
@@ -30,6 +30,7 @@ from .spec import (
     DesignSpec,
     SpecError,
     Variable,
+    evaluation_limit,
     operand_problems,
     suggest,
 )
@@ -342,11 +343,20 @@ def optimize(
 
     ``stop()`` is asked before each evaluation; when it returns a reason (a non-empty string)
     the run ends at once and returns the best design evaluated so far with ``stopped`` set.
-    ``max_evaluations`` overrides the spec's limit.
+    ``max_evaluations`` overrides the spec's limit (a whole number ≥ 1). Least squares counts it
+    as scipy's ``max_nfev`` (the evaluations of its steps; the finite-difference Jacobians, n
+    evaluations each for n variables, come on top), minimax counts every evaluation
+    (docs/spec.md, ``max_evaluations``); ``OptimizationResult.evaluations`` counts every one.
 
     A run that stops on the evaluation limit, or ends above ``spec.merit_goal``, is returned with
     ``converged=False`` and a message saying why; the caller must not present it as a success.
     """
+    require_lens(lens, "lens")
+    if not isinstance(spec, DesignSpec):
+        raise TypeError(
+            f"spec must be a DesignSpec, not {type(spec).__name__}: read it first, e.g. "
+            "spec = osc.read_spec('my-spec.toml')"
+        )
     if method is not None:
         spec = replace(spec, method=method)
     if spec.method == "minimax":  # it checks the spec itself
@@ -354,7 +364,7 @@ def optimize(
 
         return minimax(lens, spec, progress, stop=stop, max_evaluations=max_evaluations)
     check_spec(lens, spec)
-    limit = spec.max_evaluations if max_evaluations is None else int(max_evaluations)
+    limit = evaluation_limit(spec, max_evaluations)
     lo, hi = bounds(spec)
     x0 = start_values(lens, spec)  # a start value outside its bounds starts on the nearest bound
     sc = variable_scales(lens, spec)

@@ -21,6 +21,7 @@ import tomllib
 
 from ..errors import OrthoscopeError, PrescriptionError
 from ..lens import Lens
+from ..units import is_whole
 
 #: continuous variables (damped least squares) and the discrete ``glass`` substitution variable
 CONTINUOUS_KINDS = (
@@ -340,8 +341,7 @@ def suggest(word: str, choices) -> str:
     return f" (use one of: {', '.join(choices)})"
 
 
-def _is_int(v) -> bool:
-    return isinstance(v, numbers.Integral) and not isinstance(v, bool)  # numpy integers too
+_is_int = is_whole  # numpy integers too, never a bool
 
 
 def _is_num(v) -> bool:
@@ -664,6 +664,10 @@ def read_spec(path: str | Path) -> DesignSpec:
     wrong types, missing keys), one line each.
     """
     p = Path(path)
+    if not p.exists() and not p.suffix:  # a bundled spec by its name (lenses/specs/)
+        from ..files.library import bundled_file
+
+        p = bundled_file("specs", p) or p
     try:
         raw = p.read_bytes()
         d = tomllib.loads(raw.decode("utf-8"))
@@ -821,3 +825,13 @@ def start_lens(spec: DesignSpec) -> Lens:
         return load_lens(spec.start)
     except PrescriptionError as e:
         raise SpecError(f"start lens {spec.start!r}: {e}") from None
+
+
+def evaluation_limit(spec: DesignSpec, max_evaluations: int | None) -> int:
+    """The evaluation limit of a local run: ``max_evaluations`` (a whole number ≥ 1, checked
+    here: SpecError naming it) or the spec's."""
+    if max_evaluations is None:
+        return spec.max_evaluations
+    if not (_is_int(max_evaluations) and max_evaluations >= 1):
+        raise SpecError(f"max_evaluations must be a whole number >= 1, got {max_evaluations!r}")
+    return int(max_evaluations)

@@ -34,7 +34,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import LensError
-from ..lens import Lens
+from ..lens import Lens, require_lens
+from ..units import WAVELENGTH_RANGE_NM
 
 
 @dataclass(frozen=True)
@@ -346,16 +347,53 @@ def element_power(lens: Lens, first: int, last: int, wavelength: float | None = 
 
 
 def paraxial(
-    lens: Lens, object_distance: float | None = None, wavelength: float | None = None
+    lens: Lens,
+    object_distance: float | str | None = None,
+    wavelength: float | str | None = None,
+    *,
+    object_s: float | str | None = None,
+    object_scale: float | str | None = None,
 ) -> ParaxialResult:
     """First-order analysis of ``lens`` (see :class:`ParaxialResult` for every quantity).
 
-    object_distance: positive magnitude from the object plane to the first vertex, or ``inf``;
-        defaults to the lens's. wavelength: nm, defaults to the lens's.
+    Parameters
+    ----------
+    lens : Lens
+    object_distance, object_s, object_scale : optional
+        The object plane, at most one (the same words as every trace, docs/design.md
+        "Vocabulary"): positive mm from the object plane to the first vertex (or ``inf``, a
+        length with its unit ``"1.5m"``, an image scale ``"12x"``); Pestrecov's signed s from H
+        (mm, negative); the image scale N of "N×". Default: the lens's object.
+    wavelength : float or str, optional
+        nm (or ``"0.5876um"``, a line letter ``"d"``); default the lens's reference wavelength.
+
+    Returns
+    -------
+    ParaxialResult
+
     Raises :class:`LensError` for an afocal lens, a stop the paraxial chief ray cannot locate
     (pupil at infinity is allowed and reported as ±inf), an object at a focal point, or a lens
-    that is not centred (:func:`require_centred`; mirrors on the axis are fine).
+    that is not centred (:func:`require_centred`; mirrors on the axis are fine); TraceError for
+    a value the unit checks refuse.
     """
+    require_lens(lens)
+    if wavelength is not None and not (
+        isinstance(wavelength, float)
+        and WAVELENGTH_RANGE_NM[0] <= wavelength <= WAVELENGTH_RANGE_NM[1]
+    ):  # a float in range (the optimizers' calls) needs no more checking
+        from .conjugates import checked_wavelength
+
+        wavelength = checked_wavelength(wavelength)
+    if isinstance(object_distance, str) or object_s is not None or object_scale is not None:
+        from .conjugates import resolve_object_distance
+
+        object_distance = resolve_object_distance(
+            lens,
+            object_distance=object_distance,
+            object_s=object_s,
+            object_scale=object_scale,
+            wavelength=wavelength,
+        )
     od = lens.object_distance if object_distance is None else float(object_distance)
     if not (od > 0.0):
         raise LensError(f"object distance must be a positive magnitude or inf, got {od}")

@@ -480,8 +480,9 @@ def resolve_spec_path(path: str | Path) -> Path:
     p = Path(path)
     if p.exists() or p.suffix:
         return p
-    bundled = bundled_spec_dir() / f"{p.name.strip().lower()}.toml"  # names are lower case
-    return bundled if bundled.is_file() else p
+    from ..files.library import bundled_file
+
+    return bundled_file("tolerances", p) or p
 
 
 def read_tolerance_spec(path: str | Path) -> ToleranceSpec:

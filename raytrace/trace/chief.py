@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..errors import LensError, TraceError
-from ..lens import Lens
+from ..lens import Lens, require_lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
@@ -373,6 +373,7 @@ def chief_rays(
         Named arrays per field (per wavelength and field), with a status per ray; a failed ray
         has NaN coordinates.
     """
+    require_lens(lens)
     if wavelength is not None and wavelengths is not None:
         raise TraceError("give wavelength= or wavelengths=, not both")
     od = resolve_object_distance(

@@ -17,8 +17,9 @@ import numpy as np
 
 from ..errors import TraceError
 from ..kernels.codes import STATUS_OK
-from ..lens import Lens
+from ..lens import Lens, require_lens
 from ..paraxial import ImagePlane, image_planes, plane_z, resolve_paraxial
+from ..paraxial.conjugates import checked_wavelength
 from .chief import aim
 from .pupil import aimed_bundle, pupil_points
 from .rays import trace_rays
@@ -58,6 +59,7 @@ def _trace_field(
     status) per ray in the image plane, and the keywords that :class:`RayFan` and
     :class:`SpotDiagram` share (field, field_kind, object_distance, z_plane, chief_height,
     wavelength)."""
+    wavelength = checked_wavelength(wavelength)
     par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength)
     od = par.object_distance
     f, kind = _field(lens, field_deg, object_height_mm, not par.infinite)
@@ -169,6 +171,7 @@ def ray_fan(
     RayFan
         Pupil coordinates and transverse aberrations ε (mm) relative to the real chief ray.
     """
+    require_lens(lens)
     if axis not in ("x", "y"):
         raise TraceError(f"axis must be 'y' (tangential) or 'x' (sagittal), got {axis!r}")
     px, py = pupil_points("fan_y" if axis == "y" else "fan_x", int(n))
@@ -260,6 +263,7 @@ def spot_diagram(
     SpotDiagram
         Intercepts relative to the chief ray (mm), centroid, RMS and geometric radius (mm).
     """
+    require_lens(lens)
     if pattern not in ("hexapolar", "rings", "square"):
         raise TraceError(f"pattern must be hexapolar, rings or square, got {pattern!r}")
     px, py = pupil_points(pattern, int(n))

@@ -22,6 +22,7 @@ from ..errors import TraceError
 from ..kernels.codes import STATUS_NAMES
 from ..lens import Lens
 from ..packing import PackedLens, pack
+from ..paraxial.conjugates import checked_wavelength
 from .results import RayStatus
 
 #: Batches of at least this many rays use the prange kernel (when more than one thread is
@@ -93,7 +94,15 @@ class RayBatch(RayStatus):
 
 
 def _columns(a, what: str) -> list[np.ndarray]:
-    """An (n, 3) array or a sequence of three array-likes → three float64 arrays."""
+    """An (n, 3) array (or nested lists of n rows, n ≠ 3) or a sequence of three array-likes
+    → three float64 arrays."""
+    if not isinstance(a, np.ndarray) and not (isinstance(a, Sequence) and len(a) == 3):
+        try:
+            rows = np.asarray(a, dtype=np.float64)
+        except (TypeError, ValueError):
+            rows = None
+        if rows is not None and rows.ndim == 2:
+            a = rows
     if isinstance(a, np.ndarray) and a.ndim == 2:
         if a.shape[1] != 3:
             raise TraceError(f"{what} must have shape (n, 3), got {a.shape}")
@@ -102,6 +111,12 @@ def _columns(a, what: str) -> list[np.ndarray]:
     if isinstance(a, np.ndarray) and a.ndim == 1 and a.shape[0] == 3 and a.dtype != object:
         return [np.asarray(v, dtype=np.float64) for v in a]
     if isinstance(a, Sequence) and len(a) == 3:
+        if all(isinstance(v, Sequence) and len(v) == 3 for v in a):
+            raise TraceError(
+                f"{what}: three lists of three numbers are ambiguous (three rays, or the x, y, z "
+                "of three rays?): give np.array(rows) of shape (3, 3) for rays, or three 1-D "
+                "arrays for x, y, z"
+            )
         return [np.asarray(v, dtype=np.float64) for v in a]
     raise TraceError(f"{what}: expected an (n, 3) array or three arrays/values (x, y, z)")
 
@@ -116,7 +131,10 @@ def _f64(a: np.ndarray, n: int) -> np.ndarray:
 
 
 def packed_lens(lens: Lens | PackedLens, wavelength: float | None = None) -> PackedLens:
-    """``lens`` packed at ``wavelength`` (nm); a :class:`PackedLens` is used as it is."""
+    """``lens`` packed at ``wavelength`` (nm, or a string with a unit: the one check); a
+    :class:`PackedLens` is used as it is."""
+    if wavelength is not None:
+        wavelength = checked_wavelength(wavelength)
     if isinstance(lens, PackedLens):
         if wavelength is not None and float(wavelength) != lens.wavelength:
             raise TraceError(
@@ -124,7 +142,9 @@ def packed_lens(lens: Lens | PackedLens, wavelength: float | None = None) -> Pac
             )
         return lens
     if not isinstance(lens, Lens):
-        raise TraceError(f"expected a Lens (osc.load_lens) or a PackedLens, got {type(lens)!r}")
+        raise TypeError(
+            f"lens must be a Lens (osc.load_lens) or a PackedLens, not {type(lens).__name__}"
+        )
     return pack(lens, wavelength)
 
 
