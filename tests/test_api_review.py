@@ -146,3 +146,12 @@ def test_a_format_the_writer_refuses_is_said_as_such(cooke, tmp_path):
     ss[1] = replace(ss[1], aspheric=(0.0,) * 7 + (1e-20,))
     with pytest.raises(PrescriptionError, match="aspheric coefficients cannot be written"):
         osc.save_lens(replace(cooke, surfaces=tuple(ss)), tmp_path / "x.zmx")
+
+
+def test_fans_and_spots_take_one_field_and_say_so(cooke):
+    # spot_diagram(lens, [0, 20]) was "float() argument must be ... not 'list'"
+    with pytest.raises(TraceError, match="one field .* call once per field"):
+        osc.spot_diagram(cooke, [0, 20])
+    with pytest.raises(TraceError, match="one field"):
+        osc.ray_fan(cooke, "10")
+    assert osc.ray_fan(cooke, np.float64(10.0)).field == 10.0

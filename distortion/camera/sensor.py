@@ -213,7 +213,7 @@ class Sensor:
                 f"{self.height_px} pixels makes pixels of {px:g} x {py:g} µm, outside "
                 f"{lo:g}..{hi:g} µm: check the size (mm) and the pixel count"
             )
-        if max(px, py) > 1.5 * min(px, py):
+        if max(px, py) > 1.1 * min(px, py):  # sensors have square pixels (a few percent off)
             warnings.warn(
                 UnitWarning(
                     f"sensor {self.width_mm:g}x{self.height_mm:g} mm over {self.width_px}x"

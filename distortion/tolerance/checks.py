@@ -41,8 +41,9 @@ TIND_LARGE = 0.05
 TCUR_LARGE = 0.01
 #: a pivot farther than this from the element (mm) is named in the hint
 PIVOT_LARGE_MM = 1000.0
-#: a yield limit below this many µm looks like millimetres
-SMALL_LIMIT_UM = 0.1
+#: a yield limit below this many µm looks like millimetres (no production lens holds its
+#: distortion to a micrometre; 0.5 typed for 0.5 mm would be 500 µm)
+SMALL_LIMIT_UM = 1.0
 
 
 class ToleranceInputError(ToleranceSpecError, ValueError):
@@ -162,7 +163,7 @@ def check_yield_limit(
 ) -> tuple[float, float]:
     """A yield limit (µm) and field (degrees): :class:`ToleranceInputError` unless both are
     finite, the limit > 0 and the field ≥ 0; a :class:`UnitWarning` (``warn``) when the limit
-    is below 0.1 µm (it looks like millimetres)."""
+    is below 1 µm (it looks like millimetres)."""
     try:
         lim, deg = float(limit_um), float(field_deg)
     except (TypeError, ValueError):

@@ -29,6 +29,12 @@ from .results import RayStatus, field_unit
 def _field(lens: Lens, field_deg, object_height_mm, finite: bool) -> tuple[float, str]:
     if field_deg is not None and object_height_mm is not None:
         raise TraceError("give field_deg or object_height_mm, not both")
+    for name, v in (("field_deg", field_deg), ("object_height_mm", object_height_mm)):
+        if v is not None and (np.ndim(v) != 0 or isinstance(v, str | bool)):
+            raise TraceError(
+                f"{name}={v!r}: one field (a number); for several, call once per field, e.g. "
+                f"[ray_fan(lens, a) for a in (0, 10, 20)]"
+            )
     if object_height_mm is not None:
         if not finite:
             raise TraceError("object heights need a finite object distance")
