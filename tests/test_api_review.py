@@ -155,3 +155,28 @@ def test_fans_and_spots_take_one_field_and_say_so(cooke):
     with pytest.raises(TraceError, match="one field"):
         osc.ray_fan(cooke, "10")
     assert osc.ray_fan(cooke, np.float64(10.0)).field == 10.0
+
+
+def test_plots_say_what_they_need(cooke, tmp_path):
+    # matplotlib's "Number of rows must be a positive integer, not 0", an IndexError, and a
+    # save_figure refusal that told a Python user to "give --force"
+    import matplotlib.pyplot as plt
+
+    for call, msg in (
+        (lambda: osc.plot_tolerance(), "needs mc="),
+        (lambda: osc.plot_ray_fan([]), "at least one RayFan"),
+        (lambda: osc.plot_spot([]), "at least one SpotDiagram"),
+    ):
+        with pytest.raises(TypeError, match=msg):
+            call()
+    fig = osc.plot_ray_fan(osc.ray_fan(cooke, 10))
+    out = tmp_path / "fan.png"
+    osc.save_figure(fig, out)
+    with pytest.raises(Exception, match="overwrite=True"):
+        osc.save_figure(fig, out)
+    plt.close(fig)
+    # a finite object's fields are nominal angles (as the pupils and grid plots say)
+    lc = osc.lateral_colour(osc.load_lens("twinplex-like-55-525"), fields_deg=[0, 10])
+    fig = osc.plot_lateral_colour(lc)
+    assert fig.axes[0].get_xlabel() == "nominal field angle (deg)"
+    plt.close(fig)

@@ -262,6 +262,16 @@ def compare_cameras(
     radii : array_like, optional
         Radii of the profiles (mm with a pixel size, else px); default 40 up to the
         half-diagonal.
+    label_measured, label_predicted : str
+        Names of the two models in listings and plots.
+    notes : tuple of str
+        Carried into the result.
+
+    Returns
+    -------
+    CameraComparison
+        The map Δd = d_predicted − d_measured (px), the projection difference, the radial
+        profiles, and the principal-point and focal-length differences (predicted − measured).
     """
     if (measured.width, measured.height) != (predicted.width, predicted.height):
         raise DataError(

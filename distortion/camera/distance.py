@@ -149,6 +149,11 @@ def traced_models_by_distance(
         ``focus`` / ``focus_s`` / ``focus_scale`` or an image plane, ``wavelength``, ``grid``,
         ``clip`` (an object keyword here is refused: the distances are the table's rows).
         Default focus: the first object distance.
+
+    Returns
+    -------
+    ModelTable
+        One traced model per object distance (``method = "traced"``).
     """
     from .setup import make_setup
     from .traced import camera_residual, fit_points, trace_camera_points
@@ -279,6 +284,11 @@ def calibrated_models_by_distance(
         Pixel pitch (mm) when the calibrations carry none.
     n_radii : int
         Radii of the profiles, from 0 to the half-diagonal.
+
+    Returns
+    -------
+    ModelTable
+        One OpenCV model per object distance, with the method and the distances as given.
     """
     from ..coefficients import opencv_model
     from ..variation.models import (

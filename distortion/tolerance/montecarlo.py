@@ -545,7 +545,7 @@ def monte_carlo(
         ``[outputs] g_object_distance``; without either, g is not computed (NaN).
     limits : ((limit µm, field deg), ...)
         Yields counted during the run (a streamed run can answer only these); a limit > 0 µm
-        (below 0.1 µm it warns: it looks like millimetres), a field ≥ 0.
+        (below 1 µm it warns: it looks like millimetres), a field ≥ 0.
     summary : "auto" | "exact" | "streaming"
         ``"exact"`` gathers every instance (``outputs``) and takes exact statistics;
         ``"streaming"`` summarises chunk by chunk and never holds all instances
@@ -557,6 +557,12 @@ def monte_carlo(
     setup : a :class:`ToleranceSetup` to reuse (then the field / object / fit arguments are its).
     allow_large : bool
         Run more than :data:`MAX_INSTANCES` instances (the command line's ``--allow-large``).
+
+    Returns
+    -------
+    MonteCarloResult
+        The perturbations and outputs of every instance (``summary_method = "exact"``) or the
+        streamed summary, the statistics and envelopes, and the yields counted during the run.
 
     A ``KeyboardInterrupt`` propagates after the finished chunks are on disk. Warns
     (RuntimeWarning, one line) when more than :data:`FAIL_WARN_FRACTION` of the instances

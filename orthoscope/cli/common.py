@@ -160,7 +160,7 @@ def save_plot(make, path, args) -> None:
 
     with offscreen_figures():
         fig = make()
-    save_figure(fig, path, overwrite=args.force, inputs=args._inputs)
+    save_figure(fig, path, overwrite=args.force, inputs=args._inputs, flag="--force")
 
 
 def strict_check(args, status, what: str = "field(s)", see: str = " (see the table)") -> None:

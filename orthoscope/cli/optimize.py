@@ -476,7 +476,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         fig = plot_glass_map(
             pools.values(), res.glasses, title=f"{spec.name}: glass pool and chosen glasses"
         )
-        save_figure(fig, args.glass_map, overwrite=args.force, inputs=inputs)
+        save_figure(fig, args.glass_map, overwrite=args.force, inputs=inputs, flag="--force")
     if args.json:
         search = {
             "global": True,

@@ -211,7 +211,7 @@ def cmd_tolerance(args) -> int:
 
         with offscreen_figures():
             fig = plot_tolerance(mc, sens, limits=limits)
-        save_figure(fig, args.plot, overwrite=args.force, inputs=inputs)
+        save_figure(fig, args.plot, overwrite=args.force, inputs=inputs, flag="--force")
     if args.json:
         out = {"lens": lens.name, "spec": str(spec_path)}
         if sens is not None and args.sensitivity:

@@ -45,7 +45,26 @@ def _image_axes(ax, width: int, height: int) -> None:
 
 def plot_camera_residuals(tc: TracedCamera, *, ax=None, title: str | None = None):
     """Arrows of the fitted model's residual (model − traced image point) at every traced
-    chief ray over the sensor, with the RMS in the title."""
+    chief ray over the sensor, with the RMS in the title.
+
+    Residual vectors in OpenCV pixels (u right, v down; :func:`distortion.camera.camera_residual`):
+    the model's projection of each traced direction minus the traced chief ray's image point.
+    The arrows are scaled so that the longest spans about 1.5 grid steps (key above the axes);
+    grey dots mark the traced points. The title states the RMS and the largest residual (px).
+
+    Parameters
+    ----------
+    tc : TracedCamera
+        From ``osc.camera_model`` (a camera model fitted to a lens's traced chief rays).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from distortion.camera import camera_residual
 
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE_IMAGE)
@@ -78,7 +97,29 @@ def plot_distortion_picture(
     """A grid (or checkerboard) of the ideal image as the camera records it, at true scale
     (:func:`distortion.camera.distortion_picture`; warped by ``cv2.remap``). Axes in full-size
     pixels. ``reference``: draw the grid's lines where a distortion-free camera would record
-    them (thin red lines) — zoom in (``ax.set_xlim``) to see the recorded lines leave them."""
+    them (thin red lines) — zoom in (``ax.set_xlim``) to see the recorded lines leave them.
+
+    Parameters
+    ----------
+    picture : DistortionPicture or CameraModel
+        A picture made by ``osc.distortion_picture`` (its own pattern, spacing and preview scale),
+        or a camera model, whose picture is made here with the defaults (line spacing a tenth of
+        the image height, preview at most 1200 px wide; needs OpenCV, the ``camera`` extra).
+    pattern : {"grid", "checkerboard"}
+        The pattern for a camera model; ignored for a ready :class:`DistortionPicture`.
+    reference : bool
+        Draw the lines of the ideal grid (pinhole part of the model, spacing in full-size px)
+        in red; only for a grid pattern of a camera without skew (else ``DataError``).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure. Pixels are OpenCV's (u right, v down, pixel
+        centres at integers), v growing downward as the picture is seen.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from distortion.camera import distortion_picture, pinhole_part
 
     pic = picture if isinstance(picture, DistortionPicture) else distortion_picture(
@@ -116,7 +157,25 @@ def plot_distortion_picture(
 def plot_radial_comparison(c: CameraComparison, *, ax=None, title: str | None = None):
     """Radial distortion (azimuthal mean, positive outward) of the measured and the predicted
     camera against the measured radius; the part beyond the sensor's short side (where the
-    circles leave the sensor) is shaded."""
+    circles leave the sensor) is shaded.
+
+    Radii in mm and δr in µm when the comparison has a pixel size, else both in pixels (along
+    the pixels' x axis). A third, dotted curve is the difference predicted − measured.
+
+    Parameters
+    ----------
+    c : CameraComparison
+        From ``osc.compare_calibration`` or ``osc.compare_cameras`` (``profile_measured`` and
+        ``profile_predicted`` at the same radii).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, ax = figure_and_axes(ax)
     pm, pp = c.profile_measured, c.profile_predicted
     mm = pm.radius_mm is not None
@@ -142,7 +201,27 @@ def plot_radial_comparison(c: CameraComparison, *, ax=None, title: str | None = 
 
 def plot_difference_map(c: CameraComparison, *, ax=None, title: str | None = None):
     """The distortion difference predicted − measured over the sensor: its length in colour,
-    the vectors as arrows (pixels)."""
+    the vectors as arrows (pixels).
+
+    ``c.difference_px``: Δd = d_predicted − d_measured in OpenCV pixels (u right, v down), drawn
+    at the predicted camera's image points; the colour bar is |Δd| (px), the arrows are thinned to
+    about 14 per row and scaled so that the longest spans about 1.5 grid steps (key above the
+    axes). The title states the RMS and the largest |Δd| (px).
+
+    Parameters
+    ----------
+    c : CameraComparison
+        From ``osc.compare_calibration`` or ``osc.compare_cameras``. ``DataError`` when no point
+        of its map could be evaluated by both models.
+    ax : matplotlib.axes.Axes, optional
+        Draw here (the colour bar takes room from it); default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE_IMAGE)
     img = c.image_px
     d = c.difference_px
@@ -171,7 +250,18 @@ def plot_difference_map(c: CameraComparison, *, ax=None, title: str | None = Non
 
 def plot_calibration_comparison(c: CameraComparison):
     """Two panels side by side: the radial curves (:func:`plot_radial_comparison`) and the map
-    of the difference (:func:`plot_difference_map`)."""
+    of the difference (:func:`plot_difference_map`).
+
+    Parameters
+    ----------
+    c : CameraComparison
+        From ``osc.compare_calibration`` or ``osc.compare_cameras``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A new figure of 14 × 5 inches (no ``ax=``: the figure is its own); default titles.
+    """
     fig, axs = panel_figure(1, 2, figsize=(14.0, 5.0))
     plot_radial_comparison(c, ax=axs[0])
     plot_difference_map(c, ax=axs[1])

@@ -309,7 +309,24 @@ def plot_certificate(cert):
     The page is a fixed layout (no ``ax=``): header, tables, then the plots — the four
     semi-diagonals in the quadrants they point to (−x+y top left, +x+y top right, −x−y bottom
     left, +x−y bottom right), the decentering profile and the four curves together — and the
-    definitions at the foot."""
+    definitions at the foot.
+
+    Radial distortion Δr in µm (+ outward = pincushion) and the decentering profile J r² in µm,
+    against the field angle θ in degrees; coordinates in mm in the photogrammetric image frame
+    (x right, y up); :mod:`distortion.certificate` defines them.
+
+    Parameters
+    ----------
+    cert : CalibrationCertificate or dict
+        From ``osc.calibration_certificate``, or its JSON dict
+        (:func:`orthoscope.report.certificate.certificate_to_dict`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A new A4 portrait figure (8.27 × 11.69 inches) marked ``orthoscope_page = True``, so that
+        :func:`~orthoscope.plots.save.save_figure` keeps the whole page.
+    """
     d = _as_dict(cert)
     fig = blank_figure(PAGE)
     fig.set_layout_engine("none")

@@ -13,6 +13,7 @@ import numpy as np
 
 from distortion.characteristic import ChromaticDistortion
 from distortion.colour import FocalShift, LateralColour
+from distortion.curve import NOMINAL_ANGLE
 from distortion.errors import DataError
 
 from .common import GRID, ZERO, figure_and_axes, panel_figure, set_title
@@ -45,7 +46,23 @@ def wavelength_colour(nm: float) -> tuple[float, float, float]:
 
 def plot_focal_shift(fs: FocalShift, ax=None):
     """The focal-shift curve: image-plane shift (µm) against wavelength (nm), the reference
-    wavelength marked."""
+    wavelength marked.
+
+    The shift is each wavelength's image plane minus the reference wavelength's, + away from the
+    lens (``fs.shift``, mm, drawn in µm); paraxial image or best focus as ``fs.kind`` says (the
+    title states which). Up to 12 wavelengths get a marker in their spectral colour.
+
+    Parameters
+    ----------
+    fs : FocalShift
+        From ``osc.focal_shift`` (``DataError`` for anything else).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     if not isinstance(fs, FocalShift):
         raise DataError(f"expected a FocalShift (distortion.colour.focal_shift), got {type(fs)}")
     fig, ax = figure_and_axes(ax)
@@ -65,7 +82,27 @@ def plot_focal_shift(fs: FocalShift, ax=None):
 
 def plot_lateral_colour(lc: LateralColour, ax=None, *, plane: int = 0, relative: bool = False):
     """Lateral colour ``y'(λ1) − y'(λ2)`` against the field (µm, or per cent of the reference
-    wavelength's image height with ``relative``) in image plane ``plane``."""
+    wavelength's image height with ``relative``) in image plane ``plane``.
+
+    λ1, λ2 are ``lc.wavelengths`` (nm), in that order; y' the signed chief-ray image heights
+    (mm) in the plane, so positive = y'(λ1) > y'(λ2). Field axis in degrees (field angles;
+    nominal angles for a finite object) or mm (object heights).
+
+    Parameters
+    ----------
+    lc : LateralColour
+        From ``osc.lateral_colour`` (``DataError`` for anything else).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    plane : int
+        Which image plane of ``lc`` (0-based; ``DataError`` outside the range).
+    relative : bool
+        Plot ``lc.relative`` = Δy'/y'(λ_ref) in per cent instead of ``lc.linear`` in µm.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     if not isinstance(lc, LateralColour):
         raise DataError(f"expected a LateralColour (distortion.colour), got {type(lc)}")
     if not 0 <= plane < lc.n_planes:
@@ -75,7 +112,7 @@ def plot_lateral_colour(lc: LateralColour, ax=None, *, plane: int = 0, relative:
     y = 100.0 * lc.relative[plane] if relative else 1000.0 * lc.linear[plane]
     ax.plot(lc.fields, y, "o-", color="tab:purple", ms=4)
     w1, w2 = lc.wavelengths
-    ax.set_xlabel("object height (mm)" if lc.field_kind == "height" else "field angle (deg)")
+    ax.set_xlabel(_field_label(lc.field_kind))
     ax.set_ylabel(
         f"(y'({w1:g}) − y'({w2:g})) / y'({lc.reference_wavelength:g}) (%)"
         if relative
@@ -91,7 +128,29 @@ def plot_distortion_by_wavelength(
 ):
     """Characteristic distortion D0 (mm; Dr in per cent with ``relative``) at each wavelength,
     one curve per wavelength in its colour; the title states the scale (the reference
-    wavelength's F0/M0 for all, or each its own)."""
+    wavelength's F0/M0 for all, or each its own).
+
+    D0 = y' − y0' of Pestrecov (1958) Eq. (9) and Dr = D0/y0', with y0' = K0·x of Eq. (8)
+    (y' the real chief ray's signed image height, mm), against the field: degrees (field
+    angles; nominal angles for a finite object) or mm (object heights). Fields a wavelength
+    cannot trace are left out of its curve.
+
+    Parameters
+    ----------
+    cd : ChromaticDistortion
+        From ``osc.characteristic_distortion(..., wavelengths=...)`` (``DataError`` for anything
+        else; its ``scale`` decides the constant each wavelength is measured against).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    plane : int
+        Which image plane of ``cd`` (0-based; ``DataError`` outside the range).
+    relative : bool
+        Plot Dr in per cent instead of D0 in mm.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     if not isinstance(cd, ChromaticDistortion):
         raise DataError(
             "expected a ChromaticDistortion (characteristic_distortion(..., wavelengths=...)), "
@@ -106,7 +165,7 @@ def plot_distortion_by_wavelength(
         ok = np.isfinite(v)
         ax.plot(cd.fields[ok], v[ok], "o-", ms=3, color=wavelength_colour(w), label=f"{w:g} nm")
     r0 = cd[0]
-    ax.set_xlabel("object height (mm)" if r0.field_kind == "height" else "field angle (deg)")
+    ax.set_xlabel(_field_label(r0.field_kind))
     ax.set_ylabel("Dr (%)" if relative else "D0 (mm)")
     ax.grid(True, **GRID)
     ax.legend(fontsize=8, frameon=False)
@@ -122,3 +181,10 @@ def plot_colour_summary(fs: FocalShift, lc: LateralColour, cd: ChromaticDistorti
     plot_lateral_colour(lc, ax=axs[1])
     plot_distortion_by_wavelength(cd, ax=axs[2])
     return fig
+
+
+def _field_label(kind: str) -> str:
+    """The field axis: object heights, a finite object's nominal angles, or field angles."""
+    return {"height": "object height (mm)", NOMINAL_ANGLE: "nominal field angle (deg)"}.get(
+        kind, "field angle (deg)"
+    )

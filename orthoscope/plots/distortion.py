@@ -214,7 +214,23 @@ def plot_calibrated(res: CalibrationResult, *, ax=None, title: str | None = None
 
     A calibration of a traced curve is drawn through the dense trace with the same K_c; a
     calibration of a table through a monotone spline of its points (module docstring). Markers at
-    the field points. ``ax``, ``title``: as :func:`plot_characteristic`. Returns the Figure.
+    the field points. The curves are Pestrecov's Eqs. (10)–(12) and (15) (1958, Section IV):
+    ``y_c' = K_c·x``, ``D_c = y' − y_c'`` and ``D_rc = y'/y_c' − 1`` (x = tan α or the object
+    height y in mm; y' the real chief ray's signed image height, mm).
+
+    Parameters
+    ----------
+    res : CalibrationResult
+        From :func:`distortion.calibration.calibrate` (``osc.calibrate``) of a traced result or
+        of a table. The title states K_c (F_c in mm, or M_c) and the calibration method.
+    ax : matplotlib.axes.Axes, optional
+        Draw here (the per-cent scale goes on ``ax.twinx()``); default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     c = res.curve
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
@@ -258,8 +274,24 @@ def plot_rotation(res: CalibrationResult, *, ax=None, title: str | None = None):
     (:func:`rotated_characteristic`) against the calibrated curve D_c(y_c'); both in mm.
 
     Lines: the dense trace (traced results) or a monotone spline through the points (tables);
-    markers at the field points. ``ax``, ``title``: as :func:`plot_characteristic`. Returns the
-    Figure.
+    markers at the field points. The angle is that of Pestrecov's Eqs. (13)–(14):
+    ``tan ρ = K_c/K_0 − 1`` and ``tan ρ_k = k·tan ρ`` with the plot exaggeration k of the
+    calibration; the rotated abscissa is ``X' = X/cos ρ_k − Y sin ρ_k`` (Section IV.A). The legend
+    states ρ_k in degrees and k.
+
+    Parameters
+    ----------
+    res : CalibrationResult
+        From :func:`distortion.calibration.calibrate` (``osc.calibrate``); its ``k`` (the
+        ``k=`` of the calibration, default 200 as in the paper's Fig. 2) sets ρ_k.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     c = res.curve
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
@@ -372,10 +404,30 @@ def plot_distortion(
     given, the curves of several image planes (Fig. 6) for a multi-plane result, else the
     characteristic linear and relative distortion (Fig. 2).
 
-    ``distortion`` is a :class:`~distortion.characteristic.CharacteristicDistortion` (traced again
-    densely for smooth lines) or a :class:`~distortion.curve.DistortionCurve` (a table: monotone
-    spline through its points). ``ax``: draw there (default a new pyplot figure), e.g.
-    ``fig, (a, b) = plt.subplots(1, 2); osc.plot_distortion(d, ax=a)``. Returns the Figure.
+    Pestrecov (1958) Figs. 2, 3 and 6: :func:`plot_characteristic` (D_0 in mm and D_r in % of
+    Eqs. 8–9), :func:`plot_calibrated` (D_c in mm and D_rc in % of Eqs. 10–15) or
+    :func:`plot_planes` (D_0 in mm against the field, one curve per image plane).
+
+    Parameters
+    ----------
+    distortion : CharacteristicDistortion or DistortionCurve
+        A traced result (traced again densely for smooth lines; a multi-plane result gives
+        Fig. 6) or a table (a monotone spline through its points). A
+        :class:`~distortion.characteristic.ChromaticDistortion` is refused: pick one wavelength
+        with ``result.at(nm)``.
+    calibration : CalibrationResult, optional
+        A calibration (``osc.calibrate``) of ``distortion`` or of one of its image planes; the
+        chart is then that calibration's Fig. 3 (``distortion`` only checked against it:
+        ``DataError`` for a calibration of another curve, ``TypeError`` for another type).
+    ax : matplotlib.axes.Axes, optional
+        Draw here (default a new pyplot figure), e.g.
+        ``fig, (a, b) = plt.subplots(1, 2); osc.plot_distortion(d, ax=a)``.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     if calibration is not None:
         _check_same_curve(distortion, calibration)

@@ -76,7 +76,30 @@ def plot_grid_distortion(
     """The ideal grid (grey) and the real grid with its distortion exaggerated k times (red):
     points ``P0' + k·D``. ``exaggeration`` k: default a 1-2-5 factor that makes the largest
     distortion about 5 % of the picture (:func:`default_exaggeration`); k is stated in the
-    title."""
+    title.
+
+    Ideal points ``P0' = R + K0·X`` (Pestrecov 1958, Eq. 8 in 2-D) and distortion vectors
+    ``D = P' − P0'`` (mm) as :mod:`distortion.grid.field` defines them; image coordinates
+    (x', y') in mm in the lens frame (x right, y up, looking along −z), equal axes. A black
+    cross marks the reference point R. The title states max |D| in µm.
+
+    Parameters
+    ----------
+    grid : DistortionGrid
+        From ``osc.distortion_grid``; a 2-D grid of fields (rows × columns), else ``DataError``.
+    plane : int
+        Which image plane of ``grid`` (0-based).
+    exaggeration : float, optional
+        The factor k (dimensionless, > 0).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     p = _plane(grid, plane)
     if len(grid.shape) != 2:
         raise DataError("plot_grid_distortion needs a 2-D grid of fields (rows x columns)")
@@ -116,7 +139,33 @@ def plot_distortion_vectors(
 ):
     """Arrows of the distortion vectors D (or of one part of a ``decomposition``: "radial",
     "decentering", "thin_prism", "offset", "scale", "residual") at the ideal image points; the
-    arrow key states the length it stands for."""
+    arrow key states the length it stands for.
+
+    D = P' − P0' (mm; ideal points of Pestrecov 1958, Eq. 8 in 2-D) at the ideal points, in the
+    lens frame (x', y' in mm; x right, y up, looking along −z), equal axes; the arrows are
+    scaled so that the longest spans about 1.5 grid steps, the key and the title state lengths
+    in µm. A black cross marks the reference point.
+
+    Parameters
+    ----------
+    grid : DistortionGrid
+        From ``osc.distortion_grid``.
+    plane : int
+        Which image plane of ``grid`` (0-based).
+    decomposition : GridDecomposition, optional
+        From ``osc.decompose_distortion`` of the same plane (needed for any ``component`` but
+        "total"; ``DataError`` for another plane or an undetermined decomposition).
+    component : {"total", "radial", "decentering", "thin_prism", "offset", "scale", "residual"}
+        What to draw: D itself, or that part of the decomposition (mm; the parts sum to D).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     p = _plane(grid, plane)
     if component not in COMPONENTS:
         raise DataError(f"component={component!r}; use one of {', '.join(COMPONENTS)}")
@@ -222,7 +271,30 @@ def plot_radial_by_azimuth(
 ):
     """Radial distortion (solid, outward positive) and, with ``tangential``, the tangential
     part (dashed) against the field, one colour per azimuth: Pestrecov's characteristic curve
-    per azimuth (identical curves for a centred lens)."""
+    per azimuth (identical curves for a centred lens).
+
+    D·ê_r and D·ê_t in µm (radial + outward = pincushion, tangential + counter-clockwise;
+    azimuths in degrees from +x toward +y), against the total field angle θ in degrees (nominal
+    for a finite object) or the object radius in mm. Along any azimuth of a centred lens the
+    radial part is Pestrecov's D0 (1958, Eq. 9).
+
+    Parameters
+    ----------
+    curves : RadialByAzimuth
+        From ``osc.radial_by_azimuth``.
+    plane : int
+        Which image plane (0-based).
+    tangential : bool
+        Also draw the tangential part (dashed).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     g = curves.grid
     p = _plane(g, plane)
     fig, ax = figure_and_axes(ax)

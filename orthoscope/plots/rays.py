@@ -22,8 +22,29 @@ def _field_label(field: float, kind: str) -> str:
 
 def plot_ray_fan(fans: RayFan | Sequence[RayFan], *, ax=None, title: str | None = None):
     """Transverse ray aberration ε (µm) against the normalised pupil coordinate, one curve per
-    fan (tangential: ε_y against p_y, solid; sagittal: ε_x against p_x, dashed)."""
+    fan (tangential: ε_y against p_y, solid; sagittal: ε_x against p_x, dashed).
+
+    ε is the ray's intercept minus the real chief ray's in the fan's image plane (x', y' in the
+    lens frame, mm, drawn in µm); pupil coordinates run from −1 to 1. Rays that failed are left
+    out. One colour per field (degrees, or object height in mm); the title states the first
+    fan's wavelength (nm).
+
+    Parameters
+    ----------
+    fans : RayFan or sequence of RayFan
+        From ``osc.ray_fan`` (e.g. a tangential and a sagittal fan per field).
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fans = [fans] if isinstance(fans, RayFan) else list(fans)
+    if not fans:
+        raise TypeError("plot_ray_fan needs at least one RayFan (osc.ray_fan(lens, field))")
     fig, ax = figure_and_axes(ax)
     ax.axhline(0.0, **ZERO)
     ax.axvline(0.0, **ZERO)
@@ -51,8 +72,29 @@ def plot_ray_fan(fans: RayFan | Sequence[RayFan], *, ax=None, title: str | None 
 
 def plot_spot(spots: SpotDiagram | Sequence[SpotDiagram], *, ax=None, title: str | None = None):
     """Spot diagrams side by side (µm, relative to each field's real chief ray), with the RMS
-    radius circle about the centroid."""
+    radius circle about the centroid.
+
+    Each spot is its rays' intercepts minus the chief ray's (x', y' in the lens frame, mm, drawn
+    in µm), equal axes; the spots are spaced 2.6 times the largest spot radius apart along x
+    (no x ticks) and labelled with their field (degrees, or object height in mm) and RMS radius
+    (µm). Rays that failed are left out. The title states the first spot's wavelength (nm).
+
+    Parameters
+    ----------
+    spots : SpotDiagram or sequence of SpotDiagram
+        From ``osc.spot_diagram``, one per field.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure of 2.6 inches width per spot (+1) by 3.2 inches.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     spots = [spots] if isinstance(spots, SpotDiagram) else list(spots)
+    if not spots:
+        raise TypeError("plot_spot needs at least one SpotDiagram (osc.spot_diagram(lens, field))")
     fig, ax = figure_and_axes(ax, figsize=(2.6 * max(1, len(spots)) + 1.0, 3.2))
     span = max(
         (

@@ -21,12 +21,37 @@ def save_figure(
     overwrite: bool = False,
     inputs: Iterable[str | os.PathLike] = (),
     dpi: int = 150,
-    flag: str = "--force",
+    flag: str = "overwrite=True",
 ) -> Path:
     """Render ``fig`` in the format of ``path``'s suffix (.png, .svg, .pdf) and write it.
 
     The drawing is cropped to what is drawn (a tight bounding box), except for a fixed page (a
-    figure with ``orthoscope_page = True``, e.g. the A4 certificate), which keeps its size."""
+    figure with ``orthoscope_page = True``, e.g. the A4 certificate), which keeps its size.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        E.g. what a ``plot_*`` function returns.
+    path : str or os.PathLike
+        The file to write; its suffix (any case) picks the format: ``.png``, ``.svg`` or
+        ``.pdf`` (else ``OutputError``). Written atomically
+        (:func:`raytrace.files.output.write_atomic`).
+    overwrite : bool
+        Replace an existing file (else ``OutputError``).
+    inputs : iterable of str or os.PathLike
+        Files the output must never be (e.g. the lens file it was made from): ``OutputError``
+        when ``path`` is one of them, ``overwrite`` or not.
+    dpi : int
+        Dots per inch of a .png (and of any raster part of a .svg or .pdf).
+    flag : str
+        How the refusal to overwrite names the way to allow it (default the API's
+        ``"overwrite=True"``; the command line passes ``"--force"``).
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     from raytrace.files.output import check_output, write_atomic
 
     p = Path(path)

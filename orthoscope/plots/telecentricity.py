@@ -36,7 +36,26 @@ def plot_chief_ray_angle(pa: PupilAnalysis, *, ax=None, title: str | None = None
     """The image-side chief-ray angle (deg) of the real chief ray against the field, with the
     paraxial chief ray scaled linearly to the field (dashed; left scale), and their difference
     (right scale) — the pupil aberration that makes distortion change from plane to plane.
-    0 everywhere = image-side telecentric."""
+    0 everywhere = image-side telecentric.
+
+    The angle α' of the final segment with the axis is signed like its direction cosine M
+    (``atan2(M, N)``; :mod:`distortion.telecentricity`); the paraxial one is
+    ``atan(x·dK0/ds')``. Field axis in degrees (field angles; nominal angles for a finite
+    object) or mm (object heights).
+
+    Parameters
+    ----------
+    pa : PupilAnalysis
+        From ``osc.pupil_analysis`` (``DataError`` for anything else).
+    ax : matplotlib.axes.Axes, optional
+        Draw here (the difference scale goes on ``ax.twinx()``); default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     _check(pa)
     fig, ax = figure_and_axes(ax)
     ax.axhline(0.0, **ZERO)
@@ -60,7 +79,26 @@ def plot_chief_ray_angle(pa: PupilAnalysis, *, ax=None, title: str | None = None
 
 def plot_distortion_slope(pa: PupilAnalysis, *, ax=None, title: str | None = None):
     """∂D0/∂s' (µm of distortion per mm of image-plane shift) against the field: how the
-    characteristic distortion changes from one image plane to another (exact, Eq. 8)."""
+    characteristic distortion changes from one image plane to another (exact, Eq. 8).
+
+    ``∂D0/∂s' = tan α' − x·dK0/ds'`` with K0 the constant of orthoscopy of Pestrecov (1958)
+    Eq. (8) in the actual plane and D0 of Eq. (9): D0 is affine in s', so
+    ``D0(s'_2) = D0(s'_1) + (s'_2 − s'_1)·∂D0/∂s'`` exactly (s' in mm from H'). Field axis
+    in degrees (field angles; nominal angles for a finite object) or mm (object heights).
+
+    Parameters
+    ----------
+    pa : PupilAnalysis
+        From ``osc.pupil_analysis`` (``DataError`` for anything else); ``pa.slope`` is in mm/mm.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     _check(pa)
     fig, ax = figure_and_axes(ax)
     ax.axhline(0.0, **ZERO)
@@ -76,7 +114,26 @@ def plot_distortion_slope(pa: PupilAnalysis, *, ax=None, title: str | None = Non
 def plot_entrance_pupil(pa: PupilAnalysis, *, ax=None, title: str | None = None):
     """The real entrance pupil's shift from the paraxial E0 along the axis (mm, left scale) and
     the lateral viewpoint offset — the distance of the object-space chief ray from E0 (mm, right
-    scale) — against the field."""
+    scale) — against the field.
+
+    The shift is z_EP − z_E0 (absolute z, light toward +z); the offset is the signed
+    perpendicular distance ``(z_EP − z_E0)·sin θ`` (θ the real object-space chief-ray angle),
+    zero at every field for a single-viewpoint camera (:mod:`distortion.telecentricity`). Field
+    axis in degrees (field angles; nominal angles for a finite object) or mm (object heights).
+
+    Parameters
+    ----------
+    pa : PupilAnalysis
+        From ``osc.pupil_analysis`` (``DataError`` for anything else).
+    ax : matplotlib.axes.Axes, optional
+        Draw here (the offset scale goes on ``ax.twinx()``); default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     _check(pa)
     fig, ax = figure_and_axes(ax)
     ax.axhline(0.0, **ZERO)
@@ -98,7 +155,21 @@ def plot_entrance_pupil(pa: PupilAnalysis, *, ax=None, title: str | None = None)
 
 
 def plot_pupils(pa: PupilAnalysis):
-    """One figure of three panels: chief-ray angle, ∂D0/∂s' and the entrance-pupil shift."""
+    """One figure of three panels: chief-ray angle, ∂D0/∂s' and the entrance-pupil shift.
+
+    :func:`plot_chief_ray_angle`, :func:`plot_distortion_slope` and :func:`plot_entrance_pupil`
+    side by side, with their default titles.
+
+    Parameters
+    ----------
+    pa : PupilAnalysis
+        From ``osc.pupil_analysis`` (``DataError`` for anything else).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A new figure of 15 × 4.6 inches (no ``ax=``: the figure is its own).
+    """
     _check(pa)
     fig, axs = panel_figure(1, 3, figsize=(15.0, 4.6))
     plot_chief_ray_angle(pa, ax=axs[0])

@@ -23,7 +23,30 @@ def plot_envelope(mc, *, calibrated: bool = False, limits=(), ax=None, title=Non
     """Percentile envelope of the distortion curve D (µm) along +y against the field angle (deg):
     the 2.5–97.5 % and 16–84 % bands, the median and the nominal lens; ``calibrated`` draws
     ``D_cal`` (what a calibration of each lens leaves: camera constant and principal point
-    removed). ``limits`` [(µm, deg), ...] are drawn as ± marks. Returns the Figure."""
+    removed). ``limits`` [(µm, deg), ...] are drawn as ± marks. Returns the Figure.
+
+    ``D = y' − K0·tan α`` (Pestrecov 1958, Eq. 9, with K0 of Eq. 8 in the refocused plane) and
+    ``D_cal = y' − y0 − c·tan α`` (µm, + = pincushion; :class:`ToleranceOutputs`). A band or the
+    median is drawn only when the run computed those percentiles.
+
+    Parameters
+    ----------
+    mc : MonteCarloResult
+        From ``osc.tolerance_monte_carlo`` (exact or streamed summary).
+    calibrated : bool
+        Draw ``D_cal`` instead of the raw D.
+    limits : sequence of (float, float)
+        (limit in µm, field angle in degrees) pairs, each drawn as an error bar ±limit about 0
+        at that field.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, ax = figure_and_axes(ax)
     f = np.asarray(mc.fields_deg, dtype=float)
     env = np.asarray(mc.envelope_cal_um if calibrated else mc.envelope_um, dtype=float)
@@ -81,7 +104,27 @@ def plot_histogram(values=None, *, label: str, nominal: float | None = None, his
 def plot_sensitivity(rows, *, label: str, top: int = 15, ax=None, title=None):
     """Ranked horizontal bars of a sensitivity table (``rows`` as
     :meth:`SensitivityResult.table` returns them: name, delta_min, delta_max): the change at the
-    item's min and at its max, the largest ``top`` items. Returns the Figure."""
+    item's min and at its max, the largest ``top`` items. Returns the Figure.
+
+    Parameters
+    ----------
+    rows : iterable of dict
+        Each with ``"name"``, ``"delta_min"`` and ``"delta_max"`` (the output's change, signed,
+        in the output's unit), largest first; the first ``top`` are drawn, the largest on top.
+    label : str
+        The x-axis label: the output and its unit (e.g. ``"ΔD_c at 30° (µm)"``); also the
+        default title's.
+    top : int
+        How many rows to draw.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (which is wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, ax = figure_and_axes(ax)
     rows = list(rows)[:top][::-1]
     y = np.arange(len(rows))
@@ -129,12 +172,37 @@ def _hist_panels(mc):
 def plot_tolerance(mc=None, sens=None, *, limits=()):
     """One figure of a tolerancing run: the raw and calibrated envelopes and the histograms
     (when ``mc``, a MonteCarloResult, is given) and the sensitivity bars (``sens``). Returns the
-    Figure."""
+    Figure.
+
+    Panels: :func:`plot_envelope` raw and calibrated (µm against degrees), histograms of P1, P2
+    (calibrated and raw, 1e-6/mm), Fc and F0 (mm) and Fraser & Shortis's g_ss' (Eq. 6; when the
+    run computed it), and the sensitivity of D_c (µm) at the largest field of ``sens``; three
+    panels a row, 5.2 × 3.9 inches each.
+
+    Parameters
+    ----------
+    mc : MonteCarloResult, optional
+        From ``osc.tolerance_monte_carlo``.
+    sens : SensitivityResult, optional
+        From ``osc.tolerance_sensitivity``.
+    limits : sequence of (float, float)
+        (limit in µm, field angle in degrees) pairs drawn on both envelopes
+        (:func:`plot_envelope`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A new figure (no ``ax=``: the figure is its own).
+    """
     panels = []
     if mc is not None:
         panels += ["env", "env_cal"] + [("hist", h) for h in _hist_panels(mc)]
     if sens is not None:
         panels.append("sens")
+    if not panels:
+        raise TypeError(
+            "plot_tolerance needs mc= (a Monte Carlo result), sens= (a sensitivity), or both"
+        )
     cols = 3 if len(panels) > 2 else max(1, len(panels))
     rows = -(-len(panels) // cols)
     fig, axs = panel_figure(rows, cols, figsize=(5.2 * cols, 3.9 * rows))

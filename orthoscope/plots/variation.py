@@ -126,7 +126,26 @@ def plot_g(a: VariationAnalysis, *, ax=None, title: str | None = None):
     """g_ss' (Fraser & Shortis Eq. 6) against the radial distance r (mm) per object plane
     (Figs. 5–7 style). Radii of weak determination (|δr_s' − δr_s| below the analysis threshold)
     are open markers on a dashed line; the estimated g of each plane is a thin horizontal line.
-    ``ax``, ``title``: as :func:`plot_profiles`. Returns the Figure."""
+    ``ax``, ``title``: as :func:`plot_profiles`. Returns the Figure.
+
+    g_ss' is dimensionless: the pointwise values of Eq. (6) from the profiles δr (µm) of the
+    analysis; the legend gives each plane's least-squares g ± its standard error, or
+    "undetermined". The y range is set from the 2nd–98th percentiles of the strong values.
+
+    Parameters
+    ----------
+    a : VariationAnalysis or TracedVariation
+        From :func:`distortion.variation.analyze_variation` or :func:`trace_variation`; its
+        ``threshold_um`` (µm) separates weak from strong radii.
+    ax : matplotlib.axes.Axes, optional
+        Draw here; default a new pyplot figure.
+    title : str, optional
+        Replaces the default title (wrapped to the axes width either way).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     a = _analysis(a)
     fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
     colours = _colours()
