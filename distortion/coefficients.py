@@ -118,7 +118,38 @@ def fit_radial(
 ) -> RadialFit:
     """Fit δr (µm) at radii r (mm) with K1 r³ + … (+ K0 r if ``form="balanced"``), n_terms odd
     terms (1–3 … any ≥ 1). Least squares on the powers of r/r_max (well conditioned), then
-    rescaled. Needs more points than unknowns for standard errors; at least as many to fit."""
+    rescaled. Needs more points than unknowns for standard errors; at least as many to fit.
+
+    Parameters
+    ----------
+    r_mm : array_like
+        Radii in mm, 1-D and finite (measured or ideal radii: see ``radius``).
+    dr_um : array_like
+        Radial distortion δr = r_actual − r_ideal in µm (positive outward = pincushion), same
+        length as ``r_mm``.
+    form : {"gaussian", "balanced"}
+        ``"gaussian"`` (default): ``δr = K1 r³ + K2 r⁵ + …``, no linear term (referred to the
+        Gaussian principal distance); ``"balanced"``: with a linear term ``K0 r`` (a calibrated
+        principal distance; Pestrecov 1958 Eq. 12, module docstring).
+    n_terms : int
+        The number of odd terms K1 r³ … (≥ 1; default 3).
+    radius : {"measured", "ideal"}
+        What r means; only recorded in the result (the fit is the same).
+
+    Returns
+    -------
+    RadialFit
+        ``k0`` (0 for the Gaussian form), ``k`` = (K1, K2, …) in mm⁻², mm⁻⁴, …, their standard
+        errors (NaN without redundancy), residuals ``data − fit`` in µm, their RMS and largest
+        absolute value (µm).
+
+    Raises
+    ------
+    DataError
+        An unknown ``form`` or ``radius``, ``n_terms`` < 1, arrays that are not 1-D of one
+        length, non-finite values, |δr| ≥ r (radii in metres or δr in mm?), fewer points than
+        coefficients, all radii zero.
+    """
     if form not in ("gaussian", "balanced"):
         raise DataError(f"unknown form {form!r} (expected 'gaussian' or 'balanced')")
     if radius not in _RADIUS:
@@ -260,7 +291,45 @@ def opencv_model(
     ideal radius r − δr; the Gaussian (or, with ``balanced=True``, balanced) 3-term polynomial
     is fitted there; a balanced fit is converted to Gaussian with c_g = c (1 + K0); then
     k_i = K_i c_g^(2i). ``fx_px`` = c_g / pitch if the pitch is given.
+
+    Parameters
+    ----------
+    r_mm : array_like
+        Radii in mm (measured or ideal: see ``radius``).
+    dr_um : array_like
+        Radial distortion δr = r_actual − r_ideal in µm (positive outward = pincushion).
+    principal_distance_mm : float, optional
+        c in mm (positive, finite). Give it or ``focal_length_px``, not both.
+    focal_length_px : float, optional
+        c in pixels; needs ``pixel_pitch_um``.
+    pixel_pitch_um : float, optional
+        Pixel pitch in µm (a number; a value that looks like mm is refused). With it the result
+        also has ``fx`` and residuals in pixels.
+    radius : {"measured", "ideal"}
+        What r means (default the measured radius, the photogrammetric convention).
+    balanced : bool
+        Fit the balanced form (with a linear term K0 r) instead of the Gaussian one.
+
+    Returns
+    -------
+    OpenCVModel
+        k1, k2, k3 (dimensionless, same signs as K: k1 > 0 is pincushion), the Gaussian principal
+        distance c_g and the given c (mm), the pitch (µm), fx = c_g / pitch (px, or None), the
+        :class:`RadialFit`, the Gaussian K1–K3, the RMS and largest residual in px (None
+        without a pitch) and notes.
+
+    Raises
+    ------
+    DataError
+        Neither or both of ``principal_distance_mm`` and ``focal_length_px``, a focal length in
+        pixels without a pitch, c not positive, a pitch :func:`parse_pitch_um` refuses, an
+        unknown ``radius``, |δr| ≥ r, c below the largest radius / 19 (a unit slip), or a profile
+        :func:`fit_radial` refuses.
     """
+    if pixel_pitch_um is not None:
+        from .camera.sensor import parse_pitch_um
+
+        pixel_pitch_um = parse_pitch_um(pixel_pitch_um)[0]  # µm, or "6um" / "0.006mm"
     if principal_distance_mm is None:
         if focal_length_px is None:
             raise DataError("give the principal distance in mm, or the focal length in pixels")
@@ -275,10 +344,6 @@ def opencv_model(
     c = float(principal_distance_mm)
     if not (c > 0 and math.isfinite(c)):
         raise DataError(f"principal distance must be positive, got {c!r}")
-    if pixel_pitch_um is not None:
-        from .camera.sensor import parse_pitch_um
-
-        pixel_pitch_um = parse_pitch_um(float(pixel_pitch_um))[0]
     if radius not in _RADIUS:
         raise DataError(f"unknown radius convention {radius!r}")
     r = np.asarray(r_mm, dtype=float)

@@ -107,14 +107,48 @@ def compensate(
     magnification: float | None = None,
     at=None,
 ) -> CompensationResult:
-    """Residual distortion of the print of ``camera``'s negative by ``printer`` (Eq. 16).
+    """Residual distortion of the print of ``camera``'s negative by ``printer`` (Pestrecov 1958,
+    Eq. 16).
 
-    camera: object at infinity (field angles, constant F1 in mm, D1 in the negative).
-    printer: finite conjugates with the negative as its object (object heights in mm, constant M2,
-        D0 in the print plane).
-    method: how M is chosen: ``given`` (``magnification``, default M2 — the paper's compensation
-        condition for characteristic curves) or any calibration method over the camera's fields
-        (``two-point`` / ``zero-at`` with ``at`` angles, ``minimax``, ``least-squares``).
+    The residual in the negative plane is ``R = D1 − D2 − (M/M2 − 1)·F1·tan α`` (module
+    docstring); D2 is taken at the actual negative point ``y' = F1 tan α + D1``.
+
+    Parameters
+    ----------
+    camera : DistortionCurve
+        The camera lens for an object at infinity: field angles α (degrees), constant F1 (mm), D1
+        (mm) in the negative.
+    printer : DistortionCurve
+        The printer for finite conjugates with the negative as its object: object heights h in
+        the negative (mm), constant M2 (its image-space magnification, signed), D0 (mm) in the
+        print plane. Its heights must reach the camera's largest image height.
+    method : {"given", "two-point", "zero-at", "minimax", "least-squares"}
+        How the print magnification factor M is chosen: ``"given"`` (default) uses
+        ``magnification`` (default M2 — the paper's compensation condition for characteristic
+        curves); the others are calibration fits over the camera's fields
+        (:mod:`distortion.calibration`), ``"two-point"`` and ``"zero-at"`` at the ``at`` fields.
+    magnification : float, optional
+        M (Eq. 16), with ``method="given"`` only; of the sign of M2.
+    at : sequence of float, optional
+        Field angles (degrees) of the camera curve: two for ``"two-point"``, one for
+        ``"zero-at"``; none for the other methods.
+
+    Returns
+    -------
+    CompensationResult
+        F1, M2, the M used, the camera image ``F1 tan α`` and the actual negative point (mm), D1
+        and D2 (mm, negative plane), the residual R (mm, negative plane) and ``M2·R``, the
+        distortion of the print (mm, print plane).
+
+    Raises
+    ------
+    DataError
+        The camera curve is not for an object at infinity, the printer curve not for finite
+        conjugates, or the camera's image reaches beyond the printer curve's heights.
+    CalibrationError
+        An unknown method; ``at`` with a method that takes none, or the wrong number of ``at``
+        fields, or one that is not among the camera's fields; ``magnification`` with a method
+        other than ``"given"`` or of the other sign than M2; a degenerate magnification.
     """
     if camera.finite:
         raise DataError("the camera curve must be for an object at infinity (field angles, F1)")

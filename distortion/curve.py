@@ -273,7 +273,40 @@ def make_curve(
     decimals: int = 4,
 ) -> DistortionCurve:
     """Build a :class:`DistortionCurve` from arrays, computing ``x`` and ``y0'`` when not given
-    (``x = tan α`` for angles, ``x = y`` for heights; a nominal-angle curve needs ``x``)."""
+    (``x = tan α`` for angles, ``x = y`` for heights; a nominal-angle curve needs ``x``).
+
+    Parameters
+    ----------
+    fields : array_like
+        Field values: angles α in degrees (``"angle"``, ``"nominal-angle"``) or object heights y
+        in mm (``"height"``).
+    D0 : array_like
+        Linear distortion ``D0 = y' − y0'`` in mm (Pestrecov 1958, Eq. 9), one per field.
+    field_kind : {"angle", "height", "nominal-angle"}
+        ``"angle"`` (default): object at infinity; ``"height"``: finite conjugates;
+        ``"nominal-angle"``: finite conjugates, α standing for the object height y = p0 tan α.
+    constant : float
+        K0 of Eq. (8): F0 in mm (object at infinity) or M0 (finite conjugates; signed, negative
+        for a real inverted image).
+    x : array_like, optional
+        The abscissa of orthoscopy, ``tan α`` or y (mm); default from ``fields``.
+    y0p : array_like, optional
+        The ideal image size y0' in mm; default ``constant·x``.
+    name, plane, source : str
+        Free text for titles and tables (lens, image plane, origin).
+    decimals : int
+        Decimals to print linear quantities with (default 4; 3 reproduces the paper's tables).
+
+    Returns
+    -------
+    DistortionCurve
+
+    Raises
+    ------
+    ValueError
+        An unknown ``field_kind``, a nominal-angle curve without ``x``, or arrays of different
+        lengths.
+    """
     if field_kind not in FIELD_KINDS:
         raise ValueError(f"unknown field kind {field_kind!r}; expected one of {FIELD_KINDS}")
     f = np.asarray(fields, dtype=float).ravel()

@@ -363,7 +363,30 @@ def sensor_metrics(grid, plane: int = 0) -> SensorMetrics:
     ``plane`` (0-based): the picture is the rectangle its ideal points span — the sensor, for a
     grid made with ``sensor=`` (e.g. ``distortion_grid(lens, sensor="36x24", grid=(21, 15))``).
 
-    The counts of the grid must be odd (the edge centres are traced points)."""
+    The counts of the grid must be odd (the edge centres are traced points).
+
+    Parameters
+    ----------
+    grid : DistortionGrid
+        A 2-D grid of fields (rows × columns, odd counts) whose ideal points form a rectangular
+        lattice.
+    plane : int
+        The grid's image plane, 0-based (default 0).
+
+    Returns
+    -------
+    SensorMetrics
+        TV distortion (SMIA and traditional, vertical and horizontal; fractions, negative =
+        barrel), keystone, line straightness and the anamorphic ratio, measured on the traced
+        points; the picture's size in mm.
+
+    Raises
+    ------
+    DataError
+        ``plane`` out of range, a grid that is not 2-D, ideal points that are not a rectangular
+        lattice, fewer than 3 or an even number of rows or columns, a middle row or column that
+        is not the picture's centre line.
+    """
     if not 0 <= int(plane) < grid.n_planes:
         raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")
     if len(grid.shape) != 2:

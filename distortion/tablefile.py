@@ -84,10 +84,33 @@ def read_distortion_table(
     ``y0' = K0·x`` to the rounding of the printed ``y0'``; an optional ``Dr`` column (per cent)
     must agree with ``100·D0/y0'`` to the rounding of the printed numbers.
 
-    Raises :class:`raytrace.errors.DataError` naming the file and line for: an unreadable file,
-    a missing header or column, an unparseable number, NaN/inf, a row with the wrong number of
-    cells, non-monotonic fields, fewer than two off-axis rows, inconsistent y0' or Dr.
-    ``text`` may carry the file's content (then ``path`` is only used in messages).
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file; with ``text`` only used in messages and for the default name.
+    constant : float, optional
+        K0 of Pestrecov's Eq. (8): F0 in mm (angle tables, object at infinity) or M0 (height
+        tables, finite conjugates); finite and nonzero. Default: inferred.
+    name : str, optional
+        The curve's name; default the file name's stem.
+    text : str, optional
+        The file's content, read instead of the file.
+
+    Returns
+    -------
+    DistortionCurve
+        Fields (degrees or mm), x (tan α or y), y0' = K0·x recomputed exactly (mm), D0 (mm, Eq. 9:
+        y' − y0'), K0, the file's comments as ``source``; ``extra`` holds the path and the data
+        lines.
+
+    Raises
+    ------
+    DataError
+        Naming the file and line, for: an unreadable file, a missing header or column, an
+        unknown or duplicated column, an unparseable number, NaN/inf, a row with the wrong number
+        of cells, non-monotonic fields, a field angle not below 90°, fewer than two off-axis
+        rows, a ``constant`` that is zero or not finite, inconsistent y0' or Dr, |D0| ≥ |y0'|
+        (a D0 column in µm).
     """
     where = str(path)
     if text is None:

@@ -258,10 +258,47 @@ AIR = Material("air")
 
 
 def model_glass(nd: float, vd: float, model: str = "cauchy2") -> Material:
-    """An nd/vd model glass with dispersion law ``model`` (see :data:`MODELS`)."""
+    """An nd/vd model glass with dispersion law ``model`` (see :data:`MODELS`).
+
+    Parameters
+    ----------
+    nd : float
+        Refractive index at the d line (587.56 nm); positive, finite.
+    vd : float
+        Abbe number (nd − 1)/(nF − nC); positive, finite.
+    model : str
+        The dispersion law, one of :data:`MODELS`: ``"cauchy2"`` (default; ``""`` means it),
+        ``"buchdahl-rayoptics"``, ``"buchdahl-optiland"``.
+
+    Returns
+    -------
+    Material
+        ``kind="model"``.
+
+    Raises
+    ------
+    ValueError
+        nd or vd not positive and finite, an unknown ``model``.
+    """
     return Material("model", float(nd), float(vd), model=model)
 
 
 def fixed_index(n: float) -> Material:
-    """A non-dispersive medium of index ``n``."""
+    """A non-dispersive medium of index ``n``.
+
+    Parameters
+    ----------
+    n : float
+        The refractive index at every wavelength (positive, finite).
+
+    Returns
+    -------
+    Material
+        ``kind="index"``.
+
+    Raises
+    ------
+    ValueError
+        An index that is not positive and finite.
+    """
     return Material("index", float(n))

@@ -180,3 +180,31 @@ def test_plots_say_what_they_need(cooke, tmp_path):
     fig = osc.plot_lateral_colour(lc)
     assert fig.axes[0].get_xlabel() == "nominal field angle (deg)"
     plt.close(fig)
+
+
+def test_docstring_pass_findings(cooke, tmp_path):
+    # found while documenting every public function (2026-11-27)
+    spec = osc.read_spec("twinplex-like-55-525")
+    with pytest.raises(SpecError, match="unknown method 'lbfgs'"):
+        osc.optimize(cooke, spec, method="lbfgs")  # check_spec refuses it (as it should)
+    from raytrace.files.library import library_dir
+
+    specs = library_dir() / "specs"
+    text = (specs / "twinplex-like-55-525.toml").read_text(encoding="utf-8")
+    text = text.replace(f'start = "{spec.start}"', f'start = "{(specs / spec.start).as_posix()}"')
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + text.encode())  # a byte-order mark (Notepad)
+    assert osc.read_spec(bom).name == spec.name
+    empty = tmp_path / "empty.csv"
+    empty.write_text("r_mm,dr_um,focus,object\n")
+    with pytest.raises(DataError, match="no profile: the file holds no data rows"):
+        osc.read_profiles_csv(empty, min_profiles=1)
+    g = osc.distortion_grid(cooke, grid=5)
+    with pytest.raises(DataError, match="pixel_mm=0"):
+        osc.fit_brown_conrady(g, pixel_mm=0)
+    from distortion.coefficients import opencv_model
+
+    r = np.array([4.0, 8.0, 12.0, 16.0, 20.0])
+    a = opencv_model(r, r**3 * 1e-3, focal_length_px=9000, pixel_pitch_um="5um")
+    b = opencv_model(r, r**3 * 1e-3, focal_length_px=9000, pixel_pitch_um=5.0)
+    assert (a.k1, a.k2, a.k3) == (b.k1, b.k2, b.k3)

@@ -102,6 +102,29 @@ def read_calibration(
 
     ``camera_id`` chooses a camera of a COLMAP ``cameras.txt`` with several (default: the only
     one). Errors name the file and line and say what to fix (:class:`DataError`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The calibration file.
+    format : str, optional
+        One of :data:`FORMATS` (``"opencv-yaml"``, ``"opencv-json"``, ``"colmap"``,
+        ``"metashape"``, ``"photoscan"``, ``"australis"``). Default from the name: ``.yml``/
+        ``.yaml``, ``.json``, ``.xml`` (Metashape, or legacy PhotoScan by its content), ``.txt``
+        (COLMAP, or this package's Australis text by its first line), ``.aus``/``.australis``.
+    camera_id : int, optional
+        The COLMAP camera id to read.
+
+    Returns
+    -------
+    CameraModel
+        In the file's own model, units and conventions.
+
+    Raises
+    ------
+    DataError
+        An unreadable file, an unknown format or one the name does not tell, a malformed file, a
+        COLMAP file with several cameras and no ``camera_id``, or an id it does not hold.
     """
     p = Path(path)
     try:
@@ -492,7 +515,37 @@ def write_calibration(
 ) -> Path:
     """Write ``camera`` as a calibration file (format from ``format=`` or the file name; a
     ``.txt`` is COLMAP unless ``format="australis"``). Goes through ``write_atomic``: an
-    existing file is replaced only with ``overwrite=True``."""
+    existing file is replaced only with ``overwrite=True``.
+
+    Parameters
+    ----------
+    camera : CameraModel
+        Converted exactly to the format's model family when needed.
+    path : str or os.PathLike
+        The file to write.
+    format : str, optional
+        One of :data:`FORMATS`; default from the file name (as :func:`read_calibration`).
+    camera_id : int
+        The camera id written in a COLMAP ``cameras.txt`` (default 1).
+    overwrite : bool
+        Replace an existing file.
+    inputs : iterable of paths
+        Files the output must not be (the files the camera was read from).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    DataError
+        An unknown format, a name that does not tell it, a camera only a refit could convert to
+        the format.
+    OutputError
+        The path is one of ``inputs``, exists without ``overwrite``, is a folder, its folder is
+        missing or not writable, or the write fails.
+    """
     fmt = _check_format(format) if format else detect_format(path)
     return write_atomic(
         path,

@@ -392,7 +392,43 @@ def select_camera_model(
     pixels: str = "opencv",
 ) -> ModelSelection:
     """Fit a ladder of candidates (a family of :data:`FAMILIES`, or (model, free) pairs,
-    simplest first) and choose by the criterion of the module docstring."""
+    simplest first) and choose by the criterion of the module docstring.
+
+    Parameters
+    ----------
+    ideal : array_like
+        (N, 2) ideal normalised coordinates X/Z, Y/Z (x right, y down), or (N, 3) directions.
+    image_px : array_like
+        (N, 2) observed image points in the frame ``pixels``.
+    family : str or sequence of (str, free)
+        A family of :data:`FAMILIES` (``"opencv"``, ``"opencv_fisheye"``, ``"colmap"``,
+        ``"colmap_fisheye"``, ``"metashape"``, ``"australis"``), or the candidates as (model
+        name, free) pairs, simplest first; ``free`` as in :func:`fit_camera_model` (parameter
+        names, an OpenCV coefficient count, or None for the model's default).
+    width, height : int
+        The image size in pixels.
+    pixel_size_mm : (float, float), optional
+        Pixel pitch (x, y) in mm; needed by models in mm (``australis``).
+    rms_target_px : float
+        The first candidate with an RMS residual at or below this (px) is chosen (default
+        0.001 px).
+    min_improvement : float
+        Otherwise a candidate is accepted only if it lowers the RMS of the last accepted one by
+        more than this fraction (default 0.1, i.e. 10 %).
+    pixels : str
+        Frame of ``image_px``: ``"opencv"`` (default), ``"colmap"``, ``"metashape"``,
+        ``"photo_mm"``.
+
+    Returns
+    -------
+    ModelSelection
+        ``chosen`` (a :class:`CameraFit`), every candidate's fit, and the criterion in words.
+
+    Raises
+    ------
+    DataError
+        An unknown family, or a candidate :func:`fit_camera_model` refuses.
+    """
     ladder = FAMILIES.get(family) if isinstance(family, str) else tuple(family)
     if ladder is None:
         raise DataError(f"unknown model family {family!r}; use one of {', '.join(FAMILIES)}")

@@ -190,6 +190,16 @@ def distortion_picture(
         Preview scale (default: at most 1200 pixels wide).
     new_camera_matrix : (3, 3) array_like, optional
         The ideal camera (default: the model's pinhole part).
+
+    Returns
+    -------
+    DistortionPicture
+        The warped pattern (uint8 image at the preview scale) with its spacing and scale.
+
+    Raises
+    ------
+    DataError
+        OpenCV is not installed (the ``camera`` extra), or an unknown pattern.
     """
     try:
         import cv2

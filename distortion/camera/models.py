@@ -1121,7 +1121,30 @@ def camera_from_sensor(
 ) -> CameraModel:
     """A camera of ``model`` for a sensor and a principal distance (mm): focal lengths
     c / pitch, principal point from the sensor's offset, the given coefficients, others at
-    their identity."""
+    their identity.
+
+    Parameters
+    ----------
+    model : str
+        A camera model name (:data:`MODEL_NAMES`: ``"opencv"``, ``"opencv_fisheye"``,
+        ``"colmap:OPENCV"``, ``"metashape"``, ``"australis"``, …).
+    sensor : Sensor
+        Gives the image size (pixels), the pixel pitch and the principal-point offset.
+    principal_distance_mm : float
+        c in mm (positive, finite): fx = c / pitch_x and fy = c / pitch_y in pixels.
+    **coefficients : float
+        Model parameters by name (e.g. ``k1=-0.05``), in the model's own units and conventions.
+
+    Returns
+    -------
+    CameraModel
+
+    Raises
+    ------
+    DataError
+        A principal distance that is not positive and finite, an unknown model, a parameter the
+        model does not have.
+    """
     c = float(principal_distance_mm)
     if not (math.isfinite(c) and c > 0):
         raise DataError(f"principal distance must be positive (mm), got {principal_distance_mm!r}")

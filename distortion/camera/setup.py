@@ -466,7 +466,25 @@ def camera_setup_from_dict(doc: dict, where: str = "camera spec") -> CameraSetup
 
 
 def read_camera_setup(path: str | os.PathLike) -> CameraSetup:
-    """Read a TOML camera spec (module docstring) into a :class:`CameraSetup`."""
+    """Read a TOML camera spec (module docstring) into a :class:`CameraSetup`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file: ``[sensor]`` (``size``, ``pixels`` or ``pitch_um``,
+        ``principal_point_offset_mm``) and optionally ``[object]``, ``[focus]`` and ``[trace]``
+        in the words of the module docstring (mm, ``inf``, ``"2m"``, ``"12x"``; nm).
+
+    Returns
+    -------
+    CameraSetup
+
+    Raises
+    ------
+    DataError
+        An unreadable file, invalid TOML, unknown tables or keys (with the nearest valid one), no
+        ``[sensor]`` table, or values the setup refuses.
+    """
     import tomllib
 
     p = Path(path)

@@ -617,7 +617,32 @@ def camera_model(
 def opencv_coefficients(lens, sensor, *, n_coefficients: int | None = None, **kw) -> TracedCamera:
     """OpenCV's camera matrix and distortion coefficients of ``lens`` on ``sensor``:
     :func:`camera_model` with ``model="opencv"`` (as many coefficients as the criterion needs,
-    or ``n_coefficients``). ``.camera_matrix`` and ``.dist_coeffs`` are what ``cv2`` takes."""
+    or ``n_coefficients``). ``.camera_matrix`` and ``.dist_coeffs`` are what ``cv2`` takes.
+
+    Parameters
+    ----------
+    lens : Lens
+    sensor : Sensor, CameraSetup or path
+        The sensor, a whole camera setup, or a TOML camera spec file (as :func:`camera_model`).
+    n_coefficients : int, optional
+        Fix the OpenCV vector length (4, 5, 8, 12 or 14) instead of choosing it.
+    **kw
+        The other keywords of :func:`camera_model`: the object plane (``object_distance``,
+        ``object_s``, ``object_scale``; mm, ``inf``, ``"2m"``, ``"12x"``), the focus (``focus``,
+        ``focus_s``, ``focus_scale``, or ``s_prime``, ``from_last_vertex``, ``defocus`` in mm),
+        ``wavelength`` (nm, ``"0.55um"``, ``"d"``), ``grid``, ``clip``, ``free``.
+
+    Returns
+    -------
+    TracedCamera
+        ``.camera`` (an ``opencv`` :class:`CameraModel`), the residuals in pixels, the traced
+        points.
+
+    Raises
+    ------
+    DataError, TraceError, LensError
+        As :func:`camera_model`: a setup or keyword it refuses, a trace that fails.
+    """
     return camera_model(lens, sensor, "opencv", n_coefficients=n_coefficients, **kw)
 
 

@@ -165,6 +165,8 @@ def fit_brown_conrady_points(
     free = BROWN_PARAMS if affinity else BROWN_PARAMS[:8]
     n_free = len(free)
     p = float(pixel_mm)
+    if not (p > 0 and math.isfinite(p)):
+        raise DataError(f"pixel_mm={pixel_mm!r}: the virtual camera's pitch is a positive mm")
     if t.shape[0] * 2 <= n_free:
         return _undetermined(
             plane,
@@ -294,6 +296,34 @@ def fit_brown_conrady(
     P2 (and b1, b2 when ``affinity``); their correlations are in ``correlation``. With a grid
     made for a sensor the photogrammetric frame's origin is the sensor centre. ``opencv``: also
     OpenCV's k1 k2 p1 p2 k3 (camera module conversion, with its residual).
+
+    Parameters
+    ----------
+    grid : DistortionGrid
+        The traced grid; its camera constant in ``plane`` starts c.
+    plane : int
+        The grid's image plane, 0-based (default 0).
+    affinity : bool
+        Fit b1, b2 too (the full 10 parameters; default); False: 8 parameters, b1 = b2 = 0.
+    opencv : bool
+        Also convert to OpenCV's k1 k2 p1 p2 k3 (default True).
+    pixel_mm : float
+        Pitch in mm of the virtual camera the fit runs in (default :data:`PIXEL_MM`, 1 µm, so
+        residuals in its pixels are micrometres).
+
+    Returns
+    -------
+    BrownConradyFit
+        c, xp, yp (mm), K1 (mm⁻²), K2 (mm⁻⁴), K3 (mm⁻⁶), P1, P2 (mm⁻¹), b1, b2 — Australis'
+        correction at the measured radius — their standard errors and correlations, the residuals
+        (mm) and the OpenCV conversion. A grid that cannot determine the model gives a result
+        with ``not_determined`` saying why and NaN values.
+
+    Raises
+    ------
+    DataError
+        ``plane`` out of range, or an image that does not grow with the field (no positive
+        camera constant).
     """
     if not 0 <= int(plane) < grid.n_planes:
         raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")

@@ -164,7 +164,64 @@ def sensitivity(
     Raises ToleranceSpecError (one line, naming the item) when an item at one of its limits
     makes the lens untraceable, saying so when the limit looks like another unit
     (:func:`distortion.tolerance.checks.unit_hint`); warns (:class:`UnitWarning`) for such a
-    limit that still traces."""
+    limit that still traces.
+
+    Parameters
+    ----------
+    lens : Lens
+        The nominal lens.
+    spec : ToleranceSpec
+        The items, their limits and the compensator
+        (:func:`raytrace.tolerance.read_tolerance_spec`).
+    fields_deg : array_like, optional
+        Curve field angles in degrees along +y, in [0, 90); default 50 from 0 to the lens's
+        field.
+    object_distance : float or str, optional
+        mm from the object plane to the first vertex (positive; ``inf``, ``"2m"``, ``"10x"``);
+        default the lens's.
+    wavelength : float or str, optional
+        nm (or ``"0.55um"``, ``"d"``); default the lens's reference wavelength.
+    which : {"limits"}
+        Each item at its ``min`` and at its ``max`` (the only choice).
+    grid_rings : sequence of float
+        Rings of the 2-D fit points, fractions of the largest curve field (default 0.2 … 1.0);
+        at least ``radial_terms`` + 2 distinct ones.
+    grid_azimuths : int
+        Points per ring (default 8; fewer than 3: no 2-D fit).
+    radial_terms : int
+        Radial order of the 2-D fit (c, K1 … K_n; default 3).
+    g_object_distance : float or str, optional
+        The object plane s' of Fraser & Shortis's g_ss' (Eq. 6), the lens focused at
+        ``object_distance`` by its compensator (mm, ``inf``, ``"2m"``, ``"10x"``); default the
+        spec's ``[outputs] g_object_distance``; without either g is not computed (NaN).
+    setup : ToleranceSetup, optional
+        A prepared setup to reuse; the arguments from ``fields_deg`` to ``g_object_distance``
+        are then ignored.
+
+    Returns
+    -------
+    SensitivityResult
+        The nominal outputs and every item's outputs at its min and max (``rss`` is the linear
+        prediction of a Monte Carlo's spread).
+
+    Raises
+    ------
+    ToleranceSpecError
+        A spec that does not fit the lens, or an item whose limit makes the lens untraceable.
+    TypeError
+        ``spec`` is not a ToleranceSpec.
+    TraceError
+        Field angles out of range, or a nominal chief ray that fails.
+    DataError
+        Too few distinct ``grid_rings``, or a g_ss' plane that cannot be defined.
+    ValueError
+        ``which`` other than ``"limits"``.
+
+    Warns
+    -----
+    UnitWarning
+        A limit that looks like another unit but still traces.
+    """
     st = setup or prepare(lens, spec, fields_deg=fields_deg, object_distance=object_distance,
                           wavelength=wavelength, grid_rings=grid_rings,
                           grid_azimuths=grid_azimuths, radial_terms=radial_terms,

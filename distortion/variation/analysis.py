@@ -448,8 +448,40 @@ def analyze_variation(
     over planes and its precision (sample SD), and the RMS error of Eq. (6) with that mean g per
     plane. Per focus with ≥ 2 profiles: the within-field variation. For each Gaussian profile
     bracketed by two others: the Eq. (3)–(4) prediction. ``messages`` state what could not be
-    estimated and why. ``ps`` may be the path of a profile CSV
-    (:func:`distortion.variation.profiles.read_profiles_csv` reads it).
+    estimated and why.
+
+    Parameters
+    ----------
+    ps : ProfileSet, str or os.PathLike
+        The profiles (δr in µm, positive outward, at radii r in mm), or the path of a profile CSV,
+        read by :func:`distortion.variation.profiles.read_profiles_csv` with the file's own focal
+        length. At least two profiles.
+    r_min, r_max : float, optional
+        Radial range in mm (non-negative, finite, ``r_min < r_max``) over which g_ss' is
+        estimated and the profiles are compared; default all common radii.
+    threshold_um : float
+        Radii where |δr_s' − δr_s| < ``threshold_um`` (µm, ≥ 0, finite) are left out of the
+        g_ss' estimate; default :data:`~distortion.variation.models.WEAK_THRESHOLD_UM` (0.5 µm).
+    method : {"lsq", "mean"}
+        How g_ss' is estimated from Eq. (6): ``"lsq"`` (default) least squares through the
+        origin of δr_ss' − δr_s against δr_s' − δr_s; ``"mean"`` the mean of the pointwise
+        ratios over the radial range, as in the paper.
+
+    Returns
+    -------
+    VariationAnalysis
+        γ_ss' of each non-Gaussian profile whose image scales are known, Brown's Eq. (1)
+        comparisons, the per-focus g_ss' summaries, the within-field variation, the Eq. (3)–(4)
+        checks, the options used and the ``messages``.
+
+    Raises
+    ------
+    TypeError
+        ``ps`` is neither a ProfileSet nor a path.
+    DataError
+        Fewer than two profiles; a negative or non-finite ``r_min``/``r_max``, ``r_min`` not
+        below ``r_max``, a negative or non-finite ``threshold_um``, an unknown ``method``; or a
+        CSV that :func:`~distortion.variation.profiles.read_profiles_csv` refuses.
     """
     check_analysis_options(r_min, r_max, threshold_um, method)
     if isinstance(ps, str | os.PathLike):

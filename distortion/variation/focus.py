@@ -115,6 +115,41 @@ def solve_focus(
     moves forward, the rest stays). Inner focusing: ``moving``/``compensating`` = the air spaces
     before / after the group (the track stays). δ is solved (secant method) until the Gaussian
     image of the object lies within :data:`FOCUS_TOLERANCE_MM` of the image plane.
+
+    Parameters
+    ----------
+    lens : Lens
+        A centred lens; its image plane (the sensor) is the end of its last thickness and stays
+        where it is.
+    distance_mm : float
+        Focus distance in mm from the object plane to the image plane (positive; ``inf``), as a
+        focusing scale reads it — not the Lens convention (object plane to first vertex).
+    moving : int
+        The surface (1-based) whose following thickness changes by δ.
+    compensating : int, optional
+        The surface (1-based, not ``moving``) whose following thickness changes by −δ; default
+        none.
+    name : str, optional
+        The configuration's name; default ``"inf"`` or the distance in metres (``"2 m"``).
+    wavelength : float or str, optional
+        nm (or what :func:`raytrace.paraxial.paraxial` takes: ``"0.55um"``, a line letter
+        ``"d"``); default the lens's reference wavelength. The lens is focused at it.
+
+    Returns
+    -------
+    Configuration
+        The new thicknesses of ``moving`` (and ``compensating``), mm, and the object distance
+        (mm from the object plane to the first vertex; ``inf``).
+
+    Raises
+    ------
+    DataError
+        A surface number outside 1..n, ``compensating == moving``, a distance that is not
+        positive, an object plane inside the lens, a solve that meets an impossible lens or
+        does not converge.
+    LensError, TraceError
+        From :func:`raytrace.paraxial.paraxial` at the start of the solve (an afocal or
+        non-centred lens, a wavelength the unit checks refuse).
     """
     n = lens.n_surfaces
     for k, what in ((moving, "moving"), (compensating, "compensating")):
@@ -164,7 +199,31 @@ def focus_configurations(
     compensating: int | None = None,
     wavelength: float | None = None,
 ) -> Configurations:
-    """:func:`solve_focus` for each focus distance (mm from the image plane; ``inf``)."""
+    """:func:`solve_focus` for each focus distance (mm from the image plane; ``inf``).
+
+    Parameters
+    ----------
+    lens : Lens
+    distances_mm : sequence of float
+        Focus distances in mm from the object plane to the image plane (positive; ``inf``).
+    moving, compensating : int
+        Surfaces (1-based) whose following thicknesses change by δ and −δ (``compensating``
+        optional), as in :func:`solve_focus`.
+    wavelength : float or str, optional
+        nm; default the lens's reference wavelength.
+
+    Returns
+    -------
+    Configurations
+        One :class:`~raytrace.files.configurations.Configuration` per distance, in order, named
+        as :func:`solve_focus` names them; ``current`` is 1 and ``source`` says which surfaces
+        move.
+
+    Raises
+    ------
+    DataError, LensError, TraceError
+        As :func:`solve_focus`.
+    """
     return Configurations(
         tuple(
             solve_focus(lens, d, moving=moving, compensating=compensating, wavelength=wavelength)
@@ -426,11 +485,55 @@ def focus_study(
 ) -> FocusStudy:
     """Trace every configuration of ``lens`` and test Brown's model on them (module docstring).
 
-    calibrated: the two configurations (0-based) whose Gaussian profiles calibrate Eq. (3)–(4)
-    (default: the first and the last). focus_index: with it, the other configurations' object
-    planes are also traced with the lens in that configuration (δr_ss') and the whole profile
-    set goes through :func:`distortion.variation.analyze_variation` (γ, Eq. 1, g of Eq. 6).
-    Each configuration must give its object distance (surface 0) or keep the lens's.
+    Each configuration is traced in its own image plane (the end of its last thickness): its
+    image scale N = −1/m0, principal distance (image plane from H'), camera constant p0'/m_e
+    (Pestrecov Eq. 8) and Gaussian profile δr_s = Pestrecov's D0 (Eq. 9). Brown's γ_ss' (Fraser &
+    Shortis Eq. 2) and Eq. (3)–(4) are then compared with the traced profiles.
+
+    Parameters
+    ----------
+    lens : Lens
+        The base lens (centred).
+    configurations : Configurations
+        At least two, each focused at a different image scale (e.g. from
+        :func:`focus_configurations`). Each must give its object distance (surface 0) or keep
+        the lens's.
+    calibrated : (int, int), optional
+        The two configurations (0-based, different) whose Gaussian profiles calibrate Eq. (3)–(4);
+        default the first and the last.
+    focus_index : int, optional
+        A configuration (0-based). With it, the other configurations' object planes are also
+        traced with the lens in this configuration (δr_ss'; configurations focused at infinity
+        are skipped) and the whole profile set goes through
+        :func:`distortion.variation.analyze_variation` (γ, Eq. 1, g of Eq. 6).
+    n_fields : int
+        Field angles traced, from 0 to the largest (≥ 8; default 61).
+    n_r : int
+        Radii of the common grid the profiles are compared on (≥ 2; default 25).
+    max_field_deg : float, optional
+        The largest field angle in degrees, in (0, 90); default the lens's field, which must then
+        be an angle.
+    wavelength : float or str, optional
+        nm; default the lens's reference wavelength.
+
+    Returns
+    -------
+    FocusStudy
+        ``settings`` (one :class:`FocusSetting` per configuration: lengths in mm, δr in µm,
+        outward positive, against r = |y'|), ``gamma`` (Brown's γ against the first),
+        ``interpolation`` (Eq. 3–4 tests, with three or more configurations), ``analysis`` (with
+        ``focus_index``, else None) and ``notes``.
+
+    Raises
+    ------
+    PrescriptionError
+        A configuration changes a surface the lens does not have.
+    DataError
+        Fewer than two configurations, ``n_fields`` < 8 or ``n_r`` < 2, a field limit outside
+        (0, 90)° or missing for a lens whose field is a height, two configurations at the same
+        image scale, a bad ``calibrated`` pair or ``focus_index``, a trace that fails.
+    LensError
+        A configuration that makes an impossible lens.
     """
     check_surfaces(lens, configurations)
     if len(configurations) < 2:
@@ -497,5 +600,24 @@ def unit_focus_configurations(
     lens: Lens, distances_mm: Sequence[float], *, wavelength: float | None = None
 ) -> Configurations:
     """Unit focusing of ``lens``: only the last thickness (the back focus) and the object
-    distance change; :func:`solve_focus` with ``moving`` = the last surface."""
+    distance change; :func:`solve_focus` with ``moving`` = the last surface.
+
+    Parameters
+    ----------
+    lens : Lens
+    distances_mm : sequence of float
+        Focus distances in mm from the object plane to the image plane (positive; ``inf``).
+    wavelength : float or str, optional
+        nm; default the lens's reference wavelength.
+
+    Returns
+    -------
+    Configurations
+        One configuration per distance (:func:`focus_configurations`).
+
+    Raises
+    ------
+    DataError, LensError, TraceError
+        As :func:`solve_focus`.
+    """
     return focus_configurations(lens, distances_mm, moving=lens.n_surfaces, wavelength=wavelength)

@@ -78,13 +78,44 @@ def read_profiles_csv(
 ) -> ProfileSet:
     """Read a CSV of radial distortion profiles (format in the module docstring).
 
-    ``min_profiles`` (default 2, what a variation analysis needs; 1 for a coefficient fit of a
-    single profile) is the fewest profiles the file must hold.
+    Rows with the same (focus, object) pair form one profile δr(r) of Fraser & Shortis (1992): the
+    lens focused at ``focus`` (s), the object plane at ``object`` (s'); δr_ss' when they differ,
+    the Gaussian profile δr_s when they are the same.
 
-    ``focal_length_mm`` overrides the file's ``# focal_length_mm:`` metadata. Raises DataError
-    (naming the file and line) for a missing header, missing columns, units not stated,
-    non-numeric values, a column mixing image scales and metres, duplicate radii, profiles of
-    fewer than two points, or fewer than two profiles.
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file (UTF-8 text; a byte-order mark is allowed).
+    focal_length_mm : float, optional
+        Focal length f in mm; overrides the file's ``# focal_length_mm:`` metadata. Needed to turn
+        distances in metres into image scales (Eq. 2); must be positive and finite.
+    min_profiles : int
+        The fewest profiles the file must hold: 2 (default, what a variation analysis needs), 1
+        for a coefficient fit of a single profile.
+
+    Returns
+    -------
+    ProfileSet
+        The profiles (radii r in mm sorted ascending, δr in µm, positive outward; ``dr_mm``
+        columns are converted to µm), the focal length in mm (None when neither the file nor
+        ``focal_length_mm`` gives it), the file name and the file's comments.
+
+    Raises
+    ------
+    DataError
+        Naming the file (and line) for: an unreadable or non-UTF-8 file; a missing header or
+        missing columns (also units not stated in the column names, or columns separated by
+        something other than commas); a row with the wrong number of values; a non-numeric or NaN
+        value; a negative or non-finite radius, a non-finite δr; a distance or image scale that is
+        not positive; a column mixing image scales and metres; duplicate radii; a profile of one
+        point; |δr| ≥ r (radii in metres or δr in mm under a µm label); fewer than
+        ``min_profiles`` profiles; a focal length that is not positive, that is smaller than the
+        largest radius / 19 (metres?), or that is not shorter than a distance given in metres.
+
+    Warns
+    -----
+    UnitWarning
+        When distances in metres are so large that they look like millimetres.
     """
     path = Path(path)
     try:
@@ -228,7 +259,9 @@ def read_profiles_csv(
             path,
             header_line,
             f"{len(profiles)} profile(s){only}: a variation analysis needs at least two "
-            "profiles (different object planes and/or focus settings)",
+            "profiles (different object planes and/or focus settings)"
+            if min_profiles >= 2
+            else "no profile: the file holds no data rows under its header",
         )
     _warn_plain_metres(profiles, path)
     if f_mm is not None:
@@ -282,6 +315,38 @@ def analyze_csv(
     threshold_um: float = WEAK_THRESHOLD_UM,
     method: str = "lsq",
 ) -> VariationAnalysis:
-    """Read ``path`` (:func:`read_profiles_csv`) and run :func:`analyze_variation` on it."""
+    """Read ``path`` (:func:`read_profiles_csv`) and run :func:`analyze_variation` on it
+    (Fraser & Shortis 1992, Eqs. 1–4 and 6).
+
+    Parameters
+    ----------
+    path : str or Path
+        A profile CSV (format in :mod:`distortion.variation.profiles`) with at least two profiles.
+    focal_length_mm : float, optional
+        Focal length f in mm, overriding the file's ``# focal_length_mm:`` metadata; γ_ss'
+        (Eq. 2) needs it when the distances are in metres.
+    r_min, r_max : float, optional
+        Radial range in mm (radii in the image) over which g_ss' is estimated; default all
+        common radii.
+    threshold_um : float
+        Radii where |δr_s' − δr_s| < ``threshold_um`` (µm) are left out of the g_ss' estimate
+        (weak determination); default :data:`~distortion.variation.models.WEAK_THRESHOLD_UM`
+        (0.5 µm).
+    method : {"lsq", "mean"}
+        How g_ss' is estimated from Eq. (6): ``"lsq"`` (default) least squares through the
+        origin of δr_ss' − δr_s against δr_s' − δr_s; ``"mean"`` the mean of the pointwise
+        ratios over the radial range, as in the paper.
+
+    Returns
+    -------
+    VariationAnalysis
+        As :func:`analyze_variation` returns it.
+
+    Raises
+    ------
+    DataError
+        For a file :func:`read_profiles_csv` refuses, or options :func:`analyze_variation`
+        refuses.
+    """
     ps = read_profiles_csv(path, focal_length_mm=focal_length_mm)
     return analyze_variation(ps, r_min=r_min, r_max=r_max, threshold_um=threshold_um, method=method)

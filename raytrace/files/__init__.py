@@ -153,7 +153,26 @@ def _check_reads_back(lens: Lens, path: str | Path) -> None:
 def save_lens(lens: Lens, path: str | Path, *, overwrite: bool = False) -> None:
     """Save ``lens`` to ``path``: native TOML (``.toml``, full precision, so reading it back gives
     the same lens) or Zemax ``.zmx``, chosen by the suffix. Written atomically; an existing file
-    is replaced only with ``overwrite=True``, and never when it is the lens's own source file."""
+    is replaced only with ``overwrite=True``, and never when it is the lens's own source file.
+
+    Parameters
+    ----------
+    lens : Lens
+    path : str or Path
+        The file to write, ``.toml`` or ``.zmx``.
+    overwrite : bool
+        Replace an existing file (other than the lens's own source file).
+
+    Raises
+    ------
+    TypeError
+        ``lens`` is not a Lens (or the two arguments are swapped).
+    PrescriptionError
+        A suffix other than ``.toml`` or ``.zmx``.
+    OutputError
+        The file is the lens's source, exists without ``overwrite``, is a folder, or its folder
+        is missing or not writable.
+    """
     if isinstance(path, Lens) and not isinstance(lens, Lens):
         raise TypeError("save_lens(lens, path): the lens first, then the path (they are swapped)")
     require_lens(lens)
@@ -170,7 +189,33 @@ def convert(
     .zmx -> .toml reproduces the lens exactly. Commands that cannot be converted stop the
     conversion with a message naming the file and line; skipped non-optical ones are listed in
     a warning. OUT is never the same file as IN, and an existing OUT is replaced only with
-    ``overwrite``. Returns the lens that was written."""
+    ``overwrite``. Returns the lens that was written.
+
+    Parameters
+    ----------
+    in_path : str or Path
+        The lens file (``.toml``, ``.zmx``, ``.seq``) or a bundled lens name.
+    out_path : str or Path
+        The file to write, ``.toml`` or ``.zmx``.
+    overwrite : bool
+        Replace an existing OUT.
+    **options
+        ``flag``: how messages name the override (``"--force"`` on the command line).
+
+    Returns
+    -------
+    Lens
+        The lens read from IN and written to OUT.
+
+    Raises
+    ------
+    PrescriptionError
+        OUT without a writable suffix, an unknown name, a broken IN, or commands that cannot be
+        converted.
+    OutputError
+        OUT is IN, exists without ``overwrite``, is a folder, or its folder is missing or not
+        writable.
+    """
     from .library import resolve_lens_path
     from .output import check_output
 

@@ -105,7 +105,29 @@ class Configurations:
 def apply_configuration(lens: Lens, configuration: Configuration) -> Lens:
     """The lens of ``configuration``: ``lens`` with its thicknesses (and object distance)
     replaced. Raises PrescriptionError for a surface the lens does not have, and LensError
-    (from the Lens validation) for a lens that cannot exist (e.g. a glass thickness ≤ 0)."""
+    (from the Lens validation) for a lens that cannot exist (e.g. a glass thickness ≤ 0).
+
+    Parameters
+    ----------
+    lens : Lens
+        The base lens.
+    configuration : Configuration
+        Thicknesses ((surface, mm), …; surfaces 1-based as in the listings) and optionally the
+        object distance (mm from the object plane to the first vertex, positive; ``inf``).
+
+    Returns
+    -------
+    Lens
+        A new lens; when the last thickness changes its image solve is dropped (the image plane
+        is where the configuration puts it).
+
+    Raises
+    ------
+    PrescriptionError
+        A surface the lens does not have.
+    LensError
+        A lens that cannot exist.
+    """
     n = lens.n_surfaces
     surfaces = list(lens.surfaces)
     last_changed = False
@@ -518,7 +540,27 @@ def write_lens_with_configurations(
     lens: Lens, configurations: Configurations, path: str | Path, **options: Any
 ) -> None:
     """Write :func:`dumps_with_configurations` to ``path`` atomically (``options`` as in
-    :func:`raytrace.files.output.write_atomic`)."""
+    :func:`raytrace.files.output.write_atomic`).
+
+    Parameters
+    ----------
+    lens : Lens
+    configurations : Configurations
+        Configurations of ``lens``.
+    path : str or Path
+        The file to write (native TOML text, whatever the suffix).
+    **options
+        ``overwrite`` (bool: replace an existing file), ``inputs`` (files the output must not
+        be), ``encoding``, ``flag`` (how messages name the override).
+
+    Raises
+    ------
+    PrescriptionError
+        A configuration changes a surface the lens does not have.
+    OutputError
+        The file cannot or must not be written (it exists without ``overwrite``, is an input,
+        its folder is missing, …).
+    """
     write_atomic(path, dumps_with_configurations(lens, configurations), **options)
 
 
@@ -541,7 +583,24 @@ def parse_configurations(
 
 
 def read_configurations(path: str | Path) -> Configurations:
-    """The configurations of a lens file (.zmx, .seq, else native TOML by suffix)."""
+    """The configurations of a lens file (.zmx, .seq, else native TOML by suffix).
+
+    Parameters
+    ----------
+    path : str or Path
+        A lens file path (bundled names: :func:`read_configured`): Zemax ``.zmx`` (``THIC``
+        operands of the multi-configuration editor), CODE V ``.seq`` (``ZOO THI``), anything else
+        native TOML (``[[configurations]]``). Lengths in the file's unit, returned in mm.
+
+    Returns
+    -------
+    Configurations
+
+    Raises
+    ------
+    PrescriptionError
+        Naming the file and line, for a missing or unreadable file and every problem in it.
+    """
     suffix = Path(path).suffix.lower()
     kind = {".zmx": "zmx", ".seq": "seq"}.get(suffix, "toml")
     return parse_configurations(read_bytes(path), kind=kind, path=path)
@@ -549,7 +608,23 @@ def read_configurations(path: str | Path) -> Configurations:
 
 def read_configured(path: str | Path) -> tuple[Lens, Configurations]:
     """The base lens of a file (read by :func:`raytrace.files.read_lens_file`, or a bundled
-    name) and its configurations, checked to belong together."""
+    name) and its configurations, checked to belong together.
+
+    Parameters
+    ----------
+    path : str or Path
+        A lens file (``.toml``, ``.zmx``, ``.seq``) or a bundled lens name.
+
+    Returns
+    -------
+    (Lens, Configurations)
+
+    Raises
+    ------
+    PrescriptionError
+        An unknown name, a broken file, or a configuration that changes a surface the lens does
+        not have.
+    """
     from . import read_lens_file
     from .library import resolve_lens_path
 

@@ -102,11 +102,25 @@ def load_lens(name_or_path: str | Path, *, strict: bool = False) -> Lens:
     ``.toml``; see ``orthoscope lenses``) or a file path (``.toml``, Zemax ``.zmx``, CODE V
     ``.seq``, chosen by suffix). An existing file path wins over a bundled name.
 
-    ``strict``: refuse glass names that resolve only to a substitute glass (see
-    :func:`raytrace.files.read_lens_file`).
+    Parameters
+    ----------
+    name_or_path : str or Path
+        A bundled lens name or a lens file.
+    strict : bool
+        Refuse glass names that resolve only to a substitute glass (see
+        :func:`raytrace.files.read_lens_file`); default False.
 
-    Raises :class:`~raytrace.errors.PrescriptionError` naming the file, line and surface for a
-    broken file, or listing the bundled names (with "did you mean") for an unknown one."""
+    Returns
+    -------
+    Lens
+        Lengths in mm, wavelengths in nm.
+
+    Raises
+    ------
+    PrescriptionError
+        Naming the file, line and surface for a broken file, or listing the bundled names (with
+        "did you mean") for an unknown one.
+    """
     from . import read_lens_file
 
     return read_lens_file(resolve_lens_path(name_or_path), strict=strict)

@@ -333,18 +333,30 @@ def lookup_glass(
 ) -> CatalogGlass:
     """Resolve a glass name to one :class:`CatalogGlass`.
 
-    name:
-        the glass name; a catalog suffix ``NAME_SCHOTT`` (CODE V style) limits the search to
-        that catalog.
-    catalogs:
-        preferred catalogs in order (e.g. a Zemax ``GCAT`` line). With ``first_catalog_wins``
-        (Zemax's own rule) the first of them that has the name decides; otherwise, and when none
-        of them has it, all catalogs are searched.
-
     Several candidates with the same nd and vd resolve to the first in catalog order; different
-    nd/vd make the name ambiguous. Raises :class:`~raytrace.errors.PrescriptionError` for an
-    unknown or ambiguous name (the message lists similar names or the candidates and how to
-    choose).
+    nd/vd make the name ambiguous.
+
+    Parameters
+    ----------
+    name : str
+        The glass name; a catalog suffix ``NAME_SCHOTT`` (CODE V style) limits the search to that
+        catalog.
+    catalogs : sequence of str, optional
+        Preferred catalogs in order (e.g. a Zemax ``GCAT`` line; names case-insensitive, unknown
+        ones ignored). With ``first_catalog_wins`` the first of them that has the name decides;
+        otherwise, and when none of them has it, all catalogs are searched.
+    first_catalog_wins : bool
+        Zemax's own rule (default False).
+
+    Returns
+    -------
+    CatalogGlass
+
+    Raises
+    ------
+    PrescriptionError
+        An unknown or ambiguous name (the message lists similar names or the candidates and how
+        to choose).
     """
     raw, suffix = split_catalog_suffix(name)
     cats = list(catalogs) if catalogs else []
@@ -459,6 +471,31 @@ def search_glass(
     left out unless ``include_retired``; materials without nd/vd are never returned. Ties keep
     catalog order. A finite ``max_price`` keeps only glasses whose vendor prints a relative
     price (:attr:`CatalogGlass.price`: Schott, CDGM) no larger than it.
+
+    Parameters
+    ----------
+    nd : float
+        Refractive index at the d line (587.56 nm).
+    vd : float
+        Abbe number.
+    n : int
+        How many to return (default 5; 0 or less: none).
+    catalogs : sequence of str, optional
+        Catalogs to search (case-insensitive); default all of :data:`CATALOGS`.
+    include_retired : bool
+        Include withdrawn, legacy and obsolete glasses.
+    max_price : float
+        The largest relative price (default ``inf``: no limit).
+
+    Returns
+    -------
+    list of GlassMatch
+        Each glass with its distance (glass-code units).
+
+    Raises
+    ------
+    PrescriptionError
+        A catalog name that is no shipped catalog.
     """
     cats = CATALOGS
     if catalogs:

@@ -182,10 +182,33 @@ def insert_design(
     that variable (its bounds) and the air in front of it one above the spec's smallest air
     bound (else above :data:`raytrace.elements.DEFAULT_GAP`).
 
+    Parameters
+    ----------
+    lens : Lens
+    spec : DesignSpec
+        A design spec of ``lens``.
+    after : int
+        The surface (1-based) with air after it.
+    material : Material
+        The new element's glass (not air).
+    thickness : float
+        Centre thickness of the plate in mm (> 0; default 2.0).
+    gap : float, optional
+        Air in front of the plate in mm (> 0); default the middle of the air space.
+
+    Returns
+    -------
+    (Lens, DesignSpec)
+        The lens with two more surfaces (``after`` + 1 and ``after`` + 2) and the spec
+        renumbered, with the new variables.
+
     Raises
     ------
     SpecError
         The spec does not fit the lens.
+    LensError
+        No such surface, a mirror or coordinate break, glass after the surface, an air
+        ``material``, a thickness or gap that is not positive, or an air space too short.
     """
     check_spec(lens, spec, need_continuous=False)
     glass_low = _smallest_bound(lens, spec, glass=True)

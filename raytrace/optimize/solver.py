@@ -350,6 +350,36 @@ def optimize(
 
     A run that stops on the evaluation limit, or ends above ``spec.merit_goal``, is returned with
     ``converged=False`` and a message saying why; the caller must not present it as a success.
+
+    Parameters
+    ----------
+    lens : Lens
+        The start lens.
+    spec : DesignSpec
+        Variables, pick-ups and operands (:func:`raytrace.optimize.read_spec`).
+    progress : callable(int, float, OperandValue), optional
+        Called after each evaluation with its number, the merit and the worst operand.
+    stop : callable() -> str or None, optional
+        Asked before each evaluation; a non-empty string ends the run.
+    max_evaluations : int, optional
+        The evaluation limit (≥ 1); default the spec's.
+    method : {"least_squares", "minimax"}, optional
+        Default the spec's ``method``.
+
+    Returns
+    -------
+    OptimizationResult
+        The final lens, the variable values, the start and final merit (the sum of squared
+        weighted residuals for least squares), the operand values, the evaluation count,
+        ``converged``, the message, the time in seconds, ``stopped`` and the largest bound
+        violation.
+
+    Raises
+    ------
+    TypeError
+        ``lens`` is not a Lens or ``spec`` not a DesignSpec.
+    SpecError
+        The spec does not fit the lens, or ``max_evaluations`` is not a whole number ≥ 1.
     """
     require_lens(lens, "lens")
     if not isinstance(spec, DesignSpec):

@@ -639,29 +639,42 @@ def _search_settings(d: dict, at: str, probs: _Problems) -> SearchSettings:
 def read_spec(path: str | Path) -> DesignSpec:
     """Read a TOML design spec (the language: ``docs/spec.md``; examples: ``lenses/specs/``)::
 
-    name = "my-design"
-    start = "cooke-triplet-f4"        # bundled name or a path relative to the spec
-    max_evaluations = 500
-    merit_goal = 1e-6                 # optional: above it the run is a failure
-    variables = [
-      { kind = "curvature", surface = 1 },
-      { kind = "thickness", surface = 2, min = 0.5, max = 12 },
-      { kind = "glass", surface = 1, nd = [1.5, 1.7] },
-    ]
-    pickups = [ { kind = "curvature", surface = 6, source = 1, factor = -1 } ]
-    operands = [
-      { type = "efl", target = 50.0, weight = 10 },
-      { type = "distortion", field = 20, target = 0.0, plane = "gaussian" },
-    ]
-    [glass]                            # the substitution pool of glass variables
-    catalogs = ["Schott", "Ohara"]
-    [global]                           # settings of the global search (optimize --global)
-    starts = 16
-    seed = 1
-    time = "10m"
+        name = "my-design"
+        start = "cooke-triplet-f4"        # bundled name or a path relative to the spec
+        max_evaluations = 500
+        merit_goal = 1e-6                 # optional: above it the run is a failure
+        variables = [
+          { kind = "curvature", surface = 1 },
+          { kind = "thickness", surface = 2, min = 0.5, max = 12 },
+          { kind = "glass", surface = 1, nd = [1.5, 1.7] },
+        ]
+        pickups = [ { kind = "curvature", surface = 6, source = 1, factor = -1 } ]
+        operands = [
+          { type = "efl", target = 50.0, weight = 10 },
+          { type = "distortion", field = 20, target = 0.0, plane = "gaussian" },
+        ]
+        [glass]                            # the substitution pool of glass variables
+        catalogs = ["Schott", "Ohara"]
+        [global]                           # settings of the global search (optimize --global)
+        starts = 16
+        seed = 1
+        time = "10m"
 
-    Raises :class:`SpecError` listing every problem (unknown keys with the nearest valid one,
-    wrong types, missing keys), one line each.
+    Parameters
+    ----------
+    path : str or Path
+        The spec file (UTF-8 TOML), or the name (no suffix) of a bundled spec in
+        ``lenses/specs/``.
+
+    Returns
+    -------
+    DesignSpec
+
+    Raises
+    ------
+    SpecError
+        Listing every problem (unknown keys with the nearest valid one, wrong types, missing
+        keys), one line each; also a missing file, a folder, text that is not UTF-8 or not TOML.
     """
     p = Path(path)
     if not p.exists() and not p.suffix:  # a bundled spec by its name (lenses/specs/)
@@ -670,11 +683,13 @@ def read_spec(path: str | Path) -> DesignSpec:
         p = bundled_file("specs", p) or p
     try:
         raw = p.read_bytes()
-        d = tomllib.loads(raw.decode("utf-8"))
+        d = tomllib.loads(raw.decode("utf-8-sig"))  # a byte-order mark is no error
     except FileNotFoundError:
         raise SpecError(f"{p}: no such spec file") from None
     except IsADirectoryError:
         raise SpecError(f"{p}: is a folder, not a spec file") from None
+    except OSError as e:
+        raise SpecError(f"{p}: cannot read the spec: {e.strerror or e}") from None
     except UnicodeDecodeError:
         raise SpecError(f"{p}: not a UTF-8 text file") from None
     except tomllib.TOMLDecodeError as e:

@@ -200,6 +200,21 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float) -> PestrecovConstan
     ∞/∞; its value is the height of the paraxial chief ray in the plane per unit abscissa, which
     is the same in every plane: F0 = y_c (the chief ray of tan α = 1 at the last vertex), or
     M0 = y_c / p0.
+
+    Parameters
+    ----------
+    par : ParaxialResult
+        :func:`raytrace.paraxial.paraxial` of the lens and its object (m_e of Eq. 6, the pupils
+        E0, E0', p0 in mm, negative for a finite object).
+    s_prime : float
+        The image plane, mm from the second principal point H' (positive toward the image).
+
+    Returns
+    -------
+    PestrecovConstants
+        ``s_prime``, ``p0`` and ``p0p`` (mm, object and image plane from E0 and E0'),
+        ``scale`` = M0 (finite conjugates, dimensionless, signed) or F0 (object at infinity, mm)
+        and ``infinite``.
     """
     p0p = float(s_prime) - par.HpE0p
     if math.isinf(par.m_e) and math.isfinite(par.chief_height_last):

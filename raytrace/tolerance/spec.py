@@ -508,8 +508,22 @@ def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
     A ``.zmx`` path reads the file's TOL lines instead
     (:func:`raytrace.tolerance.zemax_tol.read_zmx_tolerances`). A bare name that is not a file
     (no suffix) is a bundled example, one per bundled lens and named like it
-    (``read_tolerance_spec("topogon-like-pestrecov")``). Raises :class:`ToleranceSpecError`
-    (one line) for anything wrong.
+    (``read_tolerance_spec("topogon-like-pestrecov")``).
+
+    Parameters
+    ----------
+    path : str or Path
+        A TOML tolerance spec (UTF-8), a Zemax ``.zmx`` file, or the name of a bundled example.
+
+    Returns
+    -------
+    ToleranceSpec
+
+    Raises
+    ------
+    ToleranceSpecError
+        One line, for anything wrong (a missing or unreadable file, text that is not UTF-8 or
+        not TOML, a spec that does not parse).
     """
     p = resolve_spec_path(path)
     if p.suffix.lower() == ".zmx":
