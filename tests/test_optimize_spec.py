@@ -226,3 +226,21 @@ def test_glass_max_price_key(tmp_path):
     assert spec.glass_settings(spec.variables[0]).max_price == 1.5
     with pytest.raises(SpecError, match=r"max_price.*positive number"):
         _read(tmp_path, head + "[glass]\nmax_price = -1\n")
+
+
+def test_a_misspelt_key_is_one_problem_not_two(tmp_path):
+    # docs/spec.md shows "2 problems" for two typos; each typo also produced a "missing key"
+    # line (4 problems) until the reader remembered which key a misspelling stood for
+    p = tmp_path / "my.toml"
+    p.write_text(
+        'name = "x"\nstart = "cooke-triplet-f4"\n'
+        'variables = [ { kind = "curvature", surface = 1 }, { kind = "thickness", sufrace = 2 } ]\n'
+        'operands = [ { type = "efl", target = 50 }, '
+        '{ type = "distortion", feild = 20, target = 0 } ]\n'
+    )
+    with pytest.raises(SpecError) as e:
+        read_spec(p)
+    lines = str(e.value).splitlines()
+    assert lines[0].endswith("2 problems:")
+    assert "variables[2]: unknown key 'sufrace' (did you mean 'surface'?)" in lines[1]
+    assert "unknown key 'feild' for operand distortion (did you mean 'field'?)" in lines[2]

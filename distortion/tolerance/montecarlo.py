@@ -182,7 +182,7 @@ class _Store:
             if diff and not overwrite:
                 what = _differences(diff, old, manifest)
                 raise OutputError(
-                    f"{self.dir}: holds another run (a different {what}); give a new out_dir, "
+                    f"{self.dir}: holds another run (it differs in {what}); give a new out_dir, "
                     "or overwrite=True to replace it"
                 )
             if not diff and resume:

@@ -393,6 +393,14 @@ class FocusStudy:
     analysis: VariationAnalysis | None
     notes: tuple[str, ...]
 
+    def __repr__(self) -> str:
+        worst = max((abs(g.relative_error) for g in self.gamma), default=float("nan"))
+        return (
+            f"FocusStudy({self.lens_name}: {len(self.settings)} configurations "
+            f"({', '.join(s.name for s in self.settings)}), Brown's gamma off by up to "
+            f"{worst:.3g} (relative), calibrated {self.calibrated})"
+        )
+
 
 def _spline(r: np.ndarray, dr: np.ndarray, grid: np.ndarray, label: str) -> np.ndarray:
     ok = np.isfinite(r) & np.isfinite(dr)

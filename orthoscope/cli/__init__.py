@@ -152,9 +152,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         description=(
             "Lens distortion toolkit: paraxial data, real chief rays and Pestrecov's "
             "characteristic and calibrated distortion in Gaussian and non-Gaussian image planes. "
-            "LENS is a path to a prescription file (.toml, .zmx, .seq) or the name of a bundled "
-            "lens (see 'orthoscope lenses'). Distances in mm; light travels toward +z; signs "
-            "follow Pestrecov (1958) Fig. 1."
+            "LENS is a path to a prescription file (.toml, .zmx, .seq, .len) or the name of a "
+            "bundled lens (see 'orthoscope lenses'). Distances in mm; light travels toward +z; "
+            "signs follow Pestrecov (1958) Fig. 1."
         ),
         epilog="Run 'orthoscope COMMAND --help' for each command's options.",
     )
@@ -224,11 +224,51 @@ def cli_words(message: str) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 a run that did not succeed, 2 a
     usage or input error, 130 interrupted)."""
+    restore = _sigint_outside_llvm()
     try:
         return _run(argv)
     except KeyboardInterrupt:  # before the command is known (while the engine is imported)
         print("orthoscope: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    finally:
+        restore()
+
+
+def _sigint_outside_llvm():
+    """Ctrl-C that arrives while numba loads or compiles a kernel (LLVM calls back into Python
+    there) is delivered again 50 ms later instead of at once: a KeyboardInterrupt raised inside
+    llvmlite's callbacks is lost ("Exception ignored on calling ctypes callback", the command
+    then ran to its end) or leaves LLVM's state broken (a rare segmentation fault). Returns the
+    function that puts the previous handler back (nothing changes outside the main thread or
+    when a handler of another kind is installed)."""
+    import signal
+    import threading
+
+    old = signal.getsignal(signal.SIGINT)
+    if old is not signal.default_int_handler or threading.current_thread() is not (
+        threading.main_thread()
+    ):
+        return lambda: None
+
+    signal.signal(signal.SIGINT, _sigint_handler)
+    return lambda: signal.signal(signal.SIGINT, old)
+
+
+def _sigint_handler(signum, frame) -> None:
+    """KeyboardInterrupt, unless the main thread is inside llvmlite or numba's compiler: then
+    SIGINT again in 50 ms (:func:`_sigint_outside_llvm`)."""
+    import signal
+    import threading
+
+    f = frame
+    while f is not None:
+        if f.f_globals.get("__name__", "").startswith(("llvmlite", "numba.core")):
+            t = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT))
+            t.daemon = True
+            t.start()
+            return
+        f = f.f_back
+    raise KeyboardInterrupt
 
 
 def _run(argv: Sequence[str] | None) -> int:

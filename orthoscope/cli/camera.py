@@ -627,8 +627,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_strict_arg(
         o,
-        help="Exit with status 2 when a chief ray fails, or when the lens file names a glass that "
-        "can only be read as a substitute (an N- successor, a parent glass, a model of nd/vd).",
+        help="Exit with status 2 when a chief ray fails, when the lens file names a glass that "
+        "can only be read as a substitute (an N- successor, a parent glass, a model of nd/vd), "
+        "when a glass is evaluated outside its catalog data range, or when the sensor reaches "
+        "beyond the lens's image circle (before anything is written).",
     )
     add_force_arg(q)
     add_output_args(

@@ -1,4 +1,5 @@
-"""``orthoscope convert IN OUT`` between native .toml, Zemax .zmx and CODE V .seq (read)."""
+"""``orthoscope convert IN OUT`` between native .toml, Zemax .zmx, CODE V .seq and OSLO .len
+(read)."""
 
 from __future__ import annotations
 
@@ -35,10 +36,10 @@ def cmd_convert(args) -> int:
 def register(sub: argparse._SubParsersAction) -> None:
     q = sub.add_parser(
         "convert",
-        help="Convert a lens between .toml, .zmx (read/write) and .seq (read).",
+        help="Convert a lens between .toml, .zmx (read/write), .seq and .len (read).",
         description=(
-            "Convert a lens file: IN (.toml, .zmx or .seq, or a bundled lens name) to OUT (.toml "
-            "or .zmx), formats chosen by the suffixes. Numbers are written at full double "
+            "Convert a lens file: IN (.toml, .zmx, .seq or .len, or a bundled lens name) to OUT "
+            "(.toml or .zmx), formats chosen by the suffixes. Numbers are written at full double "
             "precision, so .toml -> .zmx -> .toml reproduces the lens exactly. OUT is never the "
             "same file as IN; an existing OUT is replaced only with --force."
         ),
@@ -47,7 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument(
         "input",
         metavar="IN",
-        help="Lens to read: a .toml, .zmx or .seq file, or a bundled lens name.",
+        help="Lens to read: a .toml, .zmx, .seq or .len file, or a bundled lens name.",
     )
     q.add_argument("output", metavar="OUT", help="Lens file to write (.toml or .zmx).")
     add_force_arg(q, help="Replace an existing OUT (never the input).")

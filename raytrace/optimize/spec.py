@@ -314,14 +314,22 @@ class _Problems:
     def __init__(self, where: str) -> None:
         self.where = where
         self.lines: list[str] = []
+        self.misspelt: list[tuple[str, str]] = []  # (where in the file, the key it meant)
 
     def add(self, msg: str) -> None:
+        # a key reported as misspelt is not reported again as missing at the same place: the
+        # fix of the first line is the fix of both
+        if any(msg.startswith(f"{at}:") and f"'{key}'" in msg for at, key in self.misspelt):
+            return
         self.lines.append(msg)
 
     def unknown_keys(self, d: dict, allowed, at: str) -> None:
         for k in d:
             if k not in allowed:
                 self.add(f"{at}: unknown key {k!r}{suggest(k, allowed)}")
+                near = difflib.get_close_matches(str(k), list(allowed), n=1, cutoff=0.6)
+                if near and near[0] not in d:
+                    self.misspelt.append((at, near[0]))
 
     def raise_if_any(self) -> None:
         if not self.lines:
@@ -402,14 +410,14 @@ def operand_problems(
     if type_ not in OPERAND_PARAMS:
         return [f"unknown operand type {type_!r}{suggest(type_, OPERAND_TYPES)}"]
     allowed = OPERAND_PARAMS[type_] + BOUND_KEYS
+    meant = set()  # keys a misspelling stood for: not reported again as missing
     for k in params:
         if k not in allowed:
-            out.append(
-                f"unknown key {k!r} for operand {type_}"
-                + suggest(k, ("type", "target", "weight", *allowed))
-            )
+            keys = ("type", "target", "weight", *allowed)
+            out.append(f"unknown key {k!r} for operand {type_}" + suggest(k, keys))
+            meant.update(difflib.get_close_matches(str(k), keys, n=1, cutoff=0.6))
     for k in OPERAND_REQUIRED.get(type_, ()):
-        if k not in params:
+        if k not in params and k not in meant:
             out.append(f"operand {type_} needs a {k!r}")
     if not _is_num(target):
         out.append(f"'target' must be a number, got {target!r}")
