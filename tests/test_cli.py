@@ -395,3 +395,16 @@ def test_ctrl_c_inside_llvm_is_delivered_again_later(monkeypatch):
     assert sent == [(os.getpid(), signal.SIGINT)]
     with pytest.raises(KeyboardInterrupt):
         _sigint_handler(signal.SIGINT, sys._getframe())
+
+
+def test_a_warning_raised_again_is_printed_once(capsys):
+    # N-SK16 at 2600 nm (its data end at 2325.42 nm): the extrapolation warning came once per
+    # evaluation of the lens, three times for one trace; and again in the next run
+    zmx = str(Path(__file__).parent / "data" / "cooke-triplet-f4.zmx")
+    argv = ["trace", zmx, "--wavelength", "2600", "--fields", "0,10"]
+    from raytrace.lens import _indices
+
+    for _ in range(2):  # each run says it (the cache of a lens's indices is per process)
+        _indices.cache_clear()
+        rc, _, err = run(capsys, *argv)
+        assert rc == 0 and err.count("outside its data range") == 1, err

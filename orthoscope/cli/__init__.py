@@ -280,6 +280,7 @@ def _run(argv: Sequence[str] | None) -> int:
     debug = os.environ.get("ORTHOSCOPE_DEBUG", "") not in ("", "0")
     command = "orthoscope"
     warnings.showwarning = _one_line_warning
+    _PRINTED.clear()
     _ascii_safe_streams()
     # the command line only writes figures to files (no window): a broken MPLBACKEND must not
     # stop it
@@ -386,9 +387,18 @@ def _bad_environment() -> str | None:
     return None
 
 
+#: the warnings printed in this run (a warning raised again, e.g. for each evaluation of the
+#: lens at an extrapolated wavelength, is printed once)
+_PRINTED: set[str] = set()
+
+
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Warnings on the command line: one line, no source path."""
-    print(f"orthoscope: warning: {message}", file=sys.stderr)
+    """Warnings on the command line: one line, no source path, each text once per run."""
+    text = str(message)
+    if text in _PRINTED:
+        return
+    _PRINTED.add(text)
+    print(f"orthoscope: warning: {text}", file=sys.stderr)
 
 
 def _silence_stdout() -> None:
