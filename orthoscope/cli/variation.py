@@ -56,19 +56,10 @@ SAMPLES = [
 OUTPUTS = [("--profiles-csv", ".csv"), ("--plot", ".png"), ("--plot-g", ".png")]
 
 
-def _focus_list(values: list[str] | None):
-    from distortion.variation.traced import parse_conjugates
-
-    out = []
-    for v in values or []:
-        out.extend(parse_conjugates(v))
-    return out
-
-
 # ----------------------------------------------------------------------------- variation
 def cmd_variation(args) -> int:
     from distortion.variation.analysis import check_analysis_options
-    from distortion.variation.traced import parse_conjugates, trace_variation
+    from distortion.variation.traced import trace_variation
 
     from ..report.variation import format_traced_variation, traced_variation_to_dict
 
@@ -135,8 +126,8 @@ def cmd_variation(args) -> int:
     _check_outputs(args)
     tv = trace_variation(
         lens,
-        _focus_list(args.focus),
-        parse_conjugates(args.objects),
+        args.focus,  # as typed ("12x", "8x,16x"): trace_variation reads them (as_conjugates)
+        args.objects,
         n_r=args.n_r,
         max_field_deg=args.max_field,
         reference=args.reference,

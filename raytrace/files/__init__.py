@@ -116,8 +116,8 @@ def write_lens_file(lens: Lens, path: str | Path, **options: Any) -> None:
     """Write ``lens`` in the format of ``path``'s suffix (``.toml`` or ``.zmx``), atomically;
     ``options`` (``overwrite``, ``inputs``, ``flag``) as in
     :func:`raytrace.files.output.write_atomic`. A text that would not read back (a writer's
-    bug) is refused before anything is written."""
-    _check_reads_back(lens, path)
+    bug) is refused before anything is written (:func:`raytrace.files.output.check_reads_back`,
+    in each writer)."""
     if _check_suffix(path) == ".zmx":
         from .zemax import write_zmx
 
@@ -126,28 +126,6 @@ def write_lens_file(lens: Lens, path: str | Path, **options: Any) -> None:
         from .native import write_lens
 
         write_lens(lens, path, **options)
-
-
-def _check_reads_back(lens: Lens, path: str | Path) -> None:
-    """Raise LensError when the text ``lens`` would be written as does not read back."""
-    import warnings
-
-    from ..errors import LensError, OrthoscopeError
-
-    if _check_suffix(path) == ".zmx":
-        from .zemax import dumps_zmx as dumps
-        from .zemax import loads_zmx as loads
-    else:
-        from .native import dumps, loads
-    text = dumps(lens)  # what the format cannot hold is the writer's own refusal, raised as is
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            loads(text)
-    except OrthoscopeError as e:
-        raise LensError(
-            f"{path}: not written: the file would not read back ({e}); please report it"
-        ) from None
 
 
 def save_lens(lens: Lens, path: str | Path, *, overwrite: bool = False) -> None:

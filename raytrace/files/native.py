@@ -75,7 +75,7 @@ from ..frames import AFTER_MODES, ORDERS, Placement
 from ..lens import APERTURE_KINDS, IMAGE_FIELDS, Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from ..qtype import FORMS, QType
-from .output import write_atomic
+from .output import check_reads_back, write_atomic
 from .text import decode_text, read_bytes, solve_paraxial_image
 
 WHAT = "a TOML lens prescription"
@@ -1388,4 +1388,6 @@ def dumps(lens: Lens) -> str:
 def write_lens(lens: Lens, path: str | Path, **options: Any) -> None:
     """Write ``lens`` to ``path`` in the prescription format (UTF-8), atomically; ``options``
     (``overwrite``, ``inputs``, ``flag``) as in :func:`raytrace.files.output.write_atomic`."""
-    write_atomic(path, dumps(lens), **options)
+    text = dumps(lens)
+    check_reads_back(text, loads, path)
+    write_atomic(path, text, **options)

@@ -113,3 +113,20 @@ def write_atomic(
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
     return p
+
+
+def check_reads_back(text: str, loads, path: str | Path) -> None:
+    """Raise LensError when ``text``, about to be written to ``path``, does not read back with
+    ``loads`` (a writer's bug: nothing is written then)."""
+    import warnings
+
+    from ..errors import LensError, OrthoscopeError
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            loads(text)
+    except OrthoscopeError as e:
+        raise LensError(
+            f"{path}: not written: the file would not read back ({e}); please report it"
+        ) from None

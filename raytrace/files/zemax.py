@@ -81,7 +81,7 @@ from ..glass import lookup_glass, parse_glass_code, printed_nd_vd, resolve_glass
 from ..lens import Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from ..qtype import QType
-from .output import write_atomic
+from .output import check_reads_back, write_atomic
 from .text import (
     ImportResult,
     LineParser,
@@ -1250,7 +1250,8 @@ def write_zmx(lens: Lens, path: str | Path, *, encoding: str = "utf-16", **optio
     own: UTF-16 LE with BOM, CRLF) or ``"ascii"`` (non-ASCII characters escaped as ``?``);
     ``options`` (``overwrite``, ``inputs``, ``flag``) as in
     :func:`raytrace.files.output.write_atomic`."""
-    text = dumps_zmx(lens)
+    text = dumps_zmx(lens)  # what .zmx cannot hold is refused here, as the writer's own error
+    check_reads_back(text, loads_zmx, path)
     if encoding == "utf-16":
         data = codecs.BOM_UTF16_LE + text.encode("utf-16-le")
     elif encoding == "ascii":
