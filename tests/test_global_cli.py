@@ -58,7 +58,9 @@ def test_global_writes_the_lens_with_seed_and_merit(refocus: Path, tmp_path: Pat
     assert len(done) == 2 and median == pytest.approx(sum(done) / 2, rel=1e-5)
     lens = read_lens(out)
     assert lens.notes.startswith("provenance: derived")
-    assert "--global --seed 9 --starts 2' (0 hops per start)" in lens.notes
+    assert (
+        "--global --seed 9 --starts 2' (0 hops per start, local method least_squares)" in lens.notes
+    )
     assert lens.surfaces[-1].thickness < paraxial(lens).bfl  # refocused inside the Gaussian
 
 

@@ -164,11 +164,12 @@ def _c2_for_efl(t, f):
     return (1.0 / (f * (n - 1.0)) - C1) / ((n - 1.0) * t * C1 / n - 1.0)
 
 
-def test_a_bound_is_active_at_the_optimum_and_met():
+def _bound_reference() -> tuple[float, float]:
+    """(t, E) of the minimax optimum under efl <= EFL_MAX: on the boundary efl = EFL_MAX the
+    problem has one parameter (t), so two residuals equioscillate; grid, then the root of their
+    difference."""
     t_ref, c_ref, _ = REF
     assert _efl(t_ref, c_ref) > EFL_MAX + 5  # the bound cuts the unconstrained optimum off
-    # reference: on the boundary efl = EFL_MAX the problem has one parameter (t), so two
-    # residuals equioscillate; grid, then the root of their difference
     ts = np.linspace(2.5, 3.5, 20001)
     worst = np.max(np.abs(_residuals(ts, _c2_for_efl(ts, EFL_MAX))), axis=0)
     k = int(np.argmin(worst))
@@ -182,7 +183,11 @@ def test_a_bound_is_active_at_the_optimum_and_met():
     t_b = brentq(diff, ts[k - 5], ts[k + 5], xtol=1e-15)
     e_b = float(np.max(np.abs(_residuals(t_b, _c2_for_efl(t_b, EFL_MAX)))))
     assert e_b <= worst[k] + 1e-12
+    return float(t_b), e_b
 
+
+def test_a_bound_is_active_at_the_optimum_and_met():
+    t_b, e_b = _bound_reference()
     bound = Operand("efl", weight=1.0, params={"max": EFL_MAX})
     res = optimize(_lens(), _spec(bound))
     assert res.converged, res.message
@@ -284,14 +289,50 @@ def test_spec_reads_method_and_bounds_on_any_operand(tmp_path: Path):
     assert _read(tmp_path, HEAD + 'operands = [ { type = "efl" } ]\n').method == "least_squares"
 
 
-def test_api_refuses_mixed_target_and_bounds_and_minimax_global():
+def test_api_refuses_mixed_target_and_bounds():
     bad = Operand("efl", 50.0, 1.0, {"max": 60.0})
     with pytest.raises(SpecError, match="not both"):
         optimize(_lens(), _spec(bad))
     with pytest.raises(SpecError, match="unknown method 'newton'"):
         optimize(_lens(), _spec(), method="newton")
-    with pytest.raises(SpecError, match="local optimization only"):
-        global_optimize(_lens(), _spec(), starts=1)
+
+
+# ----------------------------------------------------------------------------- (c2) global
+def test_global_search_runs_minimax_and_reaches_the_reference_optimum():
+    """Every start's local run is minimax: each perturbed start ends at the equioscillating
+    optimum computed above from the closed forms, and so does the result."""
+    t_ref, c_ref, e_ref = REF
+    res = global_optimize(_lens(), _spec(), starts=3, seed=5, hops=1)
+    assert res.method == "minimax" and res.converged, res.message
+    assert res.merit == pytest.approx(e_ref, rel=1e-9)
+    assert res.start_merits == pytest.approx([e_ref] * 3, rel=1e-7)
+    assert res.violation == 0.0
+    t, c2 = res.lens.surfaces[0].thickness, res.lens.surfaces[1].curvature
+    assert [t, c2] == pytest.approx([t_ref, c_ref], rel=1e-7)
+
+
+def test_global_minimax_ranks_by_the_exact_penalty_and_meets_the_bound():
+    """With a bound, designs are ranked by phi = max|e| + penalty x violation (checked here on
+    the start lens against the closed forms), and the search ends on the constrained optimum."""
+    from raytrace.optimize import evaluate
+    from raytrace.optimize.minimax import penalty_merit
+
+    bound = Operand("efl", weight=1.0, params={"max": EFL_MAX})
+    spec = _spec(bound, penalty=100.0)
+    start = _lens(3.0, -0.006)
+    f = _efl(3.0, -0.006)
+    assert f > EFL_MAX  # the start breaks the bound
+    phi = float(np.max(np.abs(_residuals(3.0, -0.006)))) + 100.0 * (f - EFL_MAX)
+    vals = evaluate(start, spec.operands)
+    assert penalty_merit(spec, vals) == pytest.approx(phi, rel=1e-9)
+
+    t_b, e_b = _bound_reference()
+    res = global_optimize(start, spec, starts=3, seed=1, hops=1)
+    assert res.converged, res.message
+    assert res.violation == pytest.approx(0.0, abs=1e-9)
+    assert paraxial(res.lens).efl <= EFL_MAX + 1e-9
+    assert res.merit == pytest.approx(e_b, rel=1e-7)
+    assert res.merit_start == pytest.approx(phi, rel=1e-9)
 
 
 # ----------------------------------------------------------------------------- (d) the CLI
@@ -333,11 +374,24 @@ def test_cli_method_minimax(tmp_path: Path, capsys):
     assert paraxial(read_lens(out2)).efl == pytest.approx(49.8, abs=1e-6)
 
 
-def test_cli_refuses_global_minimax(tmp_path: Path, capsys):
+def test_cli_global_minimax(tmp_path: Path, capsys):
+    """--global with --method minimax: minimax in every local run; f = 49.5 as above."""
+    from raytrace.files.native import read_lens
+
     spec = tmp_path / "s.toml"
     spec.write_text(CLI_SPEC)
-    argv = ["optimize", str(spec), "-o", str(tmp_path / "o.toml"), "--method", "minimax"]
-    assert main(argv + ["--global"]) == 2
-    # one line (a first run on a fresh machine adds the kernel-compilation notice before it)
-    lines = [ln for ln in capsys.readouterr().err.splitlines() if "compiling" not in ln]
-    assert len(lines) == 1 and "--global runs damped least squares only" in lines[0]
+    out = tmp_path / "o.toml"
+    argv = ["optimize", str(spec), "-o", str(out), "--method", "minimax", "--quiet"]
+    assert main(argv + ["--global", "--starts", "2", "--seed", "3"]) == 0
+    text = capsys.readouterr().out
+    assert "max weighted residual (+ penalty x bound violations)" in text
+    assert "largest bound violation 0" in text
+    lens = read_lens(out)
+    assert paraxial(lens).efl == pytest.approx(49.5, abs=1e-8)
+    assert "local method minimax" in lens.notes
+    out2 = tmp_path / "o2.toml"
+    argv2 = ["optimize", str(spec), "-o", str(out2), "--method", "minimax", "--json"]
+    assert main(argv2 + ["--global", "--starts", "2", "--seed", "3"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["method"] == "minimax" and d["violation"] == 0.0
+    assert d["merit"] == pytest.approx(1.5, rel=1e-9)

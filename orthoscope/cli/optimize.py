@@ -1,7 +1,7 @@
 """CLI: ``orthoscope optimize SPEC.toml -o LENS.toml [--method M] [--global ...]`` — a
 reproducible design run: damped least squares (or, with ``--method minimax`` / the spec's
 ``method = "minimax"``, minimax) from the spec's start lens, or (``--global``) the global search
-with glass substitution (:func:`raytrace.optimize.global_optimize`)."""
+around that method with glass substitution (:func:`raytrace.optimize.global_optimize`)."""
 
 from __future__ import annotations
 
@@ -124,6 +124,12 @@ OUTPUTS = [("-o", ".toml")]
 
 #: how the CLI names the merit of each method (OptimizationResult.merit)
 MERIT_NAMES = {"least_squares": "merit", "minimax": "max weighted residual"}
+#: the global search's merit of each method (GlobalResult.merit): with minimax, the exact
+#: penalty merit, which is the max weighted residual when every bound is met
+GLOBAL_MERIT_NAMES = {
+    "least_squares": "merit",
+    "minimax": "max weighted residual (+ penalty x bound violations)",
+}
 
 
 def provenance_notes(lens, spec, res, start_name: str) -> str:
@@ -146,8 +152,9 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
     text = (
         "provenance: derived\n"
         f"Designed with 'orthoscope optimize {Path(spec.path).name} --global --seed {res.seed} "
-        f"--starts {res.starts}' ({spec.search.hops} hops per start) from the start lens "
-        f"{start_name}; merit {res.merit:.9g} (start {res.merit_start:.9g}), best of "
+        f"--starts {res.starts}' ({spec.search.hops} hops per start, local method "
+        f"{res.method}) from the start lens {start_name}; {GLOBAL_MERIT_NAMES[res.method]} "
+        f"{res.merit:.9g} (start {res.merit_start:.9g}), best of "
         f"{res.starts_done}/{res.starts} starts ("
         + (f"start {res.best_start}" if res.best_start >= 0 else "the start lens, kept")
         + f"), {res.evaluations} evaluations, {res.seconds:.0f} s with {res.workers} worker(s)"
@@ -242,12 +249,6 @@ def cmd_optimize(args) -> int:
     spec = read_spec(args.spec)
     if args.method is not None:
         spec = replace(spec, method=args.method)
-    if args.global_search and spec.method == "minimax":
-        where = "--method minimax" if args.method else f'{spec.path} sets method = "minimax"'
-        raise CliError(
-            f"--global runs damped least squares only ({where}): drop --global for a minimax "
-            "run, or add --method least_squares for the global search"
-        )
     if args.max_evaluations is not None:
         if args.max_evaluations < 1:
             raise CliError("--max-evaluations must be at least 1")
@@ -487,6 +488,9 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
             "start_merits": [None if m != m else float(m) for m in res.start_merits],
             "workers": res.workers,
             "stopped": res.stopped or None,
+            "method": res.method,
+            "merit_is": GLOBAL_MERIT_NAMES[res.method],
+            "violation": res.violation,
         }
         glasses = {
             "glasses": [
@@ -505,15 +509,18 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         print_json(_result_json(spec, res, out, written, table, search, glasses))
     else:
         print(f"{spec.name}: {res.message}")
+        name = GLOBAL_MERIT_NAMES[res.method]
         print(
-            f"merit {res.merit_start:.6g} -> {res.merit:.6g}; {res.evaluations} evaluations "
+            f"{name} {res.merit_start:.6g} -> {res.merit:.6g}; {res.evaluations} evaluations "
             f"({res.seconds:.1f} s, {res.workers} worker(s))"
         )
+        if res.method == "minimax":
+            print(f"method minimax in every local run; largest bound violation {res.violation:.3g}")
         fin = [m for m in res.start_merits if m == m]
         if fin:
             print(
-                f"merit per start: min {min(fin):.6g}, median {statistics.median(fin):.6g}, "
-                f"max {max(fin):.6g}"
+                f"{name} per start: min {min(fin):.6g}, median "
+                f"{statistics.median(fin):.6g}, max {max(fin):.6g}"
             )
         for g in res.glasses:
             print(
@@ -556,7 +563,8 @@ def register(sub: argparse._SubParsersAction) -> None:
             'spec\'s method = "minimax": the largest weighted residual is minimised, the '
             "bounds are constraints); progress (evaluation, merit, worst operand) goes to "
             "stderr. With --global: many starts and basin hops around "
-            "damped least squares, glass substitution, in parallel worker processes; seeded "
+            "the local method (damped least squares or minimax), glass substitution, in "
+            "parallel worker processes; seeded "
             "and deterministic (the same seed gives the same lens whatever --workers); a "
             "progress bar on a terminal (tqdm) or plain lines; --time or Ctrl-C stops it and "
             "keeps the best design found (Ctrl-C: exit status 130). The lens is written with its "
@@ -595,8 +603,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--global",
         dest="global_search",
         action="store_true",
-        help="Global search: many starts and basin hopping around damped least squares, with "
-        "glass substitution for the spec's glass variables.",
+        help="Global search: many starts and basin hopping around the local method (damped "
+        "least squares, or minimax), with glass substitution for the spec's glass variables.",
     )
     g.add_argument(
         "--time", metavar="T", help="Time budget, e.g. 90s, 10m, 1h30m; the best design is kept."

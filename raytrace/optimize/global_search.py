@@ -1,17 +1,24 @@
-"""Global search: many starts and basin hopping around damped least squares, with glass
-substitution over the shipped catalogs (in the manner of OpticStudio's Hammer / global search
-and CODE V's global synthesis).
+"""Global search: many starts and basin hopping around the spec's local method (damped least
+squares, or minimax), with glass substitution over the shipped catalogs (in the manner of
+OpticStudio's Hammer / global search and CODE V's global synthesis).
+
+Every local run is the spec's ``method`` (:func:`raytrace.optimize.optimize`), and the starts are
+ranked by that method's merit: the sum of squared weighted residuals for ``least_squares``; for
+``minimax`` the exact-penalty merit φ = max|weighted target residual| + penalty × Σ weighted
+bound violations (:func:`raytrace.optimize.minimax.penalty_merit`, which is the max weighted
+residual itself when every bound is met), so that a design that breaks a bound never outranks
+one that keeps them all by less than the penalty says.
 
 One *start* (start 0 is the spec's start lens as given; start k > 0 perturbs its continuous
 variables and draws a random real glass for every glass variable):
 
 1. glass fitting (when the spec has glass variables and ``model_phase``): each glass becomes a
-   continuous nd / vd model glass inside its pool's window, damped least squares runs over all
+   continuous nd / vd model glass inside its pool's window, a local run goes over all
    variables, then each glass snaps to the nearest real glass and, variable by variable, takes
    the best of its ``neighbours`` nearest real glasses, each judged after a local run;
-2. a local damped-least-squares run (:func:`raytrace.optimize.optimize`);
+2. a local run (:func:`raytrace.optimize.optimize`, the spec's method);
 3. ``hops`` basin hops: perturb the start's best design, substitute one glass by one of its
-   ``neighbours`` nearest on the glass map, run damped least squares, keep the trial when its
+   ``neighbours`` nearest on the glass map, run the local method, keep the trial when its
    merit is lower.
 
 The starts run in worker processes (``concurrent.futures.ProcessPoolExecutor``, spawn start
@@ -46,6 +53,7 @@ from ..lens import Lens
 from ..materials import model_glass
 from ..paraxial import paraxial
 from .glasses import GlassPool, availability, glass_pool
+from .minimax import penalty_merit
 from .operands import OperandValue, evaluate, merit
 from .solver import (
     ASPHERIC_KINDS,
@@ -53,6 +61,7 @@ from .solver import (
     bounds,
     check_spec,
     continuous,
+    max_violation,
     optimize,
     set_materials,
     set_values,
@@ -124,7 +133,10 @@ class StartOutcome:
 class GlobalResult:
     """The result of :func:`global_optimize`.
 
-    lens: the best design; merit: its merit (sum of squared weighted residuals); merit_start:
+    lens: the best design; method: the spec's local method; merit: its merit (``least_squares``:
+    the sum of squared weighted residuals; ``minimax``: φ = max weighted residual + penalty ×
+    bound violations, the max weighted residual when every bound is met); violation: the largest
+    weighted bound violation of the design (0 when all are met); merit_start:
     the start lens's merit; start_merits: the best merit of each start (``nan`` for a start that
     did not run); best_start: the start the design came from (-1: the start lens, when no
     finished start is better); seed: the root seed; glasses: the glass of each glass variable;
@@ -132,7 +144,8 @@ class GlobalResult:
     the polish; seconds: wall time; workers: processes used (on Dask: the cluster's workers);
     stopped: ``""``, ``"time"`` (budget spent), ``"interrupted"`` or ``"cluster"`` (the Dask
     cluster went away; the message says how); converged: the spec's merit
-    goal is met (always true without a goal); message: a one-line summary.
+    goal is met (always true without a goal) and, with minimax, every bound is met; message: a
+    one-line summary.
     """
 
     lens: Lens
@@ -149,6 +162,8 @@ class GlobalResult:
     stopped: str
     converged: bool
     message: str
+    method: str = "least_squares"
+    violation: float = 0.0
 
     @property
     def starts(self) -> int:
@@ -193,9 +208,16 @@ def design(lens: Lens, spec: DesignSpec, x: np.ndarray, g, pools=None) -> Lens:
     return apply(_base(lens, spec, x, g, pools), spec, x)
 
 
+def _search_merit(spec: DesignSpec, values: tuple[OperandValue, ...]) -> float:
+    """The merit that ranks designs: the spec's method's (module docstring)."""
+    if spec.method == "minimax":
+        return penalty_merit(spec, values)
+    return merit(values)
+
+
 def _merit_of(lens: Lens, spec: DesignSpec) -> float:
     try:
-        return merit(evaluate(lens, spec.operands, check=False))
+        return _search_merit(spec, evaluate(lens, spec.operands, check=False))
     except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
         return math.inf
 
@@ -266,7 +288,8 @@ class _Start:
         self.evaluations += res.evaluations + 2
         if res.stopped:
             self.stopped = res.stopped
-        return res.merit, res.x
+        m = res.merit if spec.method == "least_squares" else _search_merit(spec, res.operands)
+        return m, res.x
 
     def offer(self, m: float, x, g, hop: int) -> None:
         if m < self.best_m:
@@ -498,11 +521,6 @@ def global_optimize(
     )
     spec = replace(spec, search=s)
     check_spec(lens, spec, need_continuous=False)
-    if spec.method != "least_squares":
-        raise SpecError(
-            f"method {spec.method!r} runs as a local optimization only: the global search ranks "
-            'its starts by the least-squares merit (use method = "least_squares" with --global)'
-        )
     pools = _pools(spec)  # raises SpecError for an unknown glass / empty pool, before any work
     t0 = time.perf_counter()
     deadline = time.time() + s.time_budget_s if s.time_budget_s is not None else math.inf
@@ -574,14 +592,15 @@ def global_optimize(
                 )
                 evaluations += pol.evaluations
                 stopped, polished = pol.stopped, True
-                if pol.merit < _merit_of(final, spec):
+                if _search_merit(spec, pol.operands) < _merit_of(final, spec):
                     final = pol.lens
             except KeyboardInterrupt:
                 stopped = "interrupted"
             except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
                 pass
     vals = evaluate(final, spec.operands, check=False)  # check_spec ran before the starts
-    m = merit(vals)
+    m = _search_merit(spec, vals)
+    viol = max_violation(vals)
     if polished:
         emit("polish", best_k, -1, m)
     choices = tuple(
@@ -598,6 +617,8 @@ def global_optimize(
         if g
     )
     converged = spec.merit_goal is None or m <= spec.merit_goal
+    if spec.method == "minimax" and viol > 1e-9 * (1.0 + m):
+        converged = False  # as a minimax run: a design that breaks a bound has not converged
     n_done = len(done)
     if best_k < 0:
         msg = (
@@ -611,7 +632,9 @@ def global_optimize(
     if stopped:
         why = {"time": "time budget spent", "interrupted": "interrupted"}
         msg += f"; stopped: {why.get(stopped, f'the Dask cluster was lost ({lost})')}"
-    if not converged:
+    if spec.method == "minimax" and viol > 1e-9 * (1.0 + m):
+        msg += f"; a bound is not met (largest weighted violation {viol:.3g})"
+    elif not converged:
         msg += f"; above the merit goal {spec.merit_goal:.6g}"
     return GlobalResult(
         lens=final,
@@ -628,6 +651,8 @@ def global_optimize(
         stopped=stopped,
         converged=converged,
         message=msg,
+        method=spec.method,
+        violation=viol,
     )
 
 

@@ -128,6 +128,36 @@ def _max_abs(e: np.ndarray) -> float:
     return float(np.max(np.abs(e))) if e.size else 0.0
 
 
+def exact_penalty(e: np.ndarray, g: np.ndarray, penalty: float) -> float:
+    """The minimax run's merit φ = max|e| + P Σ max(0, g) (module docstring): the largest
+    |weighted residual| of the target operands (``e``) plus ``penalty`` times the sum of the
+    weighted bound violations (``g`` > 0: violated). It equals the max weighted residual when
+    every bound is met."""
+    return _max_abs(e) + penalty * float(np.sum(np.maximum(g, 0.0)))
+
+
+def penalty_merit(spec: DesignSpec, values: tuple[OperandValue, ...]) -> float:
+    """φ (:func:`exact_penalty`) of evaluated operands under ``spec``'s penalty: the merit by
+    which minimax accepts steps and the global search ranks its minimax starts.
+
+    Parameters
+    ----------
+    spec : DesignSpec
+        Gives the target / bound split of the operands and ``penalty``.
+    values : tuple of OperandValue
+        The operands evaluated on one design (:func:`raytrace.optimize.evaluate`).
+
+    Returns
+    -------
+    float
+        φ in the operands' weighted units; ``inf`` when an operand is not finite.
+    """
+    e, g = split(spec, values)
+    if not (np.all(np.isfinite(e)) and np.all(np.isfinite(g))):
+        return math.inf
+    return exact_penalty(e, g, float(spec.penalty))
+
+
 def _lp_step(e, g, J, G, radius, zlo, zhi, penalty):
     """Solve the trust-region LP in scaled steps z; returns (z, t, model φ) or None."""
     n = J.shape[1]
@@ -235,7 +265,7 @@ def minimax(
         return e, g, vals
 
     def phi(e, g) -> float:
-        return _max_abs(e) + P * float(np.sum(np.maximum(g, 0.0)))
+        return exact_penalty(e, g, P)
 
     e, g, vals = ev(x, start=True)
     m0 = _max_abs(e)
