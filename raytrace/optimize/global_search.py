@@ -6,8 +6,8 @@ Every local run is the spec's ``method`` (:func:`raytrace.optimize.optimize`), a
 ranked by that method's merit: the sum of squared weighted residuals for ``least_squares``; for
 ``minimax`` the exact-penalty merit φ = max|weighted target residual| + penalty × Σ weighted
 bound violations (:func:`raytrace.optimize.minimax.penalty_merit`, which is the max weighted
-residual itself when every bound is met), so that a design that breaks a bound never outranks
-one that keeps them all by less than the penalty says.
+residual itself when every bound is met), so that breaking a bound costs penalty × the weighted
+violation in the ranking.
 
 One *start* (start 0 is the spec's start lens as given; start k > 0 perturbs its continuous
 variables and draws a random real glass for every glass variable):
@@ -53,7 +53,7 @@ from ..lens import Lens
 from ..materials import model_glass
 from ..paraxial import paraxial
 from .glasses import GlassPool, availability, glass_pool
-from .minimax import penalty_merit
+from .minimax import bounds_met, penalty_merit
 from .operands import OperandValue, evaluate, merit
 from .solver import (
     ASPHERIC_KINDS,
@@ -215,6 +215,12 @@ def _search_merit(spec: DesignSpec, values: tuple[OperandValue, ...]) -> float:
     return merit(values)
 
 
+def _run_merit(spec: DesignSpec, res) -> float:
+    """The ranking merit of a local run's result: damped least squares reports it; a minimax
+    result reports max|e| alone, so φ is taken from its operands."""
+    return res.merit if spec.method == "least_squares" else _search_merit(spec, res.operands)
+
+
 def _merit_of(lens: Lens, spec: DesignSpec) -> float:
     try:
         return _search_merit(spec, evaluate(lens, spec.operands, check=False))
@@ -288,8 +294,7 @@ class _Start:
         self.evaluations += res.evaluations + 2
         if res.stopped:
             self.stopped = res.stopped
-        m = res.merit if spec.method == "least_squares" else _search_merit(spec, res.operands)
-        return m, res.x
+        return _run_merit(spec, res), res.x
 
     def offer(self, m: float, x, g, hop: int) -> None:
         if m < self.best_m:
@@ -592,7 +597,7 @@ def global_optimize(
                 )
                 evaluations += pol.evaluations
                 stopped, polished = pol.stopped, True
-                if _search_merit(spec, pol.operands) < _merit_of(final, spec):
+                if _run_merit(spec, pol) < _merit_of(final, spec):
                     final = pol.lens
             except KeyboardInterrupt:
                 stopped = "interrupted"
@@ -616,9 +621,9 @@ def global_optimize(
         for j, v in enumerate(_glass_vars(spec))
         if g
     )
-    converged = spec.merit_goal is None or m <= spec.merit_goal
-    if spec.method == "minimax" and viol > 1e-9 * (1.0 + m):
-        converged = False  # as a minimax run: a design that breaks a bound has not converged
+    # as a minimax run: a design that breaks a bound has not converged
+    feasible = spec.method != "minimax" or bounds_met(viol, m)
+    converged = feasible and (spec.merit_goal is None or m <= spec.merit_goal)
     n_done = len(done)
     if best_k < 0:
         msg = (
@@ -632,7 +637,7 @@ def global_optimize(
     if stopped:
         why = {"time": "time budget spent", "interrupted": "interrupted"}
         msg += f"; stopped: {why.get(stopped, f'the Dask cluster was lost ({lost})')}"
-    if spec.method == "minimax" and viol > 1e-9 * (1.0 + m):
+    if not feasible:
         msg += f"; a bound is not met (largest weighted violation {viol:.3g})"
     elif not converged:
         msg += f"; above the merit goal {spec.merit_goal:.6g}"

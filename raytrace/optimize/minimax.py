@@ -136,6 +136,12 @@ def exact_penalty(e: np.ndarray, g: np.ndarray, penalty: float) -> float:
     return _max_abs(e) + penalty * float(np.sum(np.maximum(g, 0.0)))
 
 
+def bounds_met(violation: float, merit: float) -> bool:
+    """Whether a design's largest weighted bound violation is zero to rounding (1e-9 relative to
+    1 + its max weighted residual ``merit``): the feasibility test of a minimax result."""
+    return violation <= 1e-9 * (1.0 + merit)
+
+
 def penalty_merit(spec: DesignSpec, values: tuple[OperandValue, ...]) -> float:
     """φ (:func:`exact_penalty`) of evaluated operands under ``spec``'s penalty: the merit by
     which minimax accepts steps and the global search ranks its minimax starts.
@@ -357,7 +363,7 @@ def minimax(
     m = _max_abs(e)
     viol = max_violation(vals)
     converged = status == "converged" and not stopped
-    feasible = viol <= 1e-9 * (1.0 + m)
+    feasible = bounds_met(viol, m)
     if converged and not feasible:
         converged = False
         worst = max((o for o in vals if o.operand.bounded), key=lambda o: abs(o.residual))
