@@ -239,9 +239,10 @@ def crown_singlet_spec(starts: int, hops: int) -> DesignSpec:
     )
 
 
-def test_same_seed_same_result_with_one_and_two_workers():
+@pytest.mark.parametrize("method", ["least_squares", "minimax"])
+def test_same_seed_same_result_with_one_and_two_workers(method):
     lens = singlet()
-    spec = crown_singlet_spec(starts=3, hops=1)
+    spec = replace(crown_singlet_spec(starts=3, hops=1), method=method)
     one = global_optimize(lens, spec, seed=7, workers=1)
     two = global_optimize(lens, spec, seed=7, workers=2)
     assert one.stopped == two.stopped == ""
@@ -250,6 +251,7 @@ def test_same_seed_same_result_with_one_and_two_workers():
     assert one.merit == two.merit  # bit for bit
     assert one.lens == two.lens
     assert one.glasses == two.glasses
+    assert one.method == two.method == method and math.isfinite(one.merit)
 
 
 @pytest.mark.parametrize("poisoned", ["all but the lens", "first draw"])
@@ -371,17 +373,20 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path, 
 # --------------------------------------------------------------------------- Dask
 def test_dask_cluster_gives_the_same_design_as_one_process():
     """The starts as tasks on a Dask LocalCluster (two worker processes): the same per-start
-    merits and the same design, bit for bit, as in this process; a time budget stops it with
-    the best design so far."""
+    merits and the same design, bit for bit, as in this process, with either local method; a
+    time budget stops it with the best design so far."""
     pytest.importorskip("distributed")
     from raytrace.executors import dask_client
 
     lens = load_lens("cooke-triplet-f4")
     spec = cooke_multimodal(starts=2)
     here = global_optimize(lens, spec, seed=7, workers=1)
-    client, close = dask_client("local:2")  # one cluster for both runs (a client is accepted)
+    minimax = replace(spec, method="minimax")  # the local runs are minimax on the workers too
+    here_mm = global_optimize(lens, minimax, seed=7, workers=1)
+    client, close = dask_client("local:2")  # one cluster for the runs (a client is accepted)
     try:
         dask = global_optimize(lens, spec, seed=7, executor=client)
+        dask_mm = global_optimize(lens, minimax, seed=7, executor=client)
         budget = global_optimize(
             lens, cooke_multimodal(starts=12), seed=7, executor=client, time_budget_s=1.0
         )
@@ -389,6 +394,8 @@ def test_dask_cluster_gives_the_same_design_as_one_process():
         close()
     assert np.array_equal(here.start_merits, dask.start_merits)
     assert here.merit == dask.merit and not dask.stopped
+    assert np.array_equal(here_mm.start_merits, dask_mm.start_merits)
+    assert here_mm.merit == dask_mm.merit and dask_mm.method == "minimax"
     for a, b in zip(here.lens.surfaces, dask.lens.surfaces, strict=True):
         assert a.curvature == b.curvature
     assert budget.stopped == "time" and math.isfinite(budget.merit)
