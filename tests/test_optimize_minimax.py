@@ -233,6 +233,19 @@ def test_stop_and_evaluation_limit_keep_the_best_design():
     assert res.evaluations <= 8
 
 
+@pytest.mark.parametrize("method", ["minimax", "least_squares"])
+def test_a_stop_asked_at_once_returns_the_start_design_stopped(method):
+    """A stop that is already asked when a run begins (the global search's time budget or
+    Ctrl-C landing between two local runs) ends the run with the start design, not an error:
+    minimax raised Stopped from its first evaluation, which crashed the global search."""
+    start = _lens(2.6, -0.02)
+    res = optimize(start, _spec(), stop=lambda: "time", method=method)
+    assert res.stopped == "time" and not res.converged
+    assert res.lens.surfaces[0].thickness == start.surfaces[0].thickness
+    assert res.lens.surfaces[1].curvature == start.surfaces[1].curvature
+    assert res.merit == res.merit_start
+
+
 # ----------------------------------------------------------------------------- (c) the spec
 HEAD = 'start = "cooke-triplet-f4"\nvariables = [ { kind = "curvature", surface = 1 } ]\n'
 
@@ -388,6 +401,7 @@ def test_cli_global_minimax(tmp_path: Path, capsys):
     assert "largest bound violation 0" in text
     lens = read_lens(out)
     assert paraxial(lens).efl == pytest.approx(49.5, abs=1e-8)
+    assert "--global --seed 3 --starts 2 --method minimax'" in lens.notes
     assert "local method minimax" in lens.notes
     out2 = tmp_path / "o2.toml"
     argv2 = ["optimize", str(spec), "-o", str(out2), "--method", "minimax", "--json"]

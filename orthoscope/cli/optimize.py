@@ -152,7 +152,8 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
     text = (
         "provenance: derived\n"
         f"Designed with 'orthoscope optimize {Path(spec.path).name} --global --seed {res.seed} "
-        f"--starts {res.starts}' ({spec.search.hops} hops per start, local method "
+        f"--starts {res.starts}{' --method minimax' if res.method == 'minimax' else ''}' "
+        f"({spec.search.hops} hops per start, local method "
         f"{res.method}) from the start lens {start_name}; {GLOBAL_MERIT_NAMES[res.method]} "
         f"{res.merit:.9g} (start {res.merit_start:.9g}), best of "
         f"{res.starts_done}/{res.starts} starts ("

@@ -255,7 +255,9 @@ def minimax(
 
     def ev(xv: np.ndarray, start: bool = False):
         try:
-            vals = checked_evaluate(lens, spec, xv, stop, log)
+            # the start is always evaluated (as damped least squares does), so a stop asked
+            # for at once still returns the start design, stopped; later evaluations ask stop()
+            vals = checked_evaluate(lens, spec, xv, None if start else stop, log)
         except EVAL_FAILURES as err:
             if start:  # the start must evaluate: its own error, as damped least squares gives it
                 raise
