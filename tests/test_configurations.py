@@ -365,6 +365,17 @@ def test_solve_focus_refuses_impossible_requests() -> None:
         solve_focus(lens, 1000.0, moving=2, compensating=2)
     with pytest.raises(DataError, match="surfaces 1–8"):
         focus_configurations(lens, [1000.0], moving=9)
+    with pytest.raises(DataError, match="focus distance 10 mm is inside the lens"):
+        solve_focus(lens, 10.0, moving=8)
+    # a lens the paraxial trace refuses is refused with the request's context from the
+    # first evaluation on (not only inside the secant loop)
+    from dataclasses import replace
+
+    from raytrace.frames import Placement
+
+    tilted = replace(lens, image_placement=Placement(tilt=(1.0, 0.0, 0.0)))
+    with pytest.raises(DataError, match="cannot focus on 1000 mm by moving surface 8: .*centred"):
+        solve_focus(tilted, 1000.0, moving=8)
 
 
 def test_cli_variation_configurations(capsys) -> None:

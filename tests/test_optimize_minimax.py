@@ -317,6 +317,9 @@ def test_global_search_runs_minimax_and_reaches_the_reference_optimum():
     t_ref, c_ref, e_ref = REF
     res = global_optimize(_lens(), _spec(), starts=3, seed=5, hops=1)
     assert res.method == "minimax" and res.converged, res.message
+    # the one-line message names the merit it reports (phi, not a sum of squares)
+    assert res.merit_is == "max weighted residual (+ penalty x bound violations)"
+    assert res.message.startswith(f"best {res.merit_is} {res.merit:.6g} from start")
     assert res.merit == pytest.approx(e_ref, rel=1e-9)
     assert res.start_merits == pytest.approx([e_ref] * 3, rel=1e-7)
     assert res.violation == 0.0

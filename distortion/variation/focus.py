@@ -145,11 +145,10 @@ def solve_focus(
     ------
     DataError
         A surface number outside 1..n, ``compensating == moving``, a distance that is not
-        positive, an object plane inside the lens, a solve that meets an impossible lens or
-        does not converge.
-    LensError, TraceError
-        From :func:`raytrace.paraxial.paraxial` at the start of the solve (an afocal or
-        non-centred lens, a wavelength the unit checks refuse).
+        positive, an object plane inside the lens, a lens the paraxial trace refuses (afocal,
+        not centred; at the start or on the way), a solve that does not converge.
+    TraceError
+        A wavelength the unit checks refuse.
     """
     n = lens.n_surfaces
     for k, what in ((moving, "moving"), (compensating, "compensating")):
@@ -163,7 +162,13 @@ def solve_focus(
         )
 
     def miss(d: float) -> float:
-        return _gaussian_miss(_moved(lens, moving, compensating, d, distance_mm), wavelength)
+        moved = _moved(lens, moving, compensating, d, distance_mm)  # DataError: says why
+        try:
+            return _gaussian_miss(moved, wavelength)
+        except LensError as e:
+            raise DataError(
+                f"{lens.name}: cannot focus on {distance_mm:g} mm by moving surface {moving}: {e}"
+            ) from None
 
     d0, d1 = 0.0, 1e-3 * max(1.0, abs(lens.surfaces[moving - 1].thickness))
     f0, f1 = miss(d0), miss(d1)
@@ -173,12 +178,7 @@ def solve_focus(
         if f1 == f0:
             break
         d0, d1, f0 = d1, d1 - f1 * (d1 - d0) / (f1 - f0), f1
-        try:
-            f1 = miss(d1)
-        except (LensError, DataError) as e:
-            raise DataError(
-                f"{lens.name}: cannot focus on {distance_mm:g} mm by moving surface {moving}: {e}"
-            ) from None
+        f1 = miss(d1)
     if not abs(f1) <= FOCUS_TOLERANCE_MM:
         raise DataError(
             f"{lens.name}: focusing on {distance_mm:g} mm by moving surface {moving} did not "
@@ -221,7 +221,7 @@ def focus_configurations(
 
     Raises
     ------
-    DataError, LensError, TraceError
+    DataError, TraceError
         As :func:`solve_focus`.
     """
     return Configurations(
@@ -625,7 +625,7 @@ def unit_focus_configurations(
 
     Raises
     ------
-    DataError, LensError, TraceError
+    DataError, TraceError
         As :func:`solve_focus`.
     """
     return focus_configurations(lens, distances_mm, moving=lens.n_surfaces, wavelength=wavelength)

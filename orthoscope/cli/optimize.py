@@ -124,12 +124,6 @@ OUTPUTS = [("-o", ".toml")]
 
 #: how the CLI names the merit of each method (OptimizationResult.merit)
 MERIT_NAMES = {"least_squares": "merit", "minimax": "max weighted residual"}
-#: the global search's merit of each method (GlobalResult.merit): with minimax, the exact
-#: penalty merit, which is the max weighted residual when every bound is met
-GLOBAL_MERIT_NAMES = {
-    "least_squares": "merit",
-    "minimax": "max weighted residual (+ penalty x bound violations)",
-}
 
 
 def provenance_notes(lens, spec, res, start_name: str) -> str:
@@ -154,7 +148,7 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
         f"Designed with 'orthoscope optimize {Path(spec.path).name} --global --seed {res.seed} "
         f"--starts {res.starts}{' --method minimax' if res.method == 'minimax' else ''}' "
         f"({spec.search.hops} hops per start, local method "
-        f"{res.method}) from the start lens {start_name}; {GLOBAL_MERIT_NAMES[res.method]} "
+        f"{res.method}) from the start lens {start_name}; {res.merit_is} "
         f"{res.merit:.9g} (start {res.merit_start:.9g}), best of "
         f"{res.starts_done}/{res.starts} starts ("
         + (f"start {res.best_start}" if res.best_start >= 0 else "the start lens, kept")
@@ -490,7 +484,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
             "workers": res.workers,
             "stopped": res.stopped or None,
             "method": res.method,
-            "merit_is": GLOBAL_MERIT_NAMES[res.method],
+            "merit_is": res.merit_is,
             "violation": res.violation,
         }
         glasses = {
@@ -510,7 +504,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         print_json(_result_json(spec, res, out, written, table, search, glasses))
     else:
         print(f"{spec.name}: {res.message}")
-        name = GLOBAL_MERIT_NAMES[res.method]
+        name = res.merit_is
         print(
             f"{name} {res.merit_start:.6g} -> {res.merit:.6g}; {res.evaluations} evaluations "
             f"({res.seconds:.1f} s, {res.workers} worker(s))"

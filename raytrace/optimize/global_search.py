@@ -87,6 +87,14 @@ class GlassChoice:
     price: float = math.nan
 
 
+#: the name of :attr:`GlobalResult.merit` for each local method: with minimax, the exact
+#: penalty merit φ, which is the max weighted residual when every bound is met
+MERIT_NAMES = {
+    "least_squares": "merit",
+    "minimax": "max weighted residual (+ penalty x bound violations)",
+}
+
+
 @dataclass(frozen=True)
 class SearchProgress:
     """A progress report of the global search.
@@ -164,6 +172,11 @@ class GlobalResult:
     message: str
     method: str = "least_squares"
     violation: float = 0.0
+
+    @property
+    def merit_is(self) -> str:
+        """What :attr:`merit` is (:data:`MERIT_NAMES` of the method)."""
+        return MERIT_NAMES[self.method]
 
     @property
     def starts(self) -> int:
@@ -627,12 +640,13 @@ def global_optimize(
     n_done = len(done)
     if best_k < 0:
         msg = (
-            f"merit {m:.6g}: the start lens, kept ({n_done}/{s.starts} starts finished, none "
-            f"better; seed {s.seed})"
+            f"{MERIT_NAMES[spec.method]} {m:.6g}: the start lens, kept ({n_done}/{s.starts} "
+            f"starts finished, none better; seed {s.seed})"
         )
     else:
         msg = (
-            f"best merit {m:.6g} from start {best_k} of {n_done}/{s.starts} starts (seed {s.seed})"
+            f"best {MERIT_NAMES[spec.method]} {m:.6g} from start {best_k} of {n_done}/"
+            f"{s.starts} starts (seed {s.seed})"
         )
     if stopped:
         why = {"time": "time budget spent", "interrupted": "interrupted"}
