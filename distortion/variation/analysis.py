@@ -68,7 +68,7 @@ from .models import (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class GEstimate:
     """g_ss' from one object plane (Eq. 6 rearranged: δr_ss' − δr_s = g (δr_s' − δr_s)).
 
@@ -225,7 +225,7 @@ def rms_error_eq6(dr_s: np.ndarray, dr_s_prime: np.ndarray, dr_ss_prime: np.ndar
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Profile:
     """One radial distortion profile: object at ``obj`` with the lens focused at ``focus``.
 
@@ -301,7 +301,7 @@ class BrownGamma:
     gamma: float
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class BrownComparison:
     """Brown's Eq. (1) prediction δr_s'/γ against the measured δr_ss' (µm) at radii ``r_mm``."""
 
@@ -334,7 +334,7 @@ class FocusSummary:
     summary: GSummary
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FieldVariation:
     """Distortion of all object planes at one focus setting on common radii (µm); ``spread_um``
     = max − min over the planes at each radius: the variation within the photographic field."""
@@ -346,7 +346,7 @@ class FieldVariation:
     spread_um: np.ndarray
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class InterpolationCheck:
     """Brown Eq. (3)–(4): the Gaussian profile at s predicted from those at s1, s2."""
 

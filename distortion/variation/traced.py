@@ -237,7 +237,7 @@ def conjugate_geometry(lens: Lens, c: Conjugate, *, wavelength: float | None = N
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TracedSetting:
     """One traced profile: object at ``obj`` with the lens focused at ``focus``.
 
@@ -350,7 +350,7 @@ def trace_setting(
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TracedVariation:
     """Prescription-mode result.
 

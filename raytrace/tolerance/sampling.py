@@ -1,7 +1,7 @@
 """Seeded draws of perturbed instances: instance ``i`` of a run is the same lens whatever the
 chunking, the number of workers or the host's thread count.
 
-Generator (docs/design.md, "Tolerancing"): every instance has its own stream,
+Generator (docs/tolerance.md, "Random numbers, determinism"): every instance has its own stream,
 ``numpy.random.Generator(PCG64(SeedSequence(seed, spawn_key=(i,))))`` — exactly the i-th child
 of ``SeedSequence(seed).spawn(n)``, built directly from the index so that any instance can be
 drawn alone. From its stream an instance draws one value per item, in the spec's item order:
