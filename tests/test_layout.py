@@ -137,3 +137,35 @@ def test_every_public_function_documents_its_parameters():
             if "Parameters" not in doc or (returns and "Returns" not in doc):
                 missing.append(name)
     assert missing == []
+
+
+@pytest.mark.parametrize("pkg", sorted(LAYERS))
+def test_results_holding_arrays_are_eq_false(pkg):
+    """docs/design.md, "Conventions": a dataclass with an array field is ``eq=False`` (a
+    generated ``==`` would compare arrays and raise "truth value of an array is ambiguous")."""
+    bad = []
+    for path, tree in _modules(pkg):
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.ClassDef):
+                continue
+            deco = [
+                d
+                for d in node.decorator_list
+                if (isinstance(d, ast.Call) and getattr(d.func, "id", "") == "dataclass")
+                or getattr(d, "id", "") == "dataclass"
+            ]
+            if not deco:
+                continue
+            arrays = [
+                s.target.id
+                for s in node.body
+                if isinstance(s, ast.AnnAssign)
+                and isinstance(s.target, ast.Name)
+                and re.search(r"\b(ndarray|NDArray)\b", ast.unparse(s.annotation))
+                and not ast.unparse(s.annotation).startswith("Callable")  # a function field
+            ]
+            kw = {k.arg: k.value for k in getattr(deco[0], "keywords", [])}
+            eq_false = isinstance(kw.get("eq"), ast.Constant) and kw["eq"].value is False
+            if arrays and not eq_false:
+                bad.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({arrays[0]})")
+    assert not bad, "dataclasses holding arrays without eq=False:\n" + "\n".join(bad)
