@@ -549,8 +549,9 @@ class Lens:
         return replace(self, wavelengths=wl, weights=w, wavelength=float(ref))
 
     def _out_of_range(self, m: Material, wl: np.ndarray, j: int, env) -> np.ndarray:
-        """The index of a catalog glass evaluated outside its data range, with the material's
-        warning (or strict error) repeated with the lens file and surface in front."""
+        """The index of a catalog glass evaluated outside its data range (a model glass outside
+        :data:`~raytrace.materials.MODEL_RANGE_NM`), with the material's warning (or strict
+        error) repeated with the lens file and surface in front."""
         import warnings
 
         from .materials import OutOfRangeError, OutOfRangeWarning
@@ -568,6 +569,15 @@ class Lens:
             else:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         return n
+
+    def _valid_span(self) -> tuple[float, float]:
+        """:meth:`catalog_span` narrowed by the span of the model glasses of the lens
+        (:data:`raytrace.materials.MODEL_RANGE_NM`): where no index of the lens warns."""
+        lo, hi = self.catalog_span()
+        for m in (self.object_material, *(s.material for s in self.surfaces)):
+            if m.kind == "model":
+                lo, hi = max(lo, m.valid_range_nm[0]), min(hi, m.valid_range_nm[1])
+        return lo, hi
 
     def catalog_span(self) -> tuple[float, float]:
         """The wavelengths (nm) inside the data range of every catalog glass of the lens (object
@@ -591,7 +601,7 @@ class Lens:
             key = (float(wavelengths),)
         else:
             key = tuple(float(w) for w in np.atleast_1d(np.asarray(wavelengths, dtype=float)))
-        lo, hi = self.catalog_span()
+        lo, hi = self._valid_span()
         if all(lo <= w <= hi for w in key):
             return _indices(self, key)
         return _indices.__wrapped__(self, key)  # out of a glass's range: warn every time
@@ -686,7 +696,7 @@ def _indices(lens: Lens, wavelengths: tuple[float, ...]) -> np.ndarray:
     for j, m in enumerate(mats):
         n = done.get(m)
         if n is None:
-            if m.kind == "catalog" and not m.in_range(wl):
+            if m.kind in ("catalog", "model") and not m.in_range(wl):
                 n = lens._out_of_range(m, wl, j, env)
             else:
                 n = _index(m, wl, env)

@@ -407,4 +407,6 @@ def test_a_warning_raised_again_is_printed_once(capsys):
     for _ in range(2):  # each run says it (the cache of a lens's indices is per process)
         _indices.cache_clear()
         rc, _, err = run(capsys, *argv)
-        assert rc == 0 and err.count("outside its data range") == 1, err
+        # N-SK16 (surfaces 1 and 5, one material) and the model glass of surface 3
+        lines = [ln for ln in err.splitlines() if "outside its data range" in ln]
+        assert rc == 0 and len(lines) == 2 and len(set(lines)) == 2, err

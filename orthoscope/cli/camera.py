@@ -629,7 +629,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         o,
         help="Exit with status 2 when a chief ray fails, when the lens file names a glass that "
         "can only be read as a substitute (an N- successor, a parent glass, a model of nd/vd), "
-        "when a glass is evaluated outside its catalog data range, or when the sensor reaches "
+        "when a glass is evaluated outside its catalog data range (an nd/vd model glass outside "
+        "365-1014 nm), or when the sensor reaches "
         "beyond the lens's image circle (before anything is written).",
     )
     add_force_arg(q)

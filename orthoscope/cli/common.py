@@ -397,7 +397,7 @@ FORCE_HELP = "Replace existing output files (never an input)."
 STRICT_HELP = (
     "Exit with status 2 when a field cannot be traced, when the lens file names a glass read "
     "only as a substitute (an N- successor, a parent glass, a model of nd/vd), or when a glass "
-    "is evaluated outside its catalog data range."
+    "is evaluated outside its catalog data range (an nd/vd model glass outside 365-1014 nm)."
 )
 TABLE_LAYOUT_HELP = (
     "Table orientation: 'rows' (one row per field; default) or 'paper' (fields across, as "
