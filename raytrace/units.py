@@ -79,9 +79,10 @@ def length_mm(
     if isinstance(value, str):
         v, unit = _split(value, what)
         if not unit:
-            if require_unit:
+            if require_unit and not math.isinf(v):  # inf needs no unit
+                t = value.strip()
                 raise UnitError(
-                    f"{what}: {value!r} needs a unit — write e.g. {value}m or {value}mm "
+                    f"{what}: {value!r} needs a unit — write e.g. {t}m or {t}mm "
                     "(a bare number is ambiguous here)"
                 )
             unit = "mm"
@@ -104,13 +105,17 @@ def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
     spectral-line letter (:data:`SPECTRAL_LINES`: ``"d"``, ``"F'"``).
 
     Refuses NaN, inf, zero and negative values, and values outside
-    :data:`WAVELENGTH_RANGE_NM`; a bare number below 100 looks like µm and the message says so
-    (``0.5876`` → "write 0.5876um or 587.6nm")."""
-    unit = "nm"
+    :data:`WAVELENGTH_RANGE_NM`; a bare number below 100 that is in range as µm looks like µm
+    and the message says so (``0.5876`` → "write 0.5876um or 587.6nm"; one that looks like
+    metres or millimetres says that). A value that carries its unit (``"0.55nm"``,
+    ``"0.05um"``) is taken as meant: out of range, the message gives the range (a unit is never
+    appended to it)."""
+    bare = True
     if isinstance(value, str) and value.strip() in SPECTRAL_LINES:
         return SPECTRAL_LINES[value.strip()]
     if isinstance(value, str):
         v, unit = split_unit(value)
+        bare = not unit
         unit = unit or "nm"
         if unit not in WAVELENGTH_UNITS:
             raise UnitError(f"{what}: unknown wavelength unit {unit!r} in {value!r}; use nm or um")
@@ -126,14 +131,15 @@ def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
         raise UnitError(f"{what}: a wavelength must be positive, got {value!r}")
     lo, hi = WAVELENGTH_RANGE_NM
     for factor, name in ((1e9, "metres"), (1e6, "millimetres")):
-        if v < lo and unit == "nm" and v * 1000.0 < lo and lo <= v * factor <= hi:
+        if bare and v < lo and v * 1000.0 < lo and lo <= v * factor <= hi:
             raise UnitError(
                 f"{what} {value!r} nm looks like {name}: write {v * factor:g}nm (wavelengths "
                 "are in nm)"
             )
-    if v < lo and unit == "nm":
+    if bare and v < lo and lo <= v * 1000.0 <= hi:
+        t = value.strip() if isinstance(value, str) else value
         raise UnitError(
-            f"{what} {value!r} nm looks like micrometres: write {value}um or "
+            f"{what} {value!r} nm looks like micrometres: write {t}um or "
             f"{v * 1000:g}nm (wavelengths are in nm)"
         )
     if not lo <= v <= hi:

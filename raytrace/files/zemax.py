@@ -64,7 +64,10 @@ checked and what cannot be detected; lenses/INTEROP.md, "Truncated files").
 Writing (:func:`dumps_zmx`, :func:`write_zmx`) produces a sequential file OpticStudio reads, with
 every number at full float64 precision (``repr``), model glasses, fixed semi-diameters, and the
 orthoscope fields Zemax has no place for (source, notes, the Gaussian image solve) in
-``NOTE 0 orthoscope.<key>: <json>`` lines, so that native → .zmx → native is exact.
+``NOTE 0 orthoscope.<key>: <json>`` lines, so that native → .zmx → native is exact. Catalog
+glasses are written by name with a ``GCAT`` line whose catalog order makes every name resolve to
+its own catalog under the first-catalog-wins rule above (:func:`_gcat`; refused when no order
+does).
 """
 
 from __future__ import annotations
@@ -77,7 +80,7 @@ from pathlib import Path
 
 from ..errors import LensError, PrescriptionError
 from ..frames import ORDERS, Placement
-from ..glass import lookup_glass, parse_glass_code, printed_nd_vd, resolve_glass
+from ..glass import parse_glass_code, printed_nd_vd, resolve_glass
 from ..lens import Aperture, ClearAperture, Field, Lens, Surface
 from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
 from ..qtype import QType
@@ -1005,9 +1008,18 @@ def _glas(m: Material) -> str | None:
 
 
 def _gcat(lens: Lens) -> list[str]:
-    """The GCAT catalogs of the lens's catalog glasses, in order of first use; raises when a
-    name would resolve to another catalog under OpticStudio's first-catalog-wins rule."""
-    from ..glass import CATALOGS
+    """The GCAT line: the catalogs of the lens's catalog glasses in an order in which every
+    glass name resolves to that glass, as OpticStudio and the reader here resolve it
+    (:func:`raytrace.glass.resolve_glass`: the first catalog on the line that has the name).
+
+    A glass of catalog C whose name another written catalog D also has needs C before D; the
+    order is the one that meets all these constraints and otherwise keeps the order of first use
+    (a topological order, smallest by first use: the order of first use itself whenever it
+    works). The Lens does not keep the GCAT line of a file it was read from, so that order is not
+    preferred. Raises PrescriptionError when no order works (two glasses need opposite orders,
+    e.g. Schott's SF11 and Hikari's SF11 in one lens) or a glass's name, as written, reads as
+    another glass of its own catalog."""
+    from ..glass import CATALOGS, find_glass
 
     mats = [lens.object_material, *(s.material for s in lens.surfaces)]
     for m in mats:
@@ -1017,17 +1029,51 @@ def _gcat(lens: Lens) -> list[str]:
                 "file cannot hold (OpticStudio needs it in a glass catalog); write the lens as "
                 ".toml instead"
             )
-    cats = list(dict.fromkeys(m.catalog for m in mats if m.kind == "catalog"))
-    for m in mats:
-        if m.kind == "catalog":
-            g = lookup_glass(m.name, cats, first_catalog_wins=True)
-            if g.catalog != m.catalog:
-                raise PrescriptionError(
-                    f"glass {m.name} of the {m.catalog} catalog cannot be written to .zmx next "
-                    f"to the {g.catalog} catalog, which also has a {m.name}: OpticStudio would "
-                    "take the first catalog on the GCAT line; write the lens as .toml instead"
-                )
-    return [c.upper() for c in cats]
+    glasses = list(dict.fromkeys((m.name, m.catalog) for m in mats if m.kind == "catalog"))
+    cats = list(dict.fromkeys(c for _, c in glasses))
+    # after[c][d]: the glass of catalog c whose name d also has, so c must come before d
+    after: dict[str, dict[str, str]] = {c: {} for c in cats}
+    for name, cat in glasses:
+        written = name.replace(" ", "")  # as _glas writes it
+        own = find_glass(written, [cat])
+        if not own or (own[0].catalog, own[0].name) != (cat, name):
+            other = f"as {own[0].name}" if own else "as no glass of it"
+            raise PrescriptionError(
+                f"glass {name} of the {cat} catalog cannot be written to .zmx: its name, "
+                f"written {written}, reads back in the {cat} catalog {other}; write the lens as "
+                ".toml instead"
+            )
+        for d in cats:
+            if d != cat and find_glass(written, [d]):
+                after[cat].setdefault(d, name)
+    rank = {c: i for i, c in enumerate(cats)}
+    needs = {c: sum(c in after[b] for b in cats) for c in cats}  # catalogs that must precede c
+    ready = [c for c in cats if not needs[c]]
+    order: list[str] = []
+    while ready:
+        c = min(ready, key=rank.__getitem__)
+        ready.remove(c)
+        order.append(c)
+        for d in after[c]:
+            needs[d] -= 1
+            if not needs[d]:
+                ready.append(d)
+    if len(order) < len(cats):
+        left = [c for c in cats if c not in order]
+        clashes = "; ".join(
+            f"glass {name} of the {c} catalog needs {c.upper()} before {d.upper()}, which also "
+            f"has a {name}"
+            for c in left
+            for d, name in after[c].items()
+            if d in left
+        )
+        raise PrescriptionError(
+            "the glasses of this lens cannot all be written to .zmx: OpticStudio takes the first "
+            "catalog on the GCAT line that has a glass's name, and no order of the catalogs "
+            f"gives every glass its own ({clashes}); write the lens as .toml instead, or give "
+            "one of these glasses as a model glass"
+        )
+    return [c.upper() for c in order]
 
 
 def _one_line(s: str) -> str:
