@@ -4,7 +4,8 @@ allocates anything and names what lifts the limit (``--allow-large`` on the comm
 
 #: fields (chief rays per plane), radii or rays of one request
 MAX_FIELDS = 100_000
-#: rays across a pupil (fans, spots) of one request
+#: rays of one ray fan or one field's spot diagram (pupil samples: ``--n``, or the rays that
+#: ``--pattern`` and ``--rings`` make)
 MAX_SAMPLES = 1_000_000
 #: Monte Carlo instances of one tolerance run
 MAX_INSTANCES = 1_000_000

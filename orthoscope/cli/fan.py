@@ -13,9 +13,9 @@ from .common import (
     add_object_args,
     add_output_args,
     add_plane_args,
+    add_strict_arg,
     add_wavelength_arg,
     check_plot_path,
-    check_size,
     load_input,
     number,
     print_result,
@@ -23,6 +23,7 @@ from .common import (
     resolve_object,
     resolve_planes,
     save_plot,
+    strict_check,
 )
 
 #: Quick runs of these commands for the per-command tests (tests/test_hardening.py).
@@ -46,10 +47,56 @@ def _field_kw(value: float, kind: str) -> dict:
     return {"field_deg": value} if kind == "angle" else {"object_height_mm": value}
 
 
+def _check_rays(args, pattern: str, n: int, flags: str) -> int:
+    """``n`` (``--n`` or ``--rings``, named in ``flags``) if the rays of ``pattern`` it makes are
+    within :data:`raytrace.limits.MAX_SAMPLES` (or the run has --allow-large); else CliError
+    naming the flag, the ray count and the flag that lifts the limit. Counted, not made."""
+    from raytrace import limits
+    from raytrace.trace.pupil import SAMPLE_BYTES, pupil_count
+
+    if n < 1:
+        raise CliError(f"{flags} must be at least 1, got {n}")
+    if pattern == "square" and n < 3:
+        raise CliError(
+            f"--pattern square {flags} {n}: a grid of {n} point(s) across has no point inside "
+            "the pupil (its points are the corners of the square); give --rings 3 or more"
+        )
+    count = pupil_count(pattern, n)
+    if count > limits.MAX_SAMPLES and not getattr(args, "allow_large", False):
+        given = f"{flags} {n}" if flags == "--n" else f"--pattern {pattern} {flags} {n}"
+        raise CliError(
+            f"{given}: {count} rays, more than {limits.MAX_SAMPLES} (about "
+            f"{count * SAMPLE_BYTES / 1e9:.3g} GB and a long run); give --allow-large (before "
+            "the command) to run it anyway"
+        )
+    return n
+
+
+def _trace_each(items, trace):
+    """``trace(item)`` for each item; a field that cannot be traced
+    (:class:`~raytrace.trace.fans.FieldNotTracedError`) as a
+    :class:`~orthoscope.report.rays.NotTraced` in its place, so the other fields are kept."""
+    from raytrace.trace.fans import FieldNotTracedError
+
+    from ..report.rays import NotTraced
+
+    out = []
+    for item in items:
+        try:
+            out.append(trace(item))
+        except FieldNotTracedError as e:
+            out.append(NotTraced(e, axis=item if isinstance(item, str) else None))
+    return out
+
+
 def _output(args, lens, key, items, to_dict, to_csv, to_text, what) -> None:
-    """``items`` (ray fans or spot diagrams) as JSON (``{"lens", key: [...]}``), CSV or text on
-    stdout, and the plot of ``--plot`` (:func:`orthoscope.plots.rays.plot_ray_fan` for
-    ``key="fans"``, :func:`~orthoscope.plots.rays.plot_spot` for ``"spots"``)."""
+    """``items`` (ray fans or spot diagrams, or :class:`~orthoscope.report.rays.NotTraced` for a
+    field that could not be traced) as JSON (``{"lens", key: [...]}``), CSV or text on stdout,
+    and the plot of ``--plot`` of the traced ones (:func:`orthoscope.plots.rays.plot_ray_fan`
+    for ``key="fans"``, :func:`~orthoscope.plots.rays.plot_spot` for ``"spots"``); with
+    ``--strict``, exit 2 after them when a field was not traced."""
+    from ..report.rays import NotTraced, field_status
+
     print_result(
         args,
         json=lambda: {"lens": lens.name, key: [to_dict(i) for i in items]},
@@ -57,10 +104,17 @@ def _output(args, lens, key, items, to_dict, to_csv, to_text, what) -> None:
         text=lambda: to_text(items),
     )
     if args.plot:
+        traced = [i for i in items if not isinstance(i, NotTraced)]
+        if not traced:
+            raise CliError("no field could be traced (see the output): there is nothing to plot")
         from ..plots.rays import plot_ray_fan, plot_spot
 
         plot = plot_ray_fan if key == "fans" else plot_spot
-        save_plot(lambda: plot(items, title=f"{lens.name}: {what}"), args.plot, args)
+        save_plot(lambda: plot(traced, title=f"{lens.name}: {what}"), args.plot, args)
+    status = field_status(items)
+    if key == "fans":  # the fans of both axes are one field, about one chief ray
+        status = status[:1]
+    strict_check(args, status, see=" (see the output)")
 
 
 def cmd_fan(args) -> int:
@@ -73,10 +127,12 @@ def cmd_fan(args) -> int:
     kind = args.field_kind or lens.field.kind
     field = number(args.field, "--field")
     axes = ["y", "x"] if args.axis == "both" else [args.axis]
-    n = check_size(args.n, MAX_SAMPLES, "--n", args)
-    fans = [
-        ray_fan(lens, **_field_kw(field, kind), n=n, axis=a, **_common(lens, args)) for a in axes
-    ]
+    n = _check_rays(args, "fan_y", args.n, "--n")
+    common = _common(lens, args)
+    fans = _trace_each(
+        axes,
+        lambda a: ray_fan(lens, **_field_kw(field, kind), n=n, axis=a, allow_large=True, **common),
+    )
     _output(args, lens, "fans", fans, fan_to_dict, fans_csv, format_fans, "ray fans")
     return 0
 
@@ -89,25 +145,26 @@ def cmd_spot(args) -> int:
     lens = load_input(args)
     check_plot_path(args.plot, "--plot", args)
     fields, kind = resolve_fields(lens, args)
-    check_size(args.rings, 1000, "--rings", args, per_item_bytes=6 * 200 * args.rings)
-    spots = [
-        spot_diagram(
-            lens, **_field_kw(float(f), kind), pattern=args.pattern, n=args.rings,
-            **_common(lens, args),
-        )
-        for f in fields
-    ]  # fmt: skip
+    n = _check_rays(args, args.pattern, args.rings, "--rings")
+    common = _common(lens, args)
+    spots = _trace_each(
+        [float(f) for f in fields],
+        lambda f: spot_diagram(
+            lens, **_field_kw(f, kind), pattern=args.pattern, n=n, allow_large=True, **common
+        ),
+    )
     _output(args, lens, "spots", spots, spot_to_dict, spots_csv, format_spots, "spot diagrams")
     return 0
 
 
 def _add_image_args(q: argparse.ArgumentParser, plot_help: str) -> None:
     """What fan and spot share after their own flags: object, image plane, wavelength, --plot
-    (``plot_help``), --force, --json / --csv."""
+    (``plot_help``), --strict, --force, --json / --csv."""
     add_object_args(q)
     add_plane_args(q)
     add_wavelength_arg(q)
     q.add_argument("--plot", metavar="FILE", help=plot_help)
+    add_strict_arg(q)
     add_force_arg(q)
     add_output_args(q)
 
@@ -119,14 +176,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Trace a fan of real rays across the paraxial entrance pupil, centred on the "
         "real chief ray of one field, and report the transverse ray aberration (intercept "
         "minus the chief ray's, mm) in the image plane: tangential (eps_y against py) and/or "
-        "sagittal (eps_x against px).",
+        "sagittal (eps_x against px). A field whose chief ray fails is reported as not traced "
+        "(exit 0; 2 with --strict).",
         epilog="Example: orthoscope fan cooke-triplet-f4 --field 14 --axis both --plot fan.png",
     )
     add_lens_arg(q)
     q.add_argument("--field", default="0", metavar="F", help="Field: degrees or object mm.")
     q.add_argument("--field-kind", choices=["angle", "height"], help="What --field is.")
     q.add_argument("--axis", choices=["y", "x", "both"], default="y", help="Fan direction.")
-    q.add_argument("--n", type=int, default=21, help="Rays across the pupil.")
+    q.add_argument(
+        "--n", type=int, default=21,
+        help=f"Rays across the pupil (more than {MAX_SAMPLES} need --allow-large).",
+    )  # fmt: skip
     _add_image_args(q, "Save the ray-fan plot (.png/.svg/.pdf).")
     q.set_defaults(func=cmd_fan)
 
@@ -135,7 +196,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Spot diagrams with RMS and geometric radius per field.",
         description="Trace rays over the pupil (aimed about the real chief ray) for each field "
         "and report the spot in the image plane relative to the chief ray: centroid, RMS radius "
-        "and geometric radius about the centroid (mm in JSON, µm in the table).",
+        "and geometric radius about the centroid (mm in JSON, µm in the table). A field whose "
+        "chief ray fails, or whose rays all fail, is reported as not traced (exit 0; 2 with "
+        "--strict).",
         epilog="Example: orthoscope spot cooke-triplet-f4 --fields 0,10,20 --plot spots.png",
     )
     add_lens_arg(q)
@@ -144,6 +207,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--pattern", choices=["hexapolar", "rings", "square"], default="hexapolar",
         help="Pupil sampling.",
     )  # fmt: skip
-    q.add_argument("--rings", type=int, default=8, help="Rings (or points across) of the pattern.")
+    q.add_argument(
+        "--rings", type=int, default=8,
+        help="Rings (or points across: at least 3 for square) of the pattern; more than "
+        f"{MAX_SAMPLES} rays need --allow-large.",
+    )  # fmt: skip
     _add_image_args(q, "Save the spot diagrams (.png/.svg/.pdf).")
     q.set_defaults(func=cmd_spot)

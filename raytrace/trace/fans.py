@@ -6,6 +6,10 @@ aberration ``ε = (x, y)_ray − (x, y)_chief`` (mm). A tangential fan varies py
 y direction) and plots ε_y; a sagittal fan varies px and plots ε_x. A spot diagram's RMS radius
 is taken about the spot's centroid; its geometric radius is the largest distance from the
 centroid. Units: mm, degrees, nm.
+
+Both take one field and raise :class:`FieldNotTracedError` (a :class:`TraceError`) when that field
+cannot be traced: its real chief ray fails, or (spot diagrams) no ray reaches the image plane.
+The command line catches it per field and reports the field as not traced.
 """
 
 from __future__ import annotations
@@ -23,7 +27,37 @@ from ..paraxial.conjugates import checked_wavelength
 from .chief import aim
 from .pupil import aimed_bundle, pupil_points
 from .rays import trace_rays
-from .results import RayStatus, field_unit
+from .results import RayStatus, field_unit, status_name
+
+
+class FieldNotTracedError(TraceError):
+    """The one field of :func:`ray_fan` or :func:`spot_diagram` cannot be traced.
+
+    Attributes
+    ----------
+    field, field_kind:
+        The field (degrees or object mm) and ``"angle"`` / ``"height"``.
+    status:
+        The status code (:mod:`raytrace.kernels.codes`): the chief ray's when it failed, else
+        the most frequent one of the rays (none of which reached the image plane).
+    status_name:
+        Its word (``"aim_failed"``, ``"clipped"``, ...).
+    object_distance, z_plane, wavelength:
+        The object plane, image plane (absolute z, mm) and wavelength (nm) asked for.
+    rays:
+        How many rays were traced about the chief ray (0 when the chief ray failed).
+    """
+
+    def __init__(self, message: str, *, status: int, rays: int, common: dict) -> None:
+        super().__init__(message)
+        self.status = int(status)
+        self.status_name = status_name(status)
+        self.rays = int(rays)
+        self.field = common["field"]
+        self.field_kind = common["field_kind"]
+        self.object_distance = common["object_distance"]
+        self.z_plane = common["z_plane"]
+        self.wavelength = common["wavelength"]
 
 
 def _field(lens: Lens, field_deg, object_height_mm, finite: bool) -> tuple[float, str]:
@@ -75,11 +109,15 @@ def _trace_field(
     if len(planes) != 1:
         raise TraceError("ray fans and spot diagrams take one image plane")
     z = float(plane_z(par, planes)[0])
+    where = dict(field=f, field_kind=kind, object_distance=od, z_plane=z, wavelength=par.wavelength)
     cr = aim(lens, np.array([f]), kind, od, wavelength, clip=False)
     if cr.status[0] != STATUS_OK:
-        raise TraceError(
-            f"{lens.name}: the chief ray of field {f:g} {'deg' if kind == 'angle' else 'mm'} "
-            f"fails ({cr.status_names[0]}); no fan or spot about it"
+        raise FieldNotTracedError(
+            f"{lens.name}: the chief ray of field {f:g} {field_unit(kind)} "
+            f"fails ({cr.status_names[0]}); no fan or spot about it",
+            status=cr.status[0],
+            rays=0,
+            common=where,
         )
     b = aimed_bundle(
         lens, par, (cr.y_start[0], cr.z_start[0], cr.M_start[0], cr.N_start[0]), px, py
@@ -87,15 +125,7 @@ def _trace_field(
     rb = trace_rays(lens, b.origins, b.directions, wavelength=wavelength, clip=clip)
     x, y = rb.at_plane(z)
     yc = float(cr.heights_at(z)[0])
-    common = dict(
-        field=f,
-        field_kind=kind,
-        object_distance=od,
-        z_plane=z,
-        chief_height=yc,
-        wavelength=par.wavelength,
-    )
-    return x, y - yc, rb.status, common
+    return x, y - yc, rb.status, {**where, "chief_height": yc}
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,6 +181,7 @@ def ray_fan(
     object_scale: float | None = None,
     wavelength: float | None = None,
     clip: bool = True,
+    allow_large: bool = False,
 ) -> RayFan:
     """A fan of real rays aimed about the real chief ray of one field.
 
@@ -160,7 +191,7 @@ def ray_fan(
     field_deg, object_height_mm : float
         The field: an angle in degrees (default 0) or an object height in mm (finite objects).
     n : int
-        Rays across the pupil, from −1 to 1.
+        Rays across the pupil, from −1 to 1 (a whole number, at least 1).
     axis : {"y", "x"}
         "y": tangential fan (pupil coordinate py, aberration ε_y); "x": sagittal (px, ε_x).
     plane, s_prime, from_last_vertex, defocus
@@ -171,16 +202,23 @@ def ray_fan(
         nm; default the lens's.
     clip : bool
         Apply semi-diameters (vignetted rays get a status and NaN).
+    allow_large : bool
+        Trace more than :data:`raytrace.limits.MAX_SAMPLES` rays (refused by default).
 
     Returns
     -------
     RayFan
         Pupil coordinates and transverse aberrations ε (mm) relative to the real chief ray.
+
+    Raises
+    ------
+    FieldNotTracedError
+        The field's real chief ray fails (its ``status_name`` says how).
     """
     require_lens(lens)
     if axis not in ("x", "y"):
         raise TraceError(f"axis must be 'y' (tangential) or 'x' (sagittal), got {axis!r}")
-    px, py = pupil_points("fan_y" if axis == "y" else "fan_x", int(n))
+    px, py = pupil_points("fan_y" if axis == "y" else "fan_x", n, allow_large=allow_large)
     x, dy, st, common = _trace_field(
         lens, field_deg, object_height_mm, px, py, plane=plane, s_prime=s_prime,
         from_last_vertex=from_last_vertex, defocus=defocus, object_distance=object_distance,
@@ -245,6 +283,7 @@ def spot_diagram(
     object_scale: float | None = None,
     wavelength: float | None = None,
     clip: bool = True,
+    allow_large: bool = False,
 ) -> SpotDiagram:
     """The spot diagram of one field: real rays over the pupil, aimed about the real chief ray.
 
@@ -254,7 +293,8 @@ def spot_diagram(
     field_deg, object_height_mm : float
         The field: an angle in degrees (default 0) or an object height in mm (finite objects).
     pattern : {"hexapolar", "rings", "square"}
-        Pupil sampling (:mod:`raytrace.trace.pupil`); ``n`` rings (or points across).
+        Pupil sampling (:mod:`raytrace.trace.pupil`); ``n`` rings (or points across: at least
+        3 for ``"square"``), a whole number.
     plane, s_prime, from_last_vertex, defocus
         The image plane; default the Gaussian plane.
     object_distance, object_s, object_scale
@@ -263,16 +303,24 @@ def spot_diagram(
         nm; default the lens's.
     clip : bool
         Apply semi-diameters.
+    allow_large : bool
+        Trace more than :data:`raytrace.limits.MAX_SAMPLES` rays (refused by default).
 
     Returns
     -------
     SpotDiagram
         Intercepts relative to the chief ray (mm), centroid, RMS and geometric radius (mm).
+
+    Raises
+    ------
+    FieldNotTracedError
+        The field's real chief ray fails, or no ray reaches the image plane (its
+        ``status_name`` says how).
     """
     require_lens(lens)
     if pattern not in ("hexapolar", "rings", "square"):
         raise TraceError(f"pattern must be hexapolar, rings or square, got {pattern!r}")
-    px, py = pupil_points(pattern, int(n))
+    px, py = pupil_points(pattern, n, allow_large=allow_large)
     x, dy, st, common = _trace_field(
         lens, field_deg, object_height_mm, px, py, plane=plane, s_prime=s_prime,
         from_last_vertex=from_last_vertex, defocus=defocus, object_distance=object_distance,
@@ -280,8 +328,15 @@ def spot_diagram(
     )  # fmt: skip
     ok = st == STATUS_OK
     if not ok.any():
-        raise TraceError(
-            f"{lens.name}: no ray of field {common['field']:g} reaches the image plane"
+        codes, counts = np.unique(st, return_counts=True)
+        order = np.argsort(-counts, kind="stable")
+        how = ", ".join(f"{counts[i]} {status_name(codes[i])}" for i in order)
+        raise FieldNotTracedError(
+            f"{lens.name}: no ray of field {common['field']:g} {field_unit(common['field_kind'])} "
+            f"reaches the image plane ({st.size} rays: {how})",
+            status=codes[order[0]],
+            rays=st.size,
+            common=common,
         )
     cx, cy = float(np.mean(x[ok])), float(np.mean(dy[ok]))
     r2 = (x[ok] - cx) ** 2 + (dy[ok] - cy) ** 2

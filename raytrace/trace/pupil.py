@@ -13,7 +13,8 @@ Patterns (:func:`pupil_points`):
                by half a step): every ray stands for the same pupil area, so RMS values and the
                least-RMS focus are those of a uniformly filled pupil.
 ``hexapolar``  the axis ray plus rings at ρ = k/n with 6k rays (the classic spot-diagram pattern).
-``square``     a square grid clipped to the unit circle (n points across).
+``square``     a square grid clipped to the unit circle (n points across, n >= 3: with 1 or 2
+               points across every grid point is a corner (±1, ±1), outside the pupil).
 ``fan_y``, ``fan_x``  n points from −1 to 1 along py (tangential) or px (sagittal).
 """
 
@@ -24,19 +25,61 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import limits
 from ..errors import TraceError
 from ..lens import Lens
 from ..paraxial.firstorder import ParaxialResult
+from ..units import is_whole
 
 PATTERNS = ("rings", "hexapolar", "square", "fan_y", "fan_x")
+#: memory per ray of a fan or spot diagram (bytes, about: the trace and its output), for the
+#: size a refused request would have taken
+SAMPLE_BYTES = 200
 
 
-def pupil_points(pattern: str, n: int, *, per_ring: int = 24) -> tuple[np.ndarray, np.ndarray]:
-    """Normalised pupil coordinates (px, py) of a sampling ``pattern`` (module docstring)."""
+def pupil_count(pattern: str, n: int, *, per_ring: int = 24) -> int:
+    """How many rays :func:`pupil_points` gives for ``pattern`` and ``n``, counted without making
+    them (``square`` beyond 100 000 points across: π/4·n², above every work limit)."""
+    n = int(n)
+    if pattern == "rings":
+        return n * per_ring
+    if pattern == "hexapolar":
+        return 1 + 3 * n * (n + 1)
+    if pattern == "square":
+        if n > 100_000:
+            return round(math.pi / 4 * n * n)
+        g = np.linspace(-1.0, 1.0, n)
+        half = np.sqrt(np.clip(1.0 + 1e-12 - g * g, 0.0, None))  # |x| allowed in each row
+        return int(np.sum(np.searchsorted(g, half, side="right") - np.searchsorted(g, -half)))
+    return n
+
+
+def pupil_points(
+    pattern: str, n: int, *, per_ring: int = 24, allow_large: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """Normalised pupil coordinates (px, py) of a sampling ``pattern`` (module docstring).
+
+    ``n`` is a whole number (rings, or points across); more than
+    :data:`raytrace.limits.MAX_SAMPLES` rays are refused, before any is made, unless
+    ``allow_large=True``.
+    """
     if pattern not in PATTERNS:
         raise TraceError(f"unknown pupil pattern {pattern!r}; use one of {', '.join(PATTERNS)}")
-    if not (isinstance(n, (int, np.integer)) and 1 <= n <= 10_000):
-        raise TraceError(f"pupil sampling n must be an integer 1..10000, got {n!r}")
+    if not (is_whole(n) and n >= 1):
+        raise TraceError(f"pupil sampling n must be a whole number, at least 1, got {n!r}")
+    if pattern == "square" and n < 3:
+        raise TraceError(
+            f"pattern='square' with n={n}: a grid of {n} point(s) across has no point inside "
+            "the pupil (its points are corners (±1, ±1)); give n=3 or more"
+        )
+    count = pupil_count(pattern, n, per_ring=per_ring)
+    if count > limits.MAX_SAMPLES and not allow_large:
+        given = f"n={n}" if pattern in ("fan_y", "fan_x") else f"pattern={pattern!r} with n={n}"
+        raise TraceError(
+            f"{given}: {count} rays, more than {limits.MAX_SAMPLES} "
+            f"(about {count * SAMPLE_BYTES / 1e9:.3g} GB and a long run); give allow_large=True "
+            "to run it anyway"
+        )
     if pattern == "rings":
         k = np.arange(1, n + 1)
         rho = np.repeat(np.sqrt((k - 0.5) / n), per_ring)
