@@ -193,6 +193,7 @@ _API: dict[str, str] = {
     "LensError": "raytrace.errors",
     "TraceError": "raytrace.errors",
     "OutputError": "raytrace.errors",
+    "FieldNotTracedError": "raytrace.trace.fans",
     "DataError": "distortion.errors",
     "CalibrationError": "distortion.errors",
 }
@@ -337,6 +338,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily
         spot_diagram,
         trace_rays,
     )
+    from raytrace.trace.fans import FieldNotTracedError
 
     from .plots.camera import (
         plot_calibration_comparison,
