@@ -65,7 +65,12 @@ Decentering
     tabulated at the radii ``r = c_c tan θ`` of the table, and the axis ψ (degrees from +x
     toward +y) along which the radial decentering distortion is largest (3 J r²); Brown's φ0, the
     axis of maximum tangential distortion, is ψ − 90°. Below ``DECENTERING_FLOOR_MM`` at the edge
-    of the format (a centred design) the axis is undefined and given as NaN with a note.
+    of the format (a centred design) the fitted P1, P2 are round-off of the symmetric sums (for
+    the bundled centred lenses J = 7e-20 to 1.4e-18 mm⁻¹, J r² at the edge 3e-13 to 2e-11 µm):
+    P1, P2, J and the profile are given as exactly 0 and the axis as NaN, with a note. The floor
+    (1e-9 mm = 1e-6 µm at the edge) lies five orders of magnitude below the printed 0.1 µm and
+    more than four above that round-off. The thin-prism terms S1, S2 of the same fit (JSON only)
+    are treated the same way (``√(S1² + S2²) r²`` at the edge below the floor: 0).
 
 A decentered or tilted lens (``Lens.is_centred`` false) takes its first-order data — Pestrecov's
 constants, the Gaussian plane, the field's nominal angles — from its centred lens
@@ -74,6 +79,12 @@ constants, the Gaussian plane, the field's nominal angles — from its centred l
 Radial coefficients (USGS form)
     A least-squares fit of the mean Δr on the dense fields: ``Δr = k0 r + k1 r³ + k2 r⁵ + k3 r⁷``
     (r = c_c tan θ, mm), with its RMS residual.
+
+Work limit
+    The semi-diagonals' chief rays (tabulated fields, the dense fields and the corners, on each of
+    the four) are counted from the step and the format before anything is traced; more than
+    :data:`raytrace.limits.MAX_FIELDS` is refused unless ``allow_large=True`` (``--allow-large``
+    on the command line): ``field_step_deg=1e-6`` would take tens of GB.
 """
 
 from __future__ import annotations
@@ -87,6 +98,7 @@ import numpy as np
 
 from raytrace.errors import TraceError
 from raytrace.lens import Lens
+from raytrace.limits import MAX_FIELDS
 
 from .errors import DataError
 
@@ -103,8 +115,12 @@ POLAR_AZIMUTH_STEP_DEG = 15.0
 POLAR_FIELDS = 30
 #: radial terms of the decomposition that gives the decentering
 RADIAL_TERMS = 5
-#: a decentering profile below this at the edge of the format (mm) has no axis
+#: a decentering profile below this at the edge of the format (mm) is round-off of a centred
+#: design: given as 0, with no axis (module docstring, "Decentering")
 DECENTERING_FLOOR_MM = 1e-9
+#: memory of one chief ray of the semi-diagonals, for the work limit's message (measured: about
+#: 820 bytes of peak RSS per ray, cooke-triplet-f4 at field_step_deg=0.001)
+BYTES_PER_RAY = 800
 
 METHOD_TEXT = {
     "minimax": (
@@ -358,12 +374,41 @@ def _traceable_limit(lens, par, clip, azimuth, ok_dense, dense, theta_corner) ->
     return float(f[miss[0] - 1]) if miss.size and miss[0] > 0 else lo
 
 
+def _table_count(theta_max: float, step: float) -> int:
+    """The number of tabulated fields of :func:`_table_fields`, without making them."""
+    n = int(math.floor(theta_max / step + 1e-9))
+    return n + (1 if theta_max - n * step > 0.05 * step else 0)
+
+
 def _table_fields(theta_max: float, step: float) -> np.ndarray:
     n = int(math.floor(theta_max / step + 1e-9))
     f = step * np.arange(1, n + 1)
     if theta_max - (f[-1] if f.size else 0.0) > 0.05 * step:
         f = np.append(f, theta_max)
     return f
+
+
+def _check_work(theta_max: float, step: float, n_diagonals: int, allow_large: bool) -> None:
+    """Refuse more than ``MAX_FIELDS`` chief rays on the semi-diagonals (tabulated, dense and
+    corner fields) without ``allow_large``, before anything is made or traced."""
+    nt = _table_count(theta_max, step)
+    rays = n_diagonals * (nt + DENSE_FIELDS + n_diagonals)  # the corners: one trace
+    if rays > MAX_FIELDS and not allow_large:
+        smallest = theta_max / max(MAX_FIELDS // n_diagonals - DENSE_FIELDS - n_diagonals - 1, 1)
+        raise DataError(
+            f"field_step_deg={step:g}: {nt} tabulated fields on each of the {n_diagonals} "
+            f"semi-diagonals ({rays} chief rays), more than {MAX_FIELDS} (about "
+            f"{rays * BYTES_PER_RAY / 1e9:.3g} GB and a long run); give a step of at least "
+            f"{_round_up(smallest)} deg, or allow_large=True to run it anyway"
+        )
+
+
+def _round_up(x: float) -> str:
+    """``x`` rounded up to two significant digits, as text (the smallest step allowed)."""
+    if not x > 0:
+        return f"{x:g}"
+    e = math.floor(math.log10(x)) - 1
+    return f"{math.ceil(x / 10.0**e - 1e-9) * 10.0**e:.{max(-e, 0)}f}"
 
 
 def calibration_certificate(
@@ -384,6 +429,7 @@ def calibration_certificate(
     max_field_deg: float | None = None,
     date: str | None = None,
     clip: bool = True,
+    allow_large: bool = False,
 ) -> CalibrationCertificate:
     """The predicted calibration certificate of ``lens`` (module docstring).
 
@@ -412,6 +458,10 @@ def calibration_certificate(
         The date printed (default today, ISO).
     clip : bool
         Apply the lens's semi-diameters.
+    allow_large : bool
+        Lift the work limit: more than :data:`raytrace.limits.MAX_FIELDS` chief rays on the
+        semi-diagonals (a very small ``field_step_deg``) is refused without it, before any
+        trace (module docstring, "Work limit").
 
     Returns
     -------
@@ -477,6 +527,7 @@ def calibration_certificate(
     th_max = np.degrees(np.arctan(T_max))
     if np.any(th_max >= 89.0):
         raise DataError("the format reaches 89 degrees or more; the certificate needs less")
+    _check_work(float(np.max(th_max)), step, int(az.size), allow_large)
 
     # 1. the semi-diagonals: tabulated and dense fields and the four corners in one trace (a
     # format whose corners do not trace is refused first)
@@ -536,15 +587,19 @@ def calibration_certificate(
     img = polar.actual[0].reshape(-1, 2)
     fit = solve_linear(t, img, radial_terms=RADIAL_TERMS, principal_point=(R[0], R[1]))
     P1, P2 = fit.values["P1"], fit.values["P2"]
+    S1, S2 = fit.values["S1"], fit.values["S2"]
     J, psi = decentering_profile(P1, P2)
     r_edge = cc * float(np.max(T_max))
     notes = []
-    if J * r_edge**2 < DECENTERING_FLOOR_MM:
+    if J * r_edge**2 < DECENTERING_FLOOR_MM:  # round-off of a centred design (docstring)
+        P1 = P2 = J = 0.0
         psi = math.nan
         notes.append(
             f"decentering below {DECENTERING_FLOOR_MM * 1e3:g} um at the edge of the format "
-            "(a centred design): its axis is undefined"
+            "(a centred design): P1, P2 and J are given as 0 and the axis is undefined"
         )
+    if math.hypot(S1, S2) * r_edge**2 < DECENTERING_FLOOR_MM:
+        S1 = S2 = 0.0
     radius = cc * Ta
     prof = 1000.0 * J * radius**2
 
@@ -599,8 +654,8 @@ def calibration_certificate(
             "J": J,
             "axis_deg": psi,
             "phi0_deg": psi - 90.0 if math.isfinite(psi) else math.nan,
-            "S1": fit.values["S1"],
-            "S2": fit.values["S2"],
+            "S1": S1,
+            "S2": S2,
             "residual_rms_um": fit.rms_mm * 1000.0,
         },
         decentering_profile_um=prof[:nt],

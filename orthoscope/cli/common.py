@@ -27,7 +27,7 @@ PLANE_HELP = (
     "--from-last-vertex D (mm from the last vertex), --defocus DZ (mm from the Gaussian image "
     "plane, + away from the lens), --gaussian (the Gaussian plane of the object). Default: the "
     'lens file\'s image plane (a file whose last thickness is "gaussian" means the Gaussian '
-    "plane of whatever object is traced)."
+    "plane of whatever object is traced, at the lens's reference wavelength)."
 )
 FIELDS_HELP = (
     "Comma-separated fields: half-field angles in degrees (object-space chief-ray slope angle; "
@@ -257,7 +257,8 @@ def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> N
 
 def resolve_planes(lens, args) -> list:
     """The :class:`~raytrace.paraxial.ImagePlane` list the plane flags ask for (default: the lens
-    file's plane, or the Gaussian plane when the file solves its image to the Gaussian plane)."""
+    file's plane, or, when the file solves its image to the Gaussian plane, the Gaussian plane of
+    the traced object at the lens's reference wavelength: ``--wavelength`` does not move it)."""
     from raytrace.paraxial import ImagePlane
 
     given = {}
@@ -284,8 +285,10 @@ def resolve_planes(lens, args) -> list:
             raise CliError(f"--{kind.replace('_', '-')}: the plane {dup:g} is listed twice")
         gauss = [ImagePlane("gaussian")] if args.gaussian else []
         return [ImagePlane(kind, float(v)) for v in vals] + gauss
-    if args.gaussian or lens.image_solve == "gaussian":
+    if args.gaussian:
         return [ImagePlane("gaussian")]
+    if lens.image_solve == "gaussian":  # the file's solve: for the traced object, at the
+        return [ImagePlane("gaussian_reference")]  # reference wavelength (not --wavelength's)
     return [ImagePlane("file")]
 
 
@@ -438,9 +441,10 @@ def add_table_layout_arg(p) -> None:
 
 
 def check_output_path(path, args) -> None:
-    """Refuse an output file before any work: one of the command's inputs (``args._inputs``),
-    a missing folder, an existing file without --force (``args.force``). None: nothing to
-    check."""
+    """Refuse an output file before any work (:func:`raytrace.files.output.check_output`: a
+    name that ends in a path separator, one of the command's inputs ``args._inputs``, a missing
+    folder or one that cannot take a new file, an existing file without --force ``args.force``),
+    and a second output of the run naming the same file. None: nothing to check."""
     if path is None:
         return
     import os

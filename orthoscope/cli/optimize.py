@@ -256,7 +256,7 @@ def cmd_optimize(args) -> int:
     inputs = [spec.path] + ([lens.path] if lens.path else [])
     lens, spec = _edit_elements(args, lens, spec)
     # every output is checked before the run
-    check_output(out, inputs=inputs, overwrite=args.force, flag="--force")
+    check_output(args.output, inputs=inputs, overwrite=args.force, flag="--force")  # as typed
     if args.glass_map is not None:
         gm = Path(args.glass_map)
         if not any(v.kind == "glass" for v in spec.variables):
@@ -265,7 +265,7 @@ def cmd_optimize(args) -> int:
             raise CliError(f"--glass-map {gm}: use a .png, .svg or .pdf file")
         if gm.resolve() == out.resolve():
             raise CliError("--glass-map and -o name the same file")
-        check_output(gm, inputs=inputs, overwrite=args.force, flag="--force")
+        check_output(args.glass_map, inputs=inputs, overwrite=args.force, flag="--force")
     if args.global_search:
         return _run_global(args, spec, lens, out, inputs, over)
     if args.split == ["auto"]:

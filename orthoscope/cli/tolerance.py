@@ -173,7 +173,7 @@ def cmd_tolerance(args) -> int:
     if args.plot is not None:
         plot = Path(args.plot)
         # an input named as the output is the worse mistake: say that first
-        check_output(plot, inputs=inputs, overwrite=args.force, flag="--force")
+        check_output(args.plot, inputs=inputs, overwrite=args.force, flag="--force")
         if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
             raise CliError(f"--plot {plot}: use a .png, .svg or .pdf file")
     for lim, deg in limits:

@@ -71,6 +71,21 @@ def _dense(d: dict):
     return f, arr(dn["radial_um"]), arr(dn["mean_radial_um"]), arr(dn["decentering_profile_um"])
 
 
+#: the most tabulated fields marked as points on the plots; beyond, the fields of the page's
+#: table (:func:`orthoscope.report.certificate.page_field_indices`)
+MARKED_MAX = 100
+
+
+def _marked(d: dict) -> np.ndarray:
+    """Indices of the tabulated fields the plots mark as points."""
+    n = len(d["fields_deg"])
+    if n <= MARKED_MAX:
+        return np.arange(n)
+    from ..report.certificate import page_field_indices
+
+    return np.asarray(page_field_indices(d)[0])
+
+
 #: room beyond the format's edge on the field axis (fraction of it), so that the tabulated
 #: points at the edge are drawn whole, not cut by the axes' border
 FIELD_MARGIN = 0.04
@@ -95,15 +110,16 @@ def _style(ax, xlabel: str | None, ylabel: str | None, fontsize: float = 7.0) ->
 def plot_certificate_radial(cert, index: int, *, ax=None, title: str | None = None):
     """Radial distortion (µm) against the field angle along semi-diagonal ``index`` (0–3) of a
     certificate (or its dict), with the mean of the four in grey and the tabulated values as
-    points."""
+    points (those of the page's table when there are more than ``MARKED_MAX``)."""
     d = _as_dict(cert)
     fig, ax = figure_and_axes(ax)
     f, rad, mean, _ = _dense(d)
     sd = d["semi_diagonals"][index]
     ax.plot(f, mean, color="0.6", lw=1.0, ls="--", label="mean of the four")
     ax.plot(f, rad[index], color=COLOURS[index % 4], lw=1.4, label=sd["label"])
-    tf = np.asarray(d["fields_deg"], dtype=float)
-    tv = np.array([np.nan if v is None else v for v in sd["radial_um"]], dtype=float)
+    j = _marked(d)
+    tf = np.asarray(d["fields_deg"], dtype=float)[j]
+    tv = np.array([np.nan if v is None else v for v in sd["radial_um"]], dtype=float)[j]
     ax.plot(tf, tv, "o", ms=3, color=COLOURS[index % 4])
     _field_xlim(ax, f)
     _style(ax, "field angle \u03b8 (\u00b0)", "radial distortion (\u00b5m)")
@@ -119,9 +135,10 @@ def plot_certificate_decentering(cert, *, ax=None, title: str | None = None):
     fig, ax = figure_and_axes(ax)
     f, _, _, prof = _dense(d)
     ax.plot(f, prof, color="C4", lw=1.4)
-    tf = np.asarray(d["fields_deg"], dtype=float)
+    j = _marked(d)
+    tf = np.asarray(d["fields_deg"], dtype=float)[j]
     tv = np.array([np.nan if v is None else v for v in d["decentering"]["profile_um"]], dtype=float)
-    ax.plot(tf, tv, "o", ms=3, color="C4")
+    ax.plot(tf, tv[j], "o", ms=3, color="C4")
     _field_xlim(ax, f)
     top = float(np.nanmax(np.abs(prof))) if np.isfinite(prof).any() else 0.0
     if top < 1e-3:  # a centred design: keep the axis readable around zero
@@ -228,21 +245,55 @@ def _summary(pg: _Page, d: dict) -> None:
     pg.y = min(end, pg.y)
 
 
+#: where the columns of the field table start (figure fraction): the labels' width at 7.5 pt
+TABLE_X0 = LEFT + 0.2
+#: the font of the field table's numbers (pt): 7.5, smaller where the widest number would come
+#: closer than ``TABLE_GAP_EM`` to its neighbour, never below ``TABLE_MIN_SIZE``
+TABLE_SIZE, TABLE_MIN_SIZE, TABLE_GAP_EM = 7.5, 5.0, 0.9
+
+
 def _columns(n: int) -> np.ndarray:
-    x0 = LEFT + 0.3
-    w = (RIGHT - x0) / n
-    return x0 + w * (np.arange(n) + 1)
+    """The right edges of ``n`` equal columns of the field table (figure fraction)."""
+    w = (RIGHT - TABLE_X0) / n
+    return TABLE_X0 + w * (np.arange(n) + 1)
+
+
+def _table_size(d: dict) -> float:
+    """The font size of the field table's numbers (the radial table and the decentering profile
+    row share its columns): the widest printed number, in its weight, fits its column with a
+    gap of ``TABLE_GAP_EM``."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    from ..report.certificate import decentering_cells, page_field_indices, radial_table_cells
+
+    idx, _ = page_field_indices(d)
+    head, rows = radial_table_cells(d)
+    _, prof = decentering_cells(d)
+    cells = [(head[j].text, "bold") for j in idx] + [(prof[j].text, "normal") for j in idx]
+    for i, (_, cs) in enumerate(rows):
+        weight = "bold" if i == len(rows) - 1 else "normal"
+        cells += [(cs[j].text, weight) for j in idx]
+    ttp = TextToPath()
+    em = max(
+        ttp.get_text_width_height_descent(t, FontProperties(size=1.0, weight=w), ismath=False)[0]
+        for t, w in cells
+    )
+    column_pt = (RIGHT - TABLE_X0) * PAGE[0] * 72.0 / max(len(idx), 1)
+    return float(np.clip(column_pt / (em + TABLE_GAP_EM), TABLE_MIN_SIZE, TABLE_SIZE))
 
 
 def _radial_table(pg: _Page, d: dict) -> None:
-    from ..report.certificate import radial_table_cells
+    from ..report.certificate import page_field_indices, page_table_note, radial_table_cells
 
     pg.heading(pretty("Radial distortion along the semi-diagonals (um, + outward)"))
     head, rows = radial_table_cells(d)
-    xs = _columns(len(head))
+    idx, _ = page_field_indices(d)  # at most ACROSS_MAX_FIELDS: one row of columns
+    xs = _columns(len(idx))
+    size = _table_size(d)
     pg.text(LEFT, "field angle \u03b8 (\u00b0)", size=7.5, weight="bold")
-    for x, c in zip(xs, head, strict=True):
-        pg.text(x, c.text, size=7.5, ha="right", weight="bold", gid=c.path)
+    for x, j in zip(xs, idx, strict=True):
+        pg.text(x, head[j].text, size=size, ha="right", weight="bold", gid=head[j].path)
     pg.rule(lw=0.5, dy=-0.4)
     pg.down(1.2)
     for i, (lab, cells) in enumerate(rows):
@@ -250,16 +301,20 @@ def _radial_table(pg: _Page, d: dict) -> None:
         if last:
             pg.rule(lw=0.5, dy=0.75)
         colour = COLOURS[i - 1] if 1 <= i <= 4 else "black"
-        pg.text(LEFT, pretty(lab), size=7.5, weight="bold" if last else "normal", color=colour)
-        for x, c in zip(xs, cells, strict=True):
-            pg.text(
-                x, c.text, size=7.5, ha="right", gid=c.path, weight="bold" if last else "normal"
-            )
+        weight = "bold" if last else "normal"
+        pg.text(LEFT, pretty(lab), size=7.5, weight=weight, color=colour)
+        for x, j in zip(xs, idx, strict=True):
+            c = cells[j]
+            pg.text(x, c.text, size=size, ha="right", gid=c.path, weight=weight)
+        pg.down(1.0)
+    note = page_table_note(d)
+    if note:
+        pg.text(LEFT, note, size=6.5, color="0.3", style="italic")
         pg.down(1.0)
 
 
 def _decentering(pg: _Page, d: dict) -> None:
-    from ..report.certificate import decentering_cells, radial_table_cells
+    from ..report.certificate import decentering_cells, page_field_indices
 
     pg.heading("Decentering distortion")
     params, prof = decentering_cells(d)
@@ -273,11 +328,12 @@ def _decentering(pg: _Page, d: dict) -> None:
         pg.text(x + 0.37, c.text, size=7.5, ha="right", gid=c.path, y=y)
         pg.text(x + 0.38, "\u00b0" if unit == "deg" else pretty(unit), size=7.5, y=y)
     pg.y = y0 - half * LINE
-    head, _ = radial_table_cells(d)
-    xs = _columns(len(head))
+    idx, _ = page_field_indices(d)  # the columns of the radial table above
+    xs = _columns(len(idx))
+    size = _table_size(d)
     pg.text(LEFT, pretty("profile J r^2 (um)"), size=7.5, weight="bold")
-    for x, c in zip(xs, prof, strict=True):
-        pg.text(x, c.text, size=7.5, ha="right", gid=c.path)
+    for x, j in zip(xs, idx, strict=True):
+        pg.text(x, prof[j].text, size=size, ha="right", gid=prof[j].path)
     pg.down(1.0)
 
 

@@ -58,7 +58,7 @@ def save_figure(
     fmt = p.suffix.lower()
     if fmt not in FORMATS:
         raise OutputError(f"{p}: unsupported plot format {p.suffix!r}; use {', '.join(FORMATS)}")
-    check_output(p, inputs=inputs, overwrite=overwrite, flag=flag)
+    check_output(path, inputs=inputs, overwrite=overwrite, flag=flag)  # as given: 'a.png/'
     buf = io.BytesIO()
     bbox = None if getattr(fig, "orthoscope_page", False) else "tight"
     fig.savefig(buf, format=fmt[1:], dpi=dpi, bbox_inches=bbox)

@@ -6,6 +6,13 @@ the cells of :func:`certificate_cells`, made from that dict with the precisions 
 :data:`DECIMALS`. Each cell carries its JSON path (``"decentering/profile_um/3"``), which the page
 sets as the text object's ``gid`` — so a test can check that every number on the page is its
 JSON value rounded as printed.
+
+Long tables
+    The tabulated fields run across (the USGS form) up to :data:`ACROSS_MAX_FIELDS` (12: the
+    most the default 7.5° step gives, for a format below 90°). Beyond, the text prints one row
+    per field (fields down, the semi-diagonals, their mean and the decentering profile across),
+    and the page, which has room for one row of 12 fields, tabulates one field in every k and
+    the edge (:func:`page_field_indices`), saying so; the JSON and the text carry every field.
 """
 
 from __future__ import annotations
@@ -20,6 +27,8 @@ from .jsonout import jsonable
 TITLE = "Calibration certificate - design prediction"
 #: printed decimals per kind of number
 DECIMALS = {"mm": 3, "pp": 4, "um": 1, "deg": 2, "field": 2, "coef": 4, "nm": 2}
+#: the most tabulated fields printed across (text) and on the page's one table row
+ACROSS_MAX_FIELDS = 12
 
 
 @dataclass(frozen=True)
@@ -37,21 +46,44 @@ def _get(d: dict, path: str):
     return v
 
 
-def number_text(v, kind: str, *, signed: bool = False) -> str:
-    """``v`` printed with the decimals of ``kind``; NaN / None as an em dash."""
+def number_text(v, kind: str, *, signed: bool = False, decimals: int | None = None) -> str:
+    """``v`` printed with the decimals of ``kind`` (or ``decimals``); NaN / None as an em
+    dash."""
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "\u2014"
+    dec = DECIMALS[kind] if decimals is None else int(decimals)
     if kind == "coef":
-        return f"{float(v):+.{DECIMALS[kind]}e}" if signed else f"{float(v):.{DECIMALS[kind]}e}"
-    dec = DECIMALS[kind]
+        if float(v) == 0.0:
+            signed = False  # no "+0.0000e+00" or "-0.0000e+00"
+        return f"{float(v):+.{dec}e}" if signed else f"{float(v):.{dec}e}"
     s = f"{float(v):+.{dec}f}" if signed else f"{float(v):.{dec}f}"
     if float(s) == 0.0:
         s = f"{0.0:.{dec}f}"  # no "-0.0"
     return s
 
 
-def cell(d: dict, path: str, kind: str, *, signed: bool = False) -> Cell:
-    return Cell(number_text(_get(d, path), kind, signed=signed), path)
+def cell(d: dict, path: str, kind: str, *, signed: bool = False, decimals=None) -> Cell:
+    return Cell(number_text(_get(d, path), kind, signed=signed, decimals=decimals), path)
+
+
+#: the most decimals a field angle is printed with when its step's own decimals set them
+FIELD_DECIMALS_MAX = 6
+
+
+def field_decimals(d: dict) -> int:
+    """Decimals of the tabulated field angles: ``DECIMALS["field"]`` (2), more for a finer step
+    (the first field is the step): the step's own decimals up to ``FIELD_DECIMALS_MAX``, else
+    enough that neighbouring fields never print alike (a unit of the last decimal no larger than
+    the step)."""
+    f = d["fields_deg"]
+    dec = DECIMALS["field"]
+    if len(f) < 2 or f[0] is None or not float(f[0]) > 0:
+        return dec
+    step = float(f[0])
+    for k in range(dec, FIELD_DECIMALS_MAX + 1):
+        if abs(round(step, k) - step) <= 1e-9 * step:
+            return k
+    return max(dec, min(15, math.ceil(-math.log10(step) - 1e-9)))
 
 
 def certificate_to_dict(cert: CalibrationCertificate, *, software: str | None = None) -> dict:
@@ -215,7 +247,8 @@ def radial_table_cells(d: dict) -> tuple[list[Cell], list[tuple[str, list[Cell]]
     """(header cells: the field angles, rows (label, cells)): radius and the radial distortion per
     semi-diagonal and their mean (µm)."""
     n = len(d["fields_deg"])
-    head = [cell(d, f"fields_deg/{j}", "field") for j in range(n)]
+    fd = field_decimals(d)
+    head = [cell(d, f"fields_deg/{j}", "field", decimals=fd) for j in range(n)]
     rows = [("r = CFL tan(theta) (mm)", [cell(d, f"radius_mm/{j}", "mm") for j in range(n)])]
     for i, sd in enumerate(d["semi_diagonals"]):
         lab = f"{sd['label']}  ({number_text(sd['azimuth_deg'], 'deg')} deg)"
@@ -227,6 +260,53 @@ def radial_table_cells(d: dict) -> tuple[list[Cell], list[tuple[str, list[Cell]]
         )
     rows.append(("mean", [cell(d, f"mean_radial_um/{j}", "um", signed=True) for j in range(n)]))
     return head, rows
+
+
+def _every(n: int, k: int) -> list[int]:
+    """The k-th, 2k-th, ... of ``n`` fields and the last (the edge)."""
+    idx = list(range(k - 1, n, k))
+    if not idx or idx[-1] != n - 1:
+        idx.append(n - 1)
+    return idx
+
+
+def _round_step(x: float) -> bool:
+    """True when ``x`` is 1, 2, 2.5 or 5 times a power of ten (to 1e-9)."""
+    if not x > 0:
+        return False
+    e = math.floor(math.log10(x))
+    m = x / 10.0**e
+    return any(abs(m - v) <= 1e-9 * v for v in (1.0, 2.0, 2.5, 5.0, 10.0))
+
+
+def page_field_indices(d: dict) -> tuple[list[int], int]:
+    """(indices of the tabulated fields the page prints, k): every field when there are at most
+    :data:`ACROSS_MAX_FIELDS`, else one in every k (the k-th, 2k-th, ... field: a regular step of
+    k times the table's, the first field being the step) and the last (the edge). k is the
+    smallest that fits, or a larger one up to twice that whose step is round (1, 2, 2.5 or 5
+    times a power of ten degrees): a 0.001 deg table over 20 deg prints every 2 deg."""
+    n = len(d["fields_deg"])
+    if n <= ACROSS_MAX_FIELDS:
+        return list(range(n)), 1
+    k0 = 2
+    while len(_every(n, k0)) > ACROSS_MAX_FIELDS:
+        k0 += 1
+    step = float(d["fields_deg"][0])
+    k = next((k for k in range(k0, 2 * k0 + 1) if _round_step(k * step)), k0)
+    return _every(n, k), k
+
+
+def page_table_note(d: dict) -> str | None:
+    """The line under the page's table when it prints only some of the fields (None else)."""
+    idx, k = page_field_indices(d)
+    if k == 1:
+        return None
+    n = len(d["fields_deg"])
+    step = number_text(d["fields_deg"][k - 1], "field", decimals=field_decimals(d))
+    return (
+        f"The page tabulates one field in every {k} (every {step} deg) and the edge; all {n} "
+        "tabulated fields are in the text and JSON output."
+    )
 
 
 def decentering_cells(d: dict) -> tuple[list[tuple[str, Cell, str]], list[Cell]]:
@@ -296,15 +376,23 @@ def format_certificate(cert_or_dict) -> str:
         out.append(f"  {lab:<{kw}}{val:>18} {unit}")
     head, rows = radial_table_cells(d)
     lw = max(len(r[0]) for r in rows)
-    cw = max(8, *(len(c.text) for _, cs in rows for c in cs), *(len(c.text) for c in head)) + 1
-    out += ["", "Radial distortion (um) along the semi-diagonals"]
-    out.append(f"  {'field angle (deg)':<{lw}}" + "".join(c.text.rjust(cw) for c in head))
-    for lab, cs in rows:
-        out.append(f"  {lab:<{lw}}" + "".join(c.text.rjust(cw) for c in cs))
+    across = len(head) <= ACROSS_MAX_FIELDS
+    if across:
+        cw = max(8, *(len(c.text) for _, cs in rows for c in cs), *(len(c.text) for c in head))
+        cw += 1
+        out += ["", "Radial distortion (um) along the semi-diagonals"]
+        out.append(f"  {'field angle (deg)':<{lw}}" + "".join(c.text.rjust(cw) for c in head))
+        for lab, cs in rows:
+            out.append(f"  {lab:<{lw}}" + "".join(c.text.rjust(cw) for c in cs))
+    else:
+        out += ["", *_rows_table(d, head, rows, prof)]
     out += ["", "Decentering distortion"]
     for lab, c, unit in params:
         out.append(f"  {lab:<{kw}}{c.text:>18} {unit}")
-    out.append(f"  {'profile J r^2 (um)':<{lw}}" + "".join(c.text.rjust(cw) for c in prof))
+    if across:
+        out.append(f"  {'profile J r^2 (um)':<{lw}}" + "".join(c.text.rjust(cw) for c in prof))
+    else:
+        out.append(f"  {'profile J r^2 (um)':<{kw}}the last column of the table above")
     out += ["", "Radial distortion coefficients (mean curve): " + d["radial_coefficients"]["form"]]
     out.append("  " + ", ".join(f"{lab} = {c.text}" for lab, c in coefficient_cells(d)))
     out += [""] + [f"  {s}" for s in definition_lines(d)]
@@ -312,21 +400,46 @@ def format_certificate(cert_or_dict) -> str:
     return "\n".join(out)
 
 
+def _rows_table(d: dict, head: list[Cell], rows, prof: list[Cell]) -> list[str]:
+    """The radial table with one row per field (more than ``ACROSS_MAX_FIELDS`` fields): field,
+    radius, the semi-diagonals, their mean and the decentering profile across."""
+    sds = d["semi_diagonals"]
+    labels = ["field (deg)", "r (mm)", *(sd["label"] for sd in sds), "mean", "J r^2"]
+    cols = [head, *(cs for _, cs in rows), prof]
+    widths = [
+        max(len(lab), *(len(c.text) for c in col)) for lab, col in zip(labels, cols, strict=True)
+    ]
+    where = ", ".join(f"{sd['label']} at {number_text(sd['azimuth_deg'], 'deg')} deg" for sd in sds)
+    out = [
+        f"Radial distortion (um) along the semi-diagonals: one row per field ({len(head)} fields)",
+        f"  semi-diagonals: {where}",
+        "  r = CFL tan(theta); J r^2: the decentering profile (um)",
+        "  " + "  ".join(lab.rjust(w) for lab, w in zip(labels, widths, strict=True)),
+    ]
+    for j in range(len(head)):
+        out.append(
+            "  " + "  ".join(col[j].text.rjust(w) for col, w in zip(cols, widths, strict=True))
+        )
+    return out
+
+
 def page_numbers(d: dict) -> dict[str, str]:
-    """Every printed number of the page by JSON path (for tests and tools)."""
+    """Every printed number of the page by JSON path (for tests and tools); the table's fields
+    are those of :func:`page_field_indices`."""
     out: dict[str, str] = {}
     for _, a, b, _ in summary_cells(d):
         for c in (a, b):
             if c is not None:
                 out[c.path] = c.text
+    idx, _ = page_field_indices(d)
     head, rows = radial_table_cells(d)
-    for c in head + [c for _, cs in rows for c in cs]:
+    for c in [head[j] for j in idx] + [cs[j] for _, cs in rows for j in idx]:
         out[c.path] = c.text
     params, prof = decentering_cells(d)
     for _, c, _ in params:
         out[c.path] = c.text
-    for c in prof:
-        out[c.path] = c.text
+    for j in idx:
+        out[prof[j].path] = prof[j].text
     for _, c in coefficient_cells(d):
         out[c.path] = c.text
     return out

@@ -1054,6 +1054,18 @@ def _solve_gaussian(src: _Source, lens: Lens) -> Lens:
     """Put the image plane at the paraxial image of the lens's own object (``t = "gaussian"``)."""
     n = lens.n_surfaces
     line = src.surface_line(n - 1)
+    j = lens.first_placed()
+    if j is not None:  # said as a change to the file (paraxial() says it as Python calls)
+        where = "the image surface" if j == 0 else f"surface {j}"
+        at = src.key_line("image") if j == 0 else src.surface_line(j - 1)
+        at_text = f" (line {at})" if at is not None else ""
+        raise src.error(
+            f't = "gaussian" (the paraxial image solve) needs a centred lens, and {where}'
+            f"{at_text} is decentered or tilted: give the last thickness as a number (mm from "
+            "the last vertex to the image plane), or remove the decenter / tilt",
+            line,
+            n,
+        )
     return solve_paraxial_image(
         lens,
         lambda message, at: src.error(message, at, n),

@@ -36,10 +36,16 @@ def check_output(
 ) -> Path:
     """Refuse an output that cannot or must not be written, before any work is done.
 
-    Raises :class:`~raytrace.errors.OutputError` when ``path`` is the same file as one of
-    ``inputs``, exists and ``overwrite`` is false (``flag`` names how to allow it: ``--force`` on
-    the command line), is a directory, or its folder does not exist or is not writable.
+    Raises :class:`~raytrace.errors.OutputError` when ``path`` ends in a path separator (it
+    names a folder), is the same file as one of ``inputs``, exists and ``overwrite`` is false
+    (``flag`` names how to allow it: ``--force`` on the command line), is a directory, or its
+    folder does not exist or cannot take a new file (tried by creating and removing an empty
+    one: permission bits do not tell — root passes them, yet cannot write in /proc or on a
+    read-only mount).
     """
+    text = os.fspath(path)
+    if isinstance(text, str) and text.endswith(tuple(c for c in (os.sep, os.altsep) if c)):
+        raise OutputError(f"{text}: ends in {text[-1]!r}, so it names a folder; give a file name")
     p = Path(path)
     for src in inputs:
         if src is not None and same_file(p, src):
@@ -57,8 +63,15 @@ def check_output(
         if blocker is not None and not blocker.is_dir():
             raise OutputError(f"{p}: {blocker} is a file, not a folder")
         raise OutputError(f"{p}: the folder {parent} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise OutputError(f"{p}: the folder {parent} is not writable")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".orthoscope-probe-", dir=parent)
+    except OSError as e:
+        raise OutputError(
+            f"{p}: the folder {parent} does not take new files ({e.strerror or e}); choose "
+            "another folder"
+        ) from None
+    os.close(fd)
+    os.unlink(probe)
     return p
 
 

@@ -24,6 +24,11 @@ Image plane (:class:`ImagePlane`; default: the Gaussian image plane of the objec
     mm from the Gaussian image plane of the object (+ = away from the lens);
 ``gaussian`` / ``file``
     the Gaussian image plane / the plane the lens file defines (its last thickness).
+``gaussian_reference``
+    the Gaussian image plane of the object at the lens's reference wavelength, whatever
+    wavelength is traced: where a lens file's image solve (``t = "gaussian"``, CODE V ``PIM``)
+    puts the plane for the traced object (the command line's default for such a file; for the
+    file's own object it is ``file``, to round-off).
 """
 
 from __future__ import annotations
@@ -42,14 +47,15 @@ if TYPE_CHECKING:
     from ..lens import Lens
     from .firstorder import ParaxialResult
 
-PLANE_KINDS = ("s_prime", "from_last_vertex", "defocus", "gaussian", "file")
+PLANE_KINDS = ("s_prime", "from_last_vertex", "defocus", "gaussian", "file", "gaussian_reference")
 
 
 @dataclass(frozen=True)
 class ImagePlane:
     """An image plane in the project's vocabulary (module docstring).
 
-    kind:  ``"s_prime"`` | ``"from_last_vertex"`` | ``"defocus"`` | ``"gaussian"`` | ``"file"``.
+    kind:  ``"s_prime"`` | ``"from_last_vertex"`` | ``"defocus"`` | ``"gaussian"`` | ``"file"``
+           | ``"gaussian_reference"``.
     value: the distance in mm for the first three kinds (ignored for the others).
     """
 
@@ -74,13 +80,17 @@ class ImagePlane:
             return float(par.z_from_defocus(self.value))
         if self.kind == "file":
             return float(par.z_image_file)
+        if self.kind == "gaussian_reference":
+            return float(par.z_gauss_reference)
         return float(par.z_gauss)
 
     def describe(self) -> str:
-        if self.kind in ("gaussian", "file"):
-            return {"gaussian": "the Gaussian image plane", "file": "the lens file's plane"}[
-                self.kind
-            ]
+        if self.kind in ("gaussian", "file", "gaussian_reference"):
+            return {
+                "gaussian": "the Gaussian image plane",
+                "file": "the lens file's plane",
+                "gaussian_reference": "the Gaussian image plane",  # of the reference wavelength
+            }[self.kind]
         return f"{self.kind} = {self.value:g} mm"
 
 
@@ -144,7 +154,9 @@ def plane_z(par: ParaxialResult, planes: list[ImagePlane]) -> np.ndarray:
         d = planes[i].describe()
         what = d if d.startswith("the ") else f"the image plane {d}"
         why = ""
-        if planes[i].kind == "gaussian" and math.isfinite(par.object_distance):
+        if planes[i].kind in ("gaussian", "gaussian_reference") and math.isfinite(
+            par.object_distance
+        ):
             # the object inside the front focal length: a virtual image
             why = (
                 f" (the object, {par.object_distance:g} mm in front of the first vertex, is "

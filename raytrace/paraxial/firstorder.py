@@ -59,6 +59,11 @@ class ParaxialResult:
                last vertex; m0: Gaussian lateral magnification (Eq. 5; 0 for an object at infinity).
     p0:        s − HE0 (−inf for infinity); working_fnumber: 1/(2 n' |u'_marginal|).
     z_last:    z of the last vertex; z_image_file: the image plane the lens file defines.
+    z_gauss_reference: the Gaussian image plane of this object at the lens's reference
+               wavelength (``z_gauss`` when ``wavelength`` is the reference): where an image solve
+               (``Lens.image_solve``, ``t = "gaussian"``, CODE V ``PIM``) puts the image plane for
+               this object, whatever wavelength is traced (solves use the reference wavelength,
+               as OpticStudio's and CODE V's do); NaN when there is no finite Gaussian image there.
     n_object, n_image: indices of object and image space.
     chief_height_last, chief_slope_image: the paraxial chief ray of unit object-space slope
                (tan α = 1) at the last vertex: its height (mm) and image-space slope — what
@@ -102,6 +107,7 @@ class ParaxialResult:
     wavelength: float
     chief_height_last: float = math.nan
     chief_slope_image: float = math.nan
+    z_gauss_reference: float = math.nan
 
     def __repr__(self) -> str:
         obj = (
@@ -346,6 +352,17 @@ def element_power(lens: Lens, first: int, last: int, wavelength: float | None = 
     return float(-nu)
 
 
+def _gaussian_z(lens: Lens, od: float, z_last: float) -> float:
+    """z of the Gaussian image of the axial object point ``od`` mm in front of the first vertex
+    (``inf``) at the lens's reference wavelength: an axial ray (slope 1, or height 1 from
+    infinity) through the system matrix, z_last − y'/u'; NaN when the image is at infinity."""
+    c, t, n_in, n_out = _system(lens, lens.wavelength)
+    (A, B), (C, D) = ynu_matrix(c, t, n_in, n_out, len(c))
+    n0 = float(n_in[0])
+    y, nu = (A, C) if math.isinf(od) else (A * od + B * n0, C * od + D * n0)
+    return z_last - y * float(n_out[-1]) / nu if nu != 0.0 else math.nan
+
+
 def paraxial(
     lens: Lens,
     object_distance: float | str | None = None,
@@ -465,6 +482,10 @@ def paraxial(
     else:
         k = fld.value / (z_obj - z_E0) if not (infinite or math.isinf(z_E0)) else 0.0
     lagrange = n0 * (k * (nuc1 / n0) * ym1 - (num1 / n0) * k * yc1)
+    if wl == lens.wavelength:
+        z_gauss_ref = z_gauss
+    else:  # an image solve is the reference wavelength's, whatever wavelength is traced
+        z_gauss_ref = _gaussian_z(lens, od, z_last)
     return ParaxialResult(
         efl=efl,
         f_object=f_obj,
@@ -503,4 +524,5 @@ def paraxial(
         wavelength=wl,
         chief_height_last=float(yck),
         chief_slope_image=float(uck),
+        z_gauss_reference=float(z_gauss_ref),
     )
