@@ -411,6 +411,16 @@ def _round_up(x: float) -> str:
     return f"{math.ceil(x / 10.0**e - 1e-9) * 10.0**e:.{max(-e, 0)}f}"
 
 
+def iso_date(text: str) -> str:
+    """``text`` as an ISO date ``YYYY-MM-DD`` (:class:`DataError` when it is not one)."""
+    try:
+        return _dt.date.fromisoformat(str(text)).isoformat()
+    except ValueError:
+        raise DataError(
+            f"{text!r} is not a date; write it as YYYY-MM-DD, e.g. 2026-01-31"
+        ) from None
+
+
 def calibration_certificate(
     lens: Lens,
     *,
@@ -455,7 +465,7 @@ def calibration_certificate(
     max_field_deg : float, optional
         The format's field without a sensor (default the lens's).
     date : str, optional
-        The date printed (default today, ISO).
+        The date printed, ISO ``YYYY-MM-DD`` (default today); anything else is refused.
     clip : bool
         Apply the lens's semi-diameters.
     allow_large : bool
@@ -484,6 +494,7 @@ def calibration_certificate(
         )
     if method not in METHODS:
         raise DataError(f"method={method!r}; use one of {', '.join(METHODS)}")
+    date = iso_date(date) if date is not None else _dt.date.today().isoformat()
     step = float(field_step_deg)
     if not (math.isfinite(step) and 0.0 < step < 90.0):
         raise DataError(f"field_step_deg={field_step_deg!r}: give a step between 0 and 90 degrees")
@@ -619,7 +630,7 @@ def calibration_certificate(
     return CalibrationCertificate(
         name=lens.name,
         source=str(getattr(lens, "source", "") or ""),
-        date=date or _dt.date.today().isoformat(),
+        date=date,
         object_distance=float(od),
         wavelength=float(par.wavelength),
         s_prime=sp,

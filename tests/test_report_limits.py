@@ -325,3 +325,12 @@ def test_the_folder_probe_leaves_nothing_behind(tmp_path):
                 check_output_path(str(ro / "x.pdf"), _Args())
         finally:
             ro.chmod(0o755)
+
+
+@pytest.mark.parametrize("bad", ["not a date", "2026-13-01", "31.01.2026"])
+def test_the_api_refuses_a_date_that_is_not_one(bad):
+    # the CLI's --date refused these; the API printed them on the certificate
+    lens = load_lens("cooke-triplet-f4")
+    with pytest.raises(DataError, match="is not a date; write it as YYYY-MM-DD"):
+        calibration_certificate(lens, date=bad)
+    assert calibration_certificate(lens, date="2026-01-31").date == "2026-01-31"

@@ -97,14 +97,13 @@ def _cli_words(message: str) -> str:
 
 
 def _date(text: str) -> str:
-    import datetime
+    from distortion.certificate import iso_date
+    from distortion.errors import DataError
 
     try:
-        return datetime.date.fromisoformat(text).isoformat()
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not a date; write it as YYYY-MM-DD, e.g. 2026-01-31"
-        ) from None
+        return iso_date(text)
+    except DataError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def _step(text: str) -> float:
