@@ -264,7 +264,9 @@ def focal_shift(
     object_distance, object_s, object_scale
         The object plane (default: the lens file's), resolved at the reference wavelength.
     rings : int
-        ``"best-focus"``: rings of the hexapolar pupil grid (6 k rays on ring k, plus the axis).
+        ``"best-focus"``: rings of the hexapolar pupil grid (6 k rays on ring k, plus the axis);
+        an integer from 1 (7 rays) up to the :data:`raytrace.limits.MAX_SAMPLES` rays of one
+        spot (577 rings); checked for either kind.
 
     Returns
     -------
@@ -274,6 +276,7 @@ def focal_shift(
     from raytrace.trace.chief import resolve_wavelengths
 
     require_choice(kind, FOCUS_KINDS, "focus kind")
+    rings = _check_rings(rings)
     if wavelengths is None:
         wls = tuple(float(w) for w in default_curve_wavelengths(lens))
     else:
@@ -305,6 +308,33 @@ def focal_shift(
         rms_radius=rms,
         reference_plane=ref_plane,
     )
+
+
+def _check_rings(rings) -> int:
+    """``rings`` as an int: TraceError unless it is an integer >= 1 whose hexapolar grid
+    (1 + 3 k (k + 1) rays) stays within :data:`raytrace.limits.MAX_SAMPLES`."""
+    import operator
+
+    from raytrace.limits import MAX_SAMPLES
+
+    try:
+        if isinstance(rings, bool):
+            raise TypeError
+        k = operator.index(rings)
+    except TypeError:
+        raise TraceError(
+            f"rings must be a whole number of pupil rings (>= 1), got {rings!r}"
+        ) from None
+    if k < 1:
+        raise TraceError(
+            f"rings={k}: the best-focus pupil grid needs at least 1 ring (6 rays around the axis)"
+        )
+    if 1 + 3 * k * (k + 1) > MAX_SAMPLES:
+        raise TraceError(
+            f"rings={k} makes {1 + 3 * k * (k + 1)} rays per wavelength, more than "
+            f"{MAX_SAMPLES}; a few rings (the default 8) are enough for the RMS focus"
+        )
+    return k
 
 
 def _pupil_rays(par, rings: int) -> tuple[np.ndarray, ...]:

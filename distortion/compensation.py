@@ -25,6 +25,7 @@ unchanged (Eq. 16 ⇔ Eq. 17).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,6 +33,20 @@ import numpy as np
 from .calibration import METHODS, axis_spread, fit_scale, match_fields
 from .curve import DistortionCurve, require_choice
 from .errors import CalibrationError, DataError
+
+#: A given print magnification factor M is checked against the printer's own M2. A real print
+#: differs from M2's scale by about the distortion of the two lenses (per cent at most; the
+#: fitted methods move M by well under 1 % on the bundled lenses), so |M/M2 - 1| above
+#: ``M_WARN`` (10 %) draws a :class:`MagnificationWarning` -- the residual R is then mostly the
+#: scale term (M/M2 - 1) F1 tan(alpha) -- and M/M2 outside [1/M_REFUSE, M_REFUSE] (a factor of
+#: 2) is refused: the printer at M2 makes no such print.
+M_WARN = 0.1
+M_REFUSE = 2.0
+
+
+class MagnificationWarning(UserWarning):
+    """A given print magnification factor M far (more than :data:`M_WARN`) from the printer's
+    M2."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,7 +143,8 @@ def compensate(
         curves); the others are calibration fits over the camera's fields
         (:mod:`distortion.calibration`), ``"two-point"`` and ``"zero-at"`` at the ``at`` fields.
     magnification : float, optional
-        M (Eq. 16), with ``method="given"`` only; of the sign of M2.
+        M (Eq. 16), with ``method="given"`` only; finite, of the sign of M2 and within a factor
+        of 2 of it (a warning beyond 10 %: :data:`M_WARN`).
     at : sequence of float, optional
         Field angles (degrees) of the camera curve: two for ``"two-point"``, one for
         ``"zero-at"``; none for the other methods.
@@ -148,7 +164,14 @@ def compensate(
     CalibrationError
         An unknown method; ``at`` with a method that takes none, or the wrong number of ``at``
         fields, or one that is not among the camera's fields; ``magnification`` with a method
-        other than ``"given"`` or of the other sign than M2; a degenerate magnification.
+        other than ``"given"``; a ``magnification`` that is not finite, zero, of the other sign
+        than M2 or more than a factor of 2 from it (:data:`M_REFUSE`); a degenerate
+        magnification.
+
+    Warns
+    -----
+    MagnificationWarning
+        A given ``magnification`` more than 10 % from M2 (:data:`M_WARN`).
     """
     if camera.finite:
         raise DataError("the camera curve must be for an object at infinity (field angles, F1)")
@@ -168,12 +191,8 @@ def compensate(
             f"compensation ({method}) chooses the magnification itself: magnification= goes "
             "with method 'given'"
         )
-    if magnification is not None and magnification * M2 < 0:
-        raise CalibrationError(
-            f"magnification M = {magnification:g} has the other sign than the printer's "
-            f"M2 = {M2:g}: M is the print's magnification factor (Eq. 16), of the sign of M2 "
-            f"(e.g. {-magnification:g})"
-        )
+    if magnification is not None:
+        _check_magnification(float(magnification), M2, D1 - D2, y1)
     idx = match_fields(camera.fields, at or (), f"compensation ({method})") if need else None
     if need and (idx is None or len(idx) != need):
         raise CalibrationError(f"method {method!r} needs {need} field(s) in at=")
@@ -190,3 +209,38 @@ def compensate(
     return CompensationResult(
         camera.fields.copy(), F1, M2, float(Mv), method, y1, yp, D1, D2, R, M2 * R
     )
+
+
+def _check_magnification(m: float, M2: float, d: np.ndarray, y1: np.ndarray) -> None:
+    """Refuse (CalibrationError) or warn (:class:`MagnificationWarning`) a given print
+    magnification factor ``m`` that no print of the printer at ``M2`` can have (criterion at
+    :data:`M_WARN`); ``d`` = D1 − D2 and ``y1`` = F1 tan α (mm) say what the scale term does."""
+    if not math.isfinite(m) or m == 0.0:
+        raise CalibrationError(
+            f"magnification M = {m:g} is no print magnification factor: M (Eq. 16) is finite and "
+            f"nonzero, of the sign of the printer's M2 = {M2:g}"
+        )
+    if m * M2 < 0:
+        raise CalibrationError(
+            f"magnification M = {m:g} has the other sign than the printer's M2 = {M2:g}: M is "
+            f"the print's magnification factor (Eq. 16), of the sign of M2 (e.g. {-m:g})"
+        )
+    q = m / M2
+    if not 1.0 / M_REFUSE <= q <= M_REFUSE:
+        raise CalibrationError(
+            f"magnification M = {m:g} is {q:.4g} times the printer's M2 = {M2:g}: no print of this "
+            f"printer has that scale (M lies within a factor of {M_REFUSE:g} of M2; a "
+            "compensating M differs from it by about the distortion, per cent at most)"
+        )
+    if abs(q - 1.0) > M_WARN:
+        with np.errstate(invalid="ignore"):
+            scale = float(np.nanmax(np.abs((q - 1.0) * y1))) if y1.size else 0.0
+            dist = float(np.nanmax(np.abs(d))) if np.isfinite(d).any() else 0.0
+        warnings.warn(
+            f"the print magnification factor M = {m:g} is {100.0 * (q - 1.0):+.3g} % from the "
+            f"printer's M2 = {M2:g} (more than {100.0 * M_WARN:g} %): the residual is then "
+            f"mostly the scale term (M/M2 - 1) F1 tan(alpha), up to {scale:.4g} mm against "
+            f"|D1 - D2| <= {dist:.4g} mm; a real print is within about the distortion of M2",
+            MagnificationWarning,
+            stacklevel=3,
+        )

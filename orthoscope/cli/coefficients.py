@@ -6,7 +6,15 @@ from __future__ import annotations
 import argparse
 import math
 
-from .common import CliError, add_output_args, load_scaled, print_json, refuse_flags
+from .common import (
+    CliError,
+    add_output_args,
+    add_strict_arg,
+    load_scaled,
+    print_json,
+    refuse_flags,
+    warn,
+)
 from .variation import CONJ_HELP, UNITS_EPILOG
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -32,10 +40,11 @@ def cmd_coefficients(args) -> int:
         v = getattr(args, name)
         if v is not None and not (v > 0 and math.isfinite(v)):
             raise CliError(f"--{name.replace('_', '-')} must be positive and finite, got {v}")
+    traced = None
     if args.profiles:
         r, dr, label, c, source = _csv_profile(args)
     elif args.lens:
-        r, dr, label, c, source = _traced_profile(args)
+        r, dr, label, c, source, traced = _traced_profile(args)
     else:
         raise CliError("give a CSV profile (PROFILES.csv) or a lens (--lens LENS --focus 12x)")
     gauss = fit_radial(r, dr, form="gaussian", radius="measured")
@@ -77,7 +86,9 @@ def cmd_coefficients(args) -> int:
                 "gaussian_fit": radial_fit_to_dict(gauss),
                 "balanced_fit": radial_fit_to_dict(bal),
                 "opencv": None if cv is None else opencv_to_dict(cv),
+                "traced": traced,
                 "notes": [note] if note else [],
+                "warnings": [traced["warning"]] if traced and traced["warning"] else [],
             }
         )
         return 0
@@ -104,6 +115,7 @@ def _csv_profile(args):
             ("--object", args.object),
             ("--scale-to-efl", args.scale_to_efl),
             ("--max-field", args.max_field),
+            ("--strict", args.strict),
         ),
     )
     ps = read_profiles_csv(args.profiles, min_profiles=1)
@@ -163,13 +175,31 @@ def _traced_profile(args):
     focus = parse_conjugate(args.focus)
     obj = parse_conjugate(args.object) if args.object else focus
     fmax = args.max_field
+    if fmax is not None and not (0 < fmax < 90):
+        raise CliError(
+            f"--max-field {fmax:g}: the largest nominal field angle must lie between 0 and 90 "
+            "degrees (exclusive)"
+        )
     if fmax is None:
-        fmax = lens.field.value if lens.field.kind == "angle" else None
-    if fmax is None or not 0 < fmax < 90:
-        raise CliError("give --max-field (degrees, nominal field angle) for this lens")
+        if lens.field.kind != "angle":
+            raise CliError(
+                f"{lens.name} gives its field as an object height: give --max-field (degrees, "
+                "the largest nominal field angle, between 0 and 90)"
+            )
+        fmax = lens.field.value
+        if not 0 < fmax < 90:
+            raise CliError(
+                f"{lens.name}: its field {fmax:g} deg is not between 0 and 90; give --max-field "
+                "(degrees, the largest nominal field angle)"
+            )
     import numpy as np
 
     st = trace_setting(lens, focus, obj, np.linspace(0.0, fmax, DEFAULT_N_FIELDS))
+    traced = _traced_summary(st, fmax)
+    if traced["warning"]:
+        if args.strict:
+            raise CliError(traced["warning"] + "; --strict fails")
+        warn(traced["warning"])
     r, dr = _cut(*st.valid(), args.r_max)
     r, dr = r[1:], dr[1:]  # drop the axis point (r = 0)
     if r.size < 5:
@@ -181,7 +211,43 @@ def _traced_profile(args):
     else:
         par = paraxial(lens, st.object_distance)
         c = abs(st.constant * par.p0)
-    return r, dr, st.label, c, f"traced from {lens.name}"
+    return r, dr, st.label, c, f"traced from {lens.name}", traced
+
+
+def _traced_summary(st, fmax: float) -> dict:
+    """How far the traced profile ``st`` reaches (JSON ``traced``): the fields asked for, the
+    leading run of traced fields the fits use (a failed field ends the profile), where it stops,
+    and a one-line ``warning`` (None when every field traced)."""
+    from raytrace.trace.results import status_name
+
+    fields, status = st.fields, st.status
+    r_ok, _ = st.valid()
+    n_ok = int(r_ok.size)
+    out = {
+        "max_field_deg": float(fmax),
+        "n_fields": int(fields.size),
+        "n_fields_used": n_ok,
+        "last_field_deg": float(fields[n_ok - 1]) if n_ok else None,
+        "r_last_mm": float(r_ok[-1]) if n_ok else None,
+        "first_failure": None,
+        "warning": None,
+    }
+    if n_ok == fields.size:
+        return out
+    code = int(status[n_ok])
+    out["first_failure"] = {"field_deg": float(fields[n_ok]), "status": status_name(code)}
+    names = sorted({status_name(c) for c in status[n_ok:] if c != 0}) or [status_name(code)]
+    reach = (
+        f"the profile stops at r = {r_ok[-1]:.4g} mm (field {fields[n_ok - 1]:.4g} deg)"
+        if n_ok
+        else "no field traced"
+    )
+    out["warning"] = (
+        f"{fields.size - n_ok} of {fields.size} fields ({fields[n_ok]:.4g}-{fmax:g} deg) are left "
+        f"out: the trace fails from {fields[n_ok]:.4g} deg on ({', '.join(names)}); {reach}, and "
+        "the fits cover only that; lower --max-field to fit traced fields only"
+    )
+    return out
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -234,6 +300,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Largest nominal field angle traced (default: the lens's).",
     )
     c.add_argument("--r-max", type=float, metavar="MM", help="Largest radius fitted (mm).")
+    add_strict_arg(
+        c,
+        help="--lens: exit with status 2 when a field up to --max-field cannot be traced "
+        "(default: a warning, and the fits use the fields up to the first failure), or when the "
+        "lens file names a glass read only as a substitute.",
+    )
     c.add_argument(
         "--focal-length-px", type=float, metavar="PX", help="Focal length in pixels (OpenCV fx)."
     )

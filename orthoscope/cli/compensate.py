@@ -61,6 +61,12 @@ def cmd_compensate(args) -> int:
 
     from ..report.distortion import compensation_to_dict, format_compensation
 
+    m = args.magnification
+    if m is not None and not (math.isfinite(m) and m != 0.0):
+        raise CliError(
+            f"--magnification {m:g}: the print magnification factor M must be a finite nonzero "
+            "number, of the sign of the printer's M2 (default: M2)"
+        )
     cam = _curve_from(args.camera, "camera", args)
     prn = _curve_from(args.printer, "printer", args, camera_curve=cam)
     res = compensate(
@@ -97,7 +103,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_alias(q, "--criterion", "--method", "method", choices=METHODS)
     q.add_argument(
-        "--magnification", type=float, metavar="M", help="Print magnification factor M for 'given'."
+        "--magnification",
+        type=float,
+        metavar="M",
+        help="Print magnification factor M for 'given' (default M2): of the sign of M2; more "
+        "than 10%% from M2 warns, more than a factor of 2 is refused.",
     )
     add_alias(q, "--M", "--magnification", "magnification", type=float)
     q.add_argument("--at", metavar="A[,B]", help="Field(s) for two-point or zero-at (degrees).")

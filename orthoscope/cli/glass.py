@@ -8,13 +8,15 @@ import argparse
 import math
 
 from .colour import add_wavelengths_arg
-from .common import CliError, add_output_args, add_strict_arg, print_result
+from .common import CliError, add_output_args, add_strict_arg, print_result, warn
 
 SAMPLES = [
     ["glass", "N-BK7", "--wavelengths", "F,d,C"],
     ["glass", "--search", "nd=1.62,vd=60"],
 ]
 OUTPUTS = []
+#: glasses --search lists without --count
+DEFAULT_COUNT = 10
 
 
 def _price(text: str) -> float:
@@ -64,7 +66,7 @@ def _search_spec(text: str) -> tuple[float, float]:
 def cmd_glass(args) -> int:
     import numpy as np
 
-    from raytrace.glass import lookup_glass, search_glass
+    from raytrace.glass import search_glass
 
     from ..report.glass import (
         default_wavelengths,
@@ -86,15 +88,21 @@ def cmd_glass(args) -> int:
             raise CliError("--wavelengths goes with a glass NAME, not with --search")
         nd, vd = args.search
         if not (1.0 <= nd < 5.0 and 10.0 <= vd <= 120.0):
+            swapped = (
+                f" (swapped? nd={vd:g},vd={nd:g})"
+                if 10.0 <= nd <= 120.0 and 1.0 <= vd < 5.0
+                else ""
+            )
             raise CliError(
                 f"--search: nd {nd:g} / vd {vd:g} are not glass values (optical glasses have "
-                "nd 1.4-2.1 and Abbe numbers vd 17-95)"
+                f"nd 1.4-2.1 and Abbe numbers vd 17-95){swapped}"
             )
-        if args.count < 1:
+        count = DEFAULT_COUNT if args.count is None else args.count
+        if count < 1:
             raise CliError("--count must be at least 1")
         limit = math.inf if args.max_price is None else args.max_price
         matches = search_glass(
-            nd, vd, args.count, catalogs=cats, include_retired=args.include_retired,
+            nd, vd, count, catalogs=cats, include_retired=args.include_retired,
             max_price=limit,
         )  # fmt: skip
         print_result(
@@ -103,20 +111,115 @@ def cmd_glass(args) -> int:
             text=lambda: format_search(nd, vd, matches, limit),
         )
         return 0
-    if args.max_price is not None:
-        raise CliError("--max-price goes with --search, not with a glass NAME")
-    g = lookup_glass(args.name, cats, first_catalog_wins=bool(cats))
-    if cats and g.catalog not in cats:
-        raise CliError(f"glass {args.name} is not in the {args.catalog} catalog ({g.catalog})")
+    search_only = [
+        flag
+        for flag, given in (
+            ("--max-price", args.max_price is not None),
+            ("--count", args.count is not None),
+            ("--include-retired", args.include_retired),
+        )
+        if given
+    ]
+    if search_only:
+        verb = "goes" if len(search_only) == 1 else "go"
+        raise CliError(f"{', '.join(search_only)} {verb} with --search, not with a glass NAME")
+    g = _named_glass(args.name, cats, args.catalog)
     wls = args.wavelengths
     if wls is None or wls == "lens":
         if wls == "lens":
             raise CliError("--wavelengths lens applies to lens commands; give nm or line letters")
         wls = default_wavelengths(g)
     wl = np.asarray(wls, dtype=float)
-    n = np.atleast_1d(g.material.index(wl, strict=args.strict))
+    n = _indices(g, wl, args.strict)
     print_result(args, json=lambda: glass_to_dict(g, wl, n), text=lambda: format_glass(g, wl, n))
     return 0
+
+
+def _named_glass(name: str, cats: list[str] | None, catalog_flag: str | None):
+    """The catalog glass NAME means (in the --catalog catalogs, the first that has it, when
+    given), or a CliError that says what to type: --catalog for an ambiguous name or one of
+    another catalog, --search for an nd/vd pair or glass code."""
+    from raytrace.glass import find_glass, parse_glass_code, split_catalog_suffix
+    from raytrace.glass.catalog import CATALOGS, RETIRED, canonical_catalog, similar_names
+
+    raw, suffix = split_catalog_suffix(name)
+    if suffix is not None:  # NSK16_SCHOTT: the catalog is in the name
+        named = canonical_catalog(suffix)
+        if cats and named not in cats:
+            raise CliError(
+                f"glass {name} names the {named} catalog but --catalog says {catalog_flag}: "
+                "drop one of them"
+            )
+        cats = [named]
+    cand = []
+    for c in cats or ():
+        cand = find_glass(raw, [c])
+        if cand:
+            break
+    if not cats:
+        cand = find_glass(raw)
+    if not cand:
+        elsewhere = find_glass(raw) if cats else []
+        if elsewhere:
+            where = list(dict.fromkeys(g.catalog for g in elsewhere))
+            raise CliError(
+                f"glass {raw} is not in the {', '.join(cats)} catalog"
+                f"{'s' if len(cats) > 1 else ''}; it is in {', '.join(where)}: give --catalog "
+                f"{where[0]}"
+            )
+        model = parse_glass_code(raw)
+        if model is not None:
+            raise CliError(
+                f"{name!r} is an nd/vd pair (nd {model.nd:g}, vd {model.vd:g}), not a glass name: "
+                "NAME looks up catalog glasses; for the catalog glasses nearest to it give "
+                f"--search nd={model.nd:g},vd={model.vd:g}"
+            )
+        similar = similar_names(raw)
+        hint = f"; similar names: {', '.join(similar)}" if similar else ""
+        raise CliError(
+            f"unknown glass {name!r}: it is in none of the catalogs "
+            f"({', '.join(cats or CATALOGS)}){hint}; check the spelling, or find glasses by their "
+            "numbers with --search nd=N,vd=V"
+        )
+    if len({(g.nd, g.vd) for g in cand}) > 1:
+        listing = "; ".join(
+            f"{g.catalog} {g.name} (nd {g.nd:g}, vd {g.vd:g}"
+            + (f", {g.status}" if g.status in RETIRED else "")
+            + ")"
+            for g in cand
+        )
+        options = list(dict.fromkeys(g.catalog for g in cand))
+        raise CliError(
+            f"ambiguous glass {name!r}: {listing}. Choose one with --catalog {options[0]}"
+            + (f" (or {', '.join(options[1:])})" if len(options) > 1 else "")
+        )
+    return cand[0]
+
+
+def _indices(g, wl, strict: bool):
+    """The index of glass ``g`` at the wavelengths ``wl`` (nm), with one warning line naming
+    every wavelength outside the glass's data range (with ``strict`` a CliError instead).
+    Beyond a pole of the formula the material itself refuses (OutOfRangeError)."""
+    import warnings
+
+    import numpy as np
+
+    from raytrace.materials import OutOfRangeWarning
+
+    lo, hi = g.material.valid_range_nm
+    bad = wl[(wl < lo) | (wl > hi)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", OutOfRangeWarning)
+        n = np.atleast_1d(g.material.index(wl))
+    if bad.size:
+        msg = (
+            f"glass {g.name} ({g.catalog}) evaluated at {', '.join(f'{b:g}' for b in bad)} nm, "
+            f"outside its data range {lo:g}–{hi:g} nm: the index is extrapolated"
+        )
+        if strict:
+            raise CliError(msg + "; --strict fails: use wavelengths inside the data range")
+        warn(msg)
+    return n
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -157,7 +260,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_strict_arg(
         q, help="Refuse wavelengths outside the glass's data range (default: a warning)."
     )
-    q.add_argument("--count", type=int, default=10, metavar="N", help="--search: how many.")
+    q.add_argument(
+        "--count", type=int, metavar="N", help=f"--search: how many (default {DEFAULT_COUNT})."
+    )
     q.add_argument(
         "--max-price",
         type=_price,

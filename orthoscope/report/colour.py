@@ -10,6 +10,7 @@ import numpy as np
 
 from distortion.characteristic import ChromaticDistortion
 from distortion.colour import FocalShift, LateralColour
+from raytrace.trace.results import status_name
 
 from .text import format_columns
 
@@ -20,6 +21,37 @@ def _obj(od: float) -> str:
 
 def _field_label(kind: str) -> str:
     return "object height (mm)" if kind == "height" else "field (deg)"
+
+
+def status_names(status: np.ndarray) -> list:
+    """A status array (any shape) as nested lists of the status words of the other commands'
+    JSON (``"ok"``, ``"aim_failed"``, ...: :func:`raytrace.trace.results.status_name`)."""
+    a = np.asarray(status)
+    if a.ndim == 0:
+        return status_name(int(a))
+    return [status_names(row) for row in a]
+
+
+def untraced_note(status: np.ndarray, fields: np.ndarray, wavelengths, kind: str) -> list[str]:
+    """The line under a colour table for the rays that did not trace (``[]`` when all did):
+    how many, that the table shows them as '-', and per field the wavelengths and status.
+    ``status`` (m, n): wavelengths x fields."""
+    st = np.asarray(status)
+    bad = int(np.count_nonzero(st != 0))
+    if not bad:
+        return []
+    unit = " mm" if kind == "height" else " deg"
+    parts = []
+    for j, f in enumerate(fields):
+        col = st[:, j]
+        if not np.any(col != 0):
+            continue
+        names = ", ".join(dict.fromkeys(status_name(c) for c in col if c != 0))
+        wl = ", ".join(f"{w:g}" for w, c in zip(wavelengths, col, strict=True) if c != 0)
+        parts.append(f"{f + 0.0:g}{unit} at {wl} nm ({names})")
+    return [
+        f"{bad} wavelength x field ray(s) not traced (shown as -): " + "; ".join(parts),
+    ]
 
 
 # ------------------------------------------------------------------ focal shift
@@ -83,6 +115,8 @@ def format_lateral_colour(lc: LateralColour) -> str:
         if i:
             out.append("")
         out.append(format_columns(title, _field_label(lc.field_kind), lc.fields, q))
+    ws = (w1, w2, lc.reference_wavelength)
+    out += untraced_note(lc.status, lc.fields, ws, lc.field_kind)
     return "\n".join(out)
 
 
@@ -108,7 +142,7 @@ def lateral_colour_to_dict(lc: LateralColour) -> dict:
             }
             for i in range(lc.n_planes)
         ],
-        "status": lc.status,
+        "status": status_names(lc.status),
     }
 
 
@@ -135,9 +169,7 @@ def format_chromatic_distortion(cd: ChromaticDistortion) -> str:
         if i:
             out.append("")
         out.append(format_columns(title, _field_label(r0.field_kind), cd.fields, q))
-    bad = int(np.count_nonzero(cd.status != 0))
-    if bad:
-        out.append(f"{bad} wavelength x field ray(s) not traced (shown as nan)")
+    out += untraced_note(cd.status, cd.fields, cd.wavelengths, r0.field_kind)
     return "\n".join(out)
 
 
@@ -167,5 +199,5 @@ def chromatic_distortion_to_dict(cd: ChromaticDistortion) -> dict:
             }
             for i in range(r0.n_planes)
         ],
-        "status": cd.status,
+        "status": status_names(cd.status),
     }

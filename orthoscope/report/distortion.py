@@ -198,9 +198,11 @@ def format_compensation(res: CompensationResult, *, layout: str = "rows", decima
 
 
 def compensation_to_dict(res: CompensationResult) -> dict:
-    """JSON-ready dict of a compensation result."""
+    """JSON-ready dict of a compensation result: lengths carry ``_mm`` (the camera's F1 as
+    ``F1_mm``); the magnifications ``M2`` (the printer's) and ``M`` (the print's, Eq. 16) are
+    plain numbers, as ``M0`` in the distortion JSON."""
     return {
-        "F1": res.F1,
+        "F1_mm": res.F1,
         "M2": res.M2,
         "M": res.M,
         "method": res.method,

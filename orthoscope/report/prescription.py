@@ -48,6 +48,7 @@ def prescription_to_dict(lens: Lens) -> dict:
         "source": lens.source,
         "units": "mm",
         "wavelength_nm": lens.wavelength,
+        "wavelengths_nm": [float(w) for w in lens.wavelengths],
         "object_distance_mm": lens.object_distance,
         "object_medium": material_dict(lens.object_material),
         "aperture": asdict(lens.aperture),
@@ -55,7 +56,35 @@ def prescription_to_dict(lens: Lens) -> dict:
         "image_solve": lens.image_solve,
         "image_placement": _placement(lens.image_placement),
         "surfaces": surfaces,
+        "first_order": first_order_dict(lens),
     }
+
+
+def first_order_dict(lens: Lens) -> dict:
+    """The first-order summary under the text table (:func:`raytrace.listing.summary_lines`),
+    at the reference wavelength and the lens file's object: ``efl_mm``, ``bfl_mm``, ``epd_mm``,
+    ``f_number`` (EFL/EPD), ``m_e`` (pupil magnification), ``entrance_pupil_z_mm`` and
+    ``exit_pupil_z_mm`` (from the first vertex); ``error`` says why they are null when the lens
+    has no first-order data."""
+    from raytrace.errors import LensError
+    from raytrace.paraxial.firstorder import paraxial
+
+    keys = (
+        "efl_mm",
+        "bfl_mm",
+        "epd_mm",
+        "f_number",
+        "m_e",
+        "entrance_pupil_z_mm",
+        "exit_pupil_z_mm",
+    )
+    try:
+        p = paraxial(lens)
+    except LensError as e:
+        return {**dict.fromkeys(keys), "error": str(e)}
+    fno = abs(p.efl) / p.epd if p.epd else math.inf
+    values = (p.efl, p.bfl, p.epd, fno, p.m_e, p.z_E0, p.z_E0p)
+    return {**{k: float(v) for k, v in zip(keys, values, strict=True)}, "error": None}
 
 
 def _placement(p) -> dict | None:

@@ -308,8 +308,9 @@ def split_catalog_suffix(name: str) -> tuple[str, str | None]:
     return raw, None
 
 
-def _similar(name: str, limit: int = 5) -> list[str]:
-    """Catalog names that end with ``name`` (``BK7`` → ``N-BK7``) or are close to it."""
+def similar_names(name: str, limit: int = 5) -> list[str]:
+    """Catalog names that end with ``name`` (``BK7`` → ``N-BK7``) or are close to it, as
+    ``"N-BK7 (Schott)"``."""
     key = normalize_name(name)
     if not key:
         return []
@@ -374,7 +375,7 @@ def lookup_glass(
     if not cand:
         cand = find_glass(raw)
     if not cand:
-        similar = _similar(raw)
+        similar = similar_names(raw)
         hint = f"; similar catalog names: {', '.join(similar)}" if similar else ""
         raise PrescriptionError(
             f"unknown glass {name!r}: it is in none of the catalogs "
@@ -446,6 +447,57 @@ def private_material(
     )
 
 
+class GlassSearchError(PrescriptionError, ValueError):
+    """An impossible :func:`search_glass` request (an nd or vd that is no glass value, a
+    negative price limit, no glasses asked for). A :class:`PrescriptionError` and a
+    :class:`ValueError`."""
+
+
+#: the nd :func:`search_glass` takes: every catalog glass lies within (MgF2 1.378 to Sumita's
+#: K-PSFn215 2.154); the bound :func:`parse_glass_code` uses, wide enough for the nd a lens
+#: file prints for a model glass (:func:`raytrace.glass.legacy.model_glass_error` searches it)
+SEARCH_ND = (1.0, 5.0)
+
+
+def check_search(nd, vd, n, max_price) -> tuple[float, float, int, float]:
+    """The arguments of :func:`search_glass` as (float, float, int, float), or a
+    :class:`GlassSearchError` naming the one that cannot be (with the likely slip when nd
+    looks like an Abbe number)."""
+    import operator
+
+    try:
+        nd, vd, max_price = float(nd), float(vd), float(max_price)
+    except (TypeError, ValueError):
+        raise GlassSearchError(
+            f"search_glass takes numbers: nd {nd!r}, vd {vd!r}, max_price {max_price!r}"
+        ) from None
+    lo, hi = SEARCH_ND
+    if not (math.isfinite(nd) and lo <= nd <= hi):
+        slip = (
+            f"; {nd:g} looks like an Abbe number vd (the order is nd, vd: e.g. 1.62, 60)"
+            if 10.0 <= nd <= 120.0
+            else ""
+        )
+        raise GlassSearchError(
+            f"nd {nd:g} is no refractive index at the d line (between {lo:g} and {hi:g}){slip}"
+        )
+    if not (math.isfinite(vd) and vd > 0.0):
+        raise GlassSearchError(f"vd {vd:g} is no Abbe number (a positive number, glasses 17-95)")
+    if math.isnan(max_price) or max_price <= 0.0:
+        raise GlassSearchError(
+            f"max_price {max_price:g}: a positive relative price (N-BK7 = 1), or inf for no limit"
+        )
+    try:
+        if isinstance(n, bool):
+            raise TypeError
+        count = operator.index(n)
+    except TypeError:
+        raise GlassSearchError(f"n must be a whole number of glasses (>= 1), got {n!r}") from None
+    if count < 1:
+        raise GlassSearchError(f"n = {count}: ask for at least 1 glass")
+    return nd, vd, count, max_price
+
+
 @dataclass(frozen=True)
 class GlassMatch:
     """A :func:`search_glass` result: the ``glass`` and its ``distance`` (glass-code units)."""
@@ -475,17 +527,17 @@ def search_glass(
     Parameters
     ----------
     nd : float
-        Refractive index at the d line (587.56 nm).
+        Refractive index at the d line (587.56 nm), 1 to 5 (:data:`SEARCH_ND`).
     vd : float
-        Abbe number.
+        Abbe number (positive).
     n : int
-        How many to return (default 5; 0 or less: none).
+        How many to return (default 5; at least 1).
     catalogs : sequence of str, optional
         Catalogs to search (case-insensitive); default all of :data:`CATALOGS`.
     include_retired : bool
         Include withdrawn, legacy and obsolete glasses.
     max_price : float
-        The largest relative price (default ``inf``: no limit).
+        The largest relative price, positive (default ``inf``: no limit).
 
     Returns
     -------
@@ -495,8 +547,11 @@ def search_glass(
     Raises
     ------
     PrescriptionError
-        A catalog name that is no shipped catalog.
+        A catalog name that is no shipped catalog; :class:`GlassSearchError` (also a
+        ValueError) for an nd outside 1-5 (with a hint when it looks like an Abbe number), a vd
+        that is not positive, a ``max_price`` that is not positive, or ``n`` < 1.
     """
+    nd, vd, n, max_price = check_search(nd, vd, n, max_price)
     cats = CATALOGS
     if catalogs:
         cats = tuple(dict.fromkeys(require_catalog(x) for x in catalogs))
@@ -510,7 +565,7 @@ def search_glass(
             scored.append((d, c, i))
     scored.sort(key=lambda t: t[0])
     if not math.isfinite(max_price):
-        return [GlassMatch(_glass(c, i), d) for d, c, i in scored[: max(n, 0)]]
+        return [GlassMatch(_glass(c, i), d) for d, c, i in scored[:n]]
     out = []
     for d, c, i in scored:  # nearest first: the full records are read only as far as needed
         if len(out) >= n:
