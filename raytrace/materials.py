@@ -186,16 +186,18 @@ class Material:
                 "number of nm"
             )
         bad = w[(w < lo) | (w > hi)]
+        u = np.unique(bad)  # every wavelength outside, in order (the first six)
+        at = ", ".join(f"{b:g}" for b in u[:6]) + (f" (+{u.size - 6} more)" if u.size > 6 else "")
         if self.kind == "model":
             msg = (
-                f"{what} evaluated at {bad[0]:g} nm, outside its data range {lo:g}–{hi:g} nm "
+                f"{what} evaluated at {at} nm, outside its data range {lo:g}–{hi:g} nm "
                 "(the band the nd/vd model is validated on): the index is an extrapolation of "
                 f"the model; {_catalog_hint(self.nd, self.vd, bad)}"
             )
             fitted = "defined from nd/vd"
         else:
             msg = (
-                f"{what} evaluated at {bad[0]:g} nm, outside its data range {lo:g}–{hi:g} nm: "
+                f"{what} evaluated at {at} nm, outside its data range {lo:g}–{hi:g} nm: "
                 "the index is extrapolated"
             )
             fitted = f"fitted over {lo:g}–{hi:g} nm"

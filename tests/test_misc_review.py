@@ -215,3 +215,17 @@ def test_prescription_json_has_first_order_data_and_wavelengths():
     assert fo["efl_mm"] == pytest.approx(p.efl, rel=1e-12)
     assert fo["bfl_mm"] == pytest.approx(p.bfl, rel=1e-12)
     assert fo["f_number"] == pytest.approx(4.0, rel=1e-4) and fo["error"] is None
+
+
+@pytest.mark.parametrize("cmd", ["trace", "colour", "pupils"])
+def test_max_field_zero_is_the_axis_once(cmd):
+    # --max-field 0 gave --steps + 1 identical fields in every command (orthoscope.cli.common)
+    rc, out, err = run_cli([cmd, "cooke-triplet-f4", "--max-field", "0", "--json"])
+    assert rc == 0, err
+    d = json.loads(out)
+    fields = {
+        "trace": lambda: d["rays"],
+        "pupils": lambda: d["pupils"]["fields"],
+        "colour": lambda: d["lateral_colour"]["fields"],
+    }[cmd]()
+    assert len(fields) == 1

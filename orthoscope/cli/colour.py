@@ -85,8 +85,6 @@ def cmd_colour(args) -> int:
     if args.plot:
         check_plot_path(args.plot, "--plot", args)
     od, fields, kind = resolve_object_fields(lens, args)
-    if args.fields is None and fields.size > 1 and not fields.any():
-        fields = fields[:1]  # --max-field 0: the axis once, not --steps + 1 equal rows
     planes = resolve_planes(lens, args)
     wls = args.wavelengths
     if wls is None:

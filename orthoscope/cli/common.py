@@ -362,6 +362,8 @@ def resolve_fields(lens, args) -> tuple[np.ndarray, str]:
     check_size(steps, MAX_FIELDS, "--steps", args, per_item_bytes=150)
     if not math.isfinite(fmax):
         raise CliError("--max-field must be finite")
+    if fmax == 0.0:  # the axis alone: one field, not steps + 1 copies of it
+        return np.zeros(1), kind
     return np.linspace(0.0, fmax, steps + 1), kind
 
 

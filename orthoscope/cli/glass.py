@@ -8,7 +8,7 @@ import argparse
 import math
 
 from .colour import add_wavelengths_arg
-from .common import CliError, add_output_args, add_strict_arg, print_result, warn
+from .common import CliError, add_output_args, add_strict_arg, print_result
 
 SAMPLES = [
     ["glass", "N-BK7", "--wavelengths", "F,d,C"],
@@ -130,7 +130,7 @@ def cmd_glass(args) -> int:
             raise CliError("--wavelengths lens applies to lens commands; give nm or line letters")
         wls = default_wavelengths(g)
     wl = np.asarray(wls, dtype=float)
-    n = _indices(g, wl, args.strict)
+    n = _indices(g, wl)
     print_result(args, json=lambda: glass_to_dict(g, wl, n), text=lambda: format_glass(g, wl, n))
     return 0
 
@@ -196,30 +196,13 @@ def _named_glass(name: str, cats: list[str] | None, catalog_flag: str | None):
     return cand[0]
 
 
-def _indices(g, wl, strict: bool):
-    """The index of glass ``g`` at the wavelengths ``wl`` (nm), with one warning line naming
-    every wavelength outside the glass's data range (with ``strict`` a CliError instead).
-    Beyond a pole of the formula the material itself refuses (OutOfRangeError)."""
-    import warnings
-
+def _indices(g, wl):
+    """The index of glass ``g`` at the wavelengths ``wl`` (nm): the material's one warning names
+    every wavelength outside its data range (with --strict, :func:`orthoscope.cli.main` makes
+    it an error); beyond a pole of the formula it refuses (OutOfRangeError)."""
     import numpy as np
 
-    from raytrace.materials import OutOfRangeWarning
-
-    lo, hi = g.material.valid_range_nm
-    bad = wl[(wl < lo) | (wl > hi)]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", OutOfRangeWarning)
-        n = np.atleast_1d(g.material.index(wl))
-    if bad.size:
-        msg = (
-            f"glass {g.name} ({g.catalog}) evaluated at {', '.join(f'{b:g}' for b in bad)} nm, "
-            f"outside its data range {lo:g}–{hi:g} nm: the index is extrapolated"
-        )
-        if strict:
-            raise CliError(msg + "; --strict fails: use wavelengths inside the data range")
-        warn(msg)
-    return n
+    return np.atleast_1d(g.material.index(wl))  # --strict: the warning is an error (main)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
