@@ -186,13 +186,14 @@ class Material:
                 "number of nm"
             )
         bad = w[(w < lo) | (w > hi)]
-        u = np.unique(bad)  # every wavelength outside, in order (the first six)
+        u = np.unique(bad)  # every wavelength outside, ascending (the first six)
         at = ", ".join(f"{b:g}" for b in u[:6]) + (f" (+{u.size - 6} more)" if u.size > 6 else "")
         if self.kind == "model":
             msg = (
-                f"{what} evaluated at {at} nm, outside its data range {lo:g}–{hi:g} nm "
-                "(the band the nd/vd model is validated on): the index is an extrapolation of "
-                f"the model; {_catalog_hint(self.nd, self.vd, bad)}"
+                f"{what} evaluated at {at} nm, outside the range {lo:g}–{hi:g} nm its nd/vd "
+                "model is validated over (Schott's i to t lines): the index is an extrapolation "
+                f"of the model; use a catalog glass with data there (search_glass({self.nd:g}, "
+                f"{self.vd:g}) lists the nearest)"
             )
             fitted = "defined from nd/vd"
         else:
@@ -250,36 +251,6 @@ def _formula_holds(m: Material, wavelength_nm: float) -> bool:
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         n = _raw_index(m, path)
     return bool(np.all(np.isfinite(n)) and np.all(n >= 1.0))
-
-
-@functools.lru_cache(maxsize=256)
-def _nearest_with_data(nd: float, vd: float, lo: float, hi: float) -> str:
-    """The catalog glass nearest to (nd, vd) whose data cover lo..hi nm (``"Schott N-SK16"``),
-    among the 20 nearest current ones; ``""`` when none does or no catalog can be read."""
-    from .errors import OrthoscopeError
-    from .glass.catalog import search_glass  # deferred: raytrace.glass imports this module
-
-    try:
-        for hit in search_glass(nd, vd, 20):
-            g = hit.glass
-            if g.wavelength_range_nm[0] <= lo and hi <= g.wavelength_range_nm[1]:
-                return f"{g.catalog} {g.name}"
-    except (OrthoscopeError, OSError):
-        pass
-    return ""
-
-
-def _catalog_hint(nd: float, vd: float, bad: np.ndarray) -> str:
-    """What to use instead of a model glass at the wavelengths ``bad`` (nm)."""
-    lo, hi = float(np.min(bad)), float(np.max(bad))
-    name = _nearest_with_data(nd, vd, lo, hi)
-    if name:
-        return f"use a catalog glass with data there (e.g. {name}, near nd {nd:g}, vd {vd:g})"
-    at = f"{lo:g} nm" if lo == hi else f"{lo:g}–{hi:g} nm"
-    return (
-        "use a catalog glass with data there (none of the 20 current catalog glasses nearest to "
-        f"nd {nd:g}, vd {vd:g} has data at {at})"
-    )
 
 
 def _raw_index(m: Material, wavelength_nm: np.ndarray) -> np.ndarray:

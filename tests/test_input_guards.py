@@ -189,21 +189,19 @@ def test_model_glass_outside_its_range_warns_and_strict_refuses(law, wl):
     msg = str(rec[0].message)
     first = wl if np.ndim(wl) == 0 else wl[1]
     assert msg.startswith(
-        f"model glass {m.describe()} evaluated at {first:g} nm, outside its data "
+        f"model glass {m.describe()} evaluated at {first:g} nm, outside the range "
+        "365.01–1013.98 nm its nd/vd model is validated over"
     )
-    assert (
-        "outside its data range 365.01–1013.98 nm" in msg
-    )  # the CLI's --strict filter matches this
     assert "the index is an extrapolation of the model; use a catalog glass" in msg
     with pytest.raises(OutOfRangeError, match="use wavelengths inside the range"):
         m.index(wl, strict=True)
 
 
-def test_the_warning_names_a_catalog_glass_with_data_there():
-    with pytest.warns(OutOfRangeWarning, match=r"\(e\.g\. \w+ [\w-]+, near nd 1\.62, vd 60\.3\)"):
+def test_the_warning_says_how_to_find_a_catalog_glass():
+    # the hint is a call, not a catalog search inside every evaluation (a search per new model
+    # glass made each out-of-range index ~70 times slower, in the optimizer's glass fitting)
+    with pytest.warns(OutOfRangeWarning, match=r"search_glass\(1\.62, 60\.3\) lists the nearest"):
         model_glass(1.62, 60.3).index(1550.0)
-    with pytest.warns(OutOfRangeWarning, match="has data at 5000 nm"):  # none reaches 5 µm
-        model_glass(1.62, 60.3).index(5000.0)
 
 
 def test_a_buchdahl_model_near_its_pole_has_no_index():

@@ -39,7 +39,7 @@ def test_coefficients_says_when_the_profile_stops_before_max_field():
     t = d["traced"]
     assert (t["n_fields"], t["n_fields_used"], t["max_field_deg"]) == (121, 90, 40.0)
     assert t["first_failure"] == {"field_deg": 30.0, "status": "aim_failed"}
-    assert t["r_last_mm"] == pytest.approx(32.0253, abs=1e-4)
+    assert t["r_last_mm"] == pytest.approx(32.0253, abs=1e-4)  # regression pin (our output)
     assert d["warnings"] == [t["warning"]] and len(d["gaussian_fit"]["r_mm"]) == 89
     # --strict refuses it; a profile that traces to the end is silent and says so in JSON
     rc, out, err = run_cli([*TRIPLET_12X, "--max-field", "40", "--strict"])
@@ -104,6 +104,7 @@ def test_compensate_json_keys_carry_units():
     pair = ["compensate", "topogon-us2031792-fig1", "twinplex-like-55-525", "--fields", "0,10,20"]
     rc, out, _ = run_cli([*pair, "--json"])
     d = json.loads(out)
+    # regression pin (our output): the key's value; the point is the unit-suffixed name
     assert rc == 0 and "F1" not in d and d["F1_mm"] == pytest.approx(66.0378, abs=1e-4)
     assert {"M2", "M", "alpha_deg", "residual_mm"} <= set(d)
 

@@ -100,7 +100,8 @@ def test_spot_and_fan_agree_with_the_api_file_plane(capsys, wl):
 
 
 def test_spot_at_f_is_the_sensor_plane_spot(capsys):
-    # the reviewer's numbers: RMS 10.82 um in the sensor plane, not 6.81 um in F's Gaussian plane
+    # regression pin (orthoscope's own output, 2026-11-27): RMS 10.82 um in the sensor plane; the
+    # old code gave 6.81 um, F's Gaussian plane (the plane itself is checked against the API above)
     d = _run(capsys, "spot", LENS, "--wavelength", "F", "--fields", "0")["spots"][0]
     assert d["rms_radius_mm"] * 1e3 == pytest.approx(10.82, abs=0.01)
 
@@ -121,7 +122,8 @@ def test_distortion_agrees_with_the_api_file_plane(capsys, converted_zmx, wl):
 
 
 def test_chief_ray_height_at_f_in_the_sensor_plane(capsys):
-    # the reviewer's number: 18.3058 mm at 20 deg in the sensor plane (18.2815 in F's Gaussian)
+    # regression pin (orthoscope's own output, 2026-11-27): 18.3058 mm at 20 deg in the sensor
+    # plane; the old code gave 18.2815, F's Gaussian plane
     d = _run(capsys, "distortion", LENS, "--wavelength", "F", "--fields", "20")["distortion"]
     assert d["planes"][0]["yp_mm"][0] == pytest.approx(18.3058, abs=1e-4)
 

@@ -149,7 +149,10 @@ def test_every_corpus_zmx_that_loads_round_trips_through_the_writer(path):
     try:
         lens = quiet(read_zmx, path)
     except PrescriptionError as e:
-        pytest.skip(f"not read: {e.reason[:80]}")
+        # a file the reader refuses (gratings, toroids, unknown glasses, NSC) says why in one
+        # line; nothing to write back
+        assert e.reason and "\n" not in e.reason
+        return
     text = dumps_zmx(lens)
     if "GCAT " in text:
         resolves_as_opticstudio(text, lens)

@@ -201,6 +201,8 @@ CLI_FLAGS = {
     "r_min": "--r-min",
     "r_max": "--r-max",
     "threshold_um": "--threshold-um",
+    "field_step_deg": "--field-step",
+    "max_field_deg": "--max-field",
 }
 
 
@@ -210,6 +212,7 @@ def cli_words(message: str) -> str:
     import re
 
     message = message.replace("pixel_size_mm=(pitch_x, pitch_y) in mm", "--pitch (or --sensor)")
+    message = message.replace("allow_large=True", "--allow-large (before the command)")
     keys = "|".join(CLI_FLAGS)
     message = re.sub(  # key=6 -> --flag 6 (a number the person gave)
         rf"(?<![\w.])({keys})=(-?[0-9][0-9.eE+-]*)\b",
@@ -306,8 +309,10 @@ def _run(argv: Sequence[str] | None) -> int:
             _numba_without_blas_probe()
             _compile_notice()
         with warnings.catch_warnings():
-            if getattr(args, "strict", False):  # a glass evaluated outside its data range fails
-                warnings.filterwarnings("error", message=r".*outside its data range")
+            if getattr(args, "strict", False):  # a glass evaluated outside its range fails
+                from raytrace.materials import OutOfRangeWarning
+
+                warnings.filterwarnings("error", category=OutOfRangeWarning)
             return int(args.func(args) or 0)
     except KeyboardInterrupt:
         print(f"{command}: interrupted", file=sys.stderr)

@@ -45,7 +45,6 @@ REFERENCE_POINT_HELP = (
 
 def cmd_report(args) -> int:
     from distortion.certificate import calibration_certificate
-    from distortion.errors import DataError
 
     from ..report.certificate import certificate_to_dict, format_certificate
 
@@ -57,22 +56,20 @@ def cmd_report(args) -> int:
     planes = resolve_planes(lens, args)
     if len(planes) != 1:
         raise CliError("a certificate is for one image plane: give one value")
-    try:  # the work limit is checked there, before any trace
-        cert = calibration_certificate(
-            lens,
-            sensor=args.sensor,
-            object_distance=od,
-            plane=planes,
-            wavelength=args.wavelength,
-            reference_point=args.reference_point,
-            method=args.method,
-            field_step_deg=args.field_step,
-            max_field_deg=args.max_field,
-            date=args.date,
-            allow_large=bool(getattr(args, "allow_large", False)),
-        )
-    except DataError as e:
-        raise CliError(_cli_words(str(e))) from None
+    # the work limit is checked there, before any trace (its message in flags: cli_words)
+    cert = calibration_certificate(
+        lens,
+        sensor=args.sensor,
+        object_distance=od,
+        plane=planes,
+        wavelength=args.wavelength,
+        reference_point=args.reference_point,
+        method=args.method,
+        field_step_deg=args.field_step,
+        max_field_deg=args.max_field,
+        date=args.date,
+        allow_large=bool(getattr(args, "allow_large", False)),
+    )
     d = certificate_to_dict(cert)
     print_result(args, json=lambda: {"certificate": d}, text=lambda: format_certificate(d))
     if args.output:
@@ -80,20 +77,6 @@ def cmd_report(args) -> int:
 
         save_plot(lambda: plot_certificate(d), args.output, args)
     return 0
-
-
-#: the API's keywords in its messages, as this command says them
-_API_WORDS = (
-    ("field_step_deg=", "--field-step "),
-    ("max_field_deg=", "--max-field "),
-    ("allow_large=True", "--allow-large (before the command)"),
-)
-
-
-def _cli_words(message: str) -> str:
-    for api, cli in _API_WORDS:
-        message = message.replace(api, cli)
-    return message
 
 
 def _date(text: str) -> str:
