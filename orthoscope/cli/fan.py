@@ -50,25 +50,19 @@ def _field_kw(value: float, kind: str) -> dict:
 def _check_rays(args, pattern: str, n: int, flags: str) -> int:
     """``n`` (``--n`` or ``--rings``, named in ``flags``) if the rays of ``pattern`` it makes are
     within :data:`raytrace.limits.MAX_SAMPLES` (or the run has --allow-large); else CliError
-    naming the flag, the ray count and the flag that lifts the limit. Counted, not made."""
-    from raytrace import limits
-    from raytrace.trace.pupil import SAMPLE_BYTES, pupil_count
+    naming the flag (:func:`raytrace.trace.pupil.check_sampling`, said with the flags)."""
+    from raytrace.errors import TraceError
+    from raytrace.trace.pupil import check_sampling
 
-    if n < 1:
-        raise CliError(f"{flags} must be at least 1, got {n}")
-    if pattern == "square" and n < 3:
-        raise CliError(
-            f"--pattern square {flags} {n}: a grid of {n} point(s) across has no point inside "
-            "the pupil (its points are the corners of the square); give --rings 3 or more"
-        )
-    count = pupil_count(pattern, n)
-    if count > limits.MAX_SAMPLES and not getattr(args, "allow_large", False):
-        given = f"{flags} {n}" if flags == "--n" else f"--pattern {pattern} {flags} {n}"
-        raise CliError(
-            f"{given}: {count} rays, more than {limits.MAX_SAMPLES} (about "
-            f"{count * SAMPLE_BYTES / 1e9:.3g} GB and a long run); give --allow-large (before "
-            "the command) to run it anyway"
-        )
+    words = (
+        f"{flags} {{n}}",
+        f"--pattern {{pattern}} {flags} {{n}}",
+        "--allow-large (before the command)",
+    )
+    try:
+        check_sampling(pattern, n, allow_large=getattr(args, "allow_large", False), words=words)
+    except TraceError as e:
+        raise CliError(str(e)) from None
     return n
 
 

@@ -54,6 +54,43 @@ def pupil_count(pattern: str, n: int, *, per_ring: int = 24) -> int:
     return n
 
 
+def check_sampling(
+    pattern: str,
+    n,
+    *,
+    per_ring: int = 24,
+    allow_large: bool = False,
+    words: tuple[str, str, str] = ("n={n}", "pattern={pattern!r} with n={n}", "allow_large=True"),
+) -> int:
+    """The ray count of ``pattern`` and ``n`` (:func:`pupil_count`), or :class:`TraceError`:
+    an unknown pattern, ``n`` not a whole number ≥ 1, a square grid with no point inside the
+    pupil (n < 3), more than :data:`raytrace.limits.MAX_SAMPLES` rays without ``allow_large``
+    (counted, not made). ``words``: how the caller says ``n`` and the pattern (format strings)
+    and how the limit is lifted (the command line names its flags)."""
+    say_n, say_pattern, lift = words
+    name = say_n.split("{")[0].rstrip("= ")
+    if pattern not in PATTERNS:
+        raise TraceError(f"unknown pupil pattern {pattern!r}; use one of {', '.join(PATTERNS)}")
+    if not (is_whole(n) and n >= 1):
+        raise TraceError(f"pupil sampling {name} must be a whole number, at least 1, got {n!r}")
+    if pattern == "square" and n < 3:
+        raise TraceError(
+            f"{say_pattern.format(pattern=pattern, n=n)}: a grid of {n} point(s) across has no "
+            f"point inside the pupil (its points are corners (±1, ±1)); give "
+            f"{say_n.format(n=3)} or more"
+        )
+    count = pupil_count(pattern, n, per_ring=per_ring)
+    if count > limits.MAX_SAMPLES and not allow_large:
+        fan = pattern in ("fan_y", "fan_x")
+        given = say_n.format(n=n) if fan else say_pattern.format(pattern=pattern, n=n)
+        raise TraceError(
+            f"{given}: {count} rays, more than {limits.MAX_SAMPLES} "
+            f"(about {count * SAMPLE_BYTES / 1e9:.3g} GB and a long run); give {lift} to run it "
+            "anyway"
+        )
+    return count
+
+
 def pupil_points(
     pattern: str, n: int, *, per_ring: int = 24, allow_large: bool = False
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -63,23 +100,7 @@ def pupil_points(
     :data:`raytrace.limits.MAX_SAMPLES` rays are refused, before any is made, unless
     ``allow_large=True``.
     """
-    if pattern not in PATTERNS:
-        raise TraceError(f"unknown pupil pattern {pattern!r}; use one of {', '.join(PATTERNS)}")
-    if not (is_whole(n) and n >= 1):
-        raise TraceError(f"pupil sampling n must be a whole number, at least 1, got {n!r}")
-    if pattern == "square" and n < 3:
-        raise TraceError(
-            f"pattern='square' with n={n}: a grid of {n} point(s) across has no point inside "
-            "the pupil (its points are corners (±1, ±1)); give n=3 or more"
-        )
-    count = pupil_count(pattern, n, per_ring=per_ring)
-    if count > limits.MAX_SAMPLES and not allow_large:
-        given = f"n={n}" if pattern in ("fan_y", "fan_x") else f"pattern={pattern!r} with n={n}"
-        raise TraceError(
-            f"{given}: {count} rays, more than {limits.MAX_SAMPLES} "
-            f"(about {count * SAMPLE_BYTES / 1e9:.3g} GB and a long run); give allow_large=True "
-            "to run it anyway"
-        )
+    check_sampling(pattern, n, per_ring=per_ring, allow_large=allow_large)
     if pattern == "rings":
         k = np.arange(1, n + 1)
         rho = np.repeat(np.sqrt((k - 0.5) / n), per_ring)
