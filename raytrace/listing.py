@@ -90,7 +90,7 @@ def summary_lines(lens: Lens) -> list[str]:
         p = paraxial(lens)
     except LensError as e:
         return [head, f"first-order data undefined: {e}"]
-    fno = abs(p.efl) / p.epd if p.epd else math.inf
+    fno = p.f_number
     return [
         head,
         f"EFL {p.efl:.6f} mm   BFL {p.bfl:.6f} mm   EPD {p.epd:.6g} mm   f/{fno:.4g}   "

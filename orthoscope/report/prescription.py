@@ -82,8 +82,7 @@ def first_order_dict(lens: Lens) -> dict:
         p = paraxial(lens)
     except LensError as e:
         return {**dict.fromkeys(keys), "error": str(e)}
-    fno = abs(p.efl) / p.epd if p.epd else math.inf
-    values = (p.efl, p.bfl, p.epd, fno, p.m_e, p.z_E0, p.z_E0p)
+    values = (p.efl, p.bfl, p.epd, p.f_number, p.m_e, p.z_E0, p.z_E0p)
     return {**{k: float(v) for k, v in zip(keys, values, strict=True)}, "error": None}
 
 

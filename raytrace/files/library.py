@@ -132,14 +132,13 @@ def lens_info(lens: Lens, name: str | None = None) -> LensInfo:
 
     try:
         par = paraxial(lens)
-        efl = float(par.efl)
-        epd = float(par.epd)
+        efl, epd, f_number = float(par.efl), float(par.epd), par.f_number
     except LensError:
-        efl, epd = math.nan, math.nan
+        efl, epd, f_number = math.nan, math.nan, math.nan
     if lens.aperture.kind == "fnumber":
         fno: float | None = lens.aperture.value
     elif lens.aperture.kind == "epd" and epd > 0:
-        fno = abs(efl) / epd
+        fno = f_number
     else:
         fno = None
     path = Path(lens.path) if lens.path else Path()

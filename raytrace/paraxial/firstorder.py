@@ -109,6 +109,12 @@ class ParaxialResult:
     chief_slope_image: float = math.nan
     z_gauss_reference: float = math.nan
 
+    @property
+    def f_number(self) -> float:
+        """The f-number |EFL| / EPD of the lens's aperture (inf for a zero EPD); the working
+        f-number of a finite object is :attr:`working_fnumber`."""
+        return abs(self.efl) / self.epd if self.epd else math.inf
+
     def __repr__(self) -> str:
         obj = (
             "object at infinity"
