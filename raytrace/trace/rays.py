@@ -136,6 +136,20 @@ def _f64(a: np.ndarray, n: int) -> np.ndarray:
     return np.array(np.broadcast_to(a, (n,)), dtype=np.float64, order="C")
 
 
+def _ray_columns(origins, directions) -> list[np.ndarray]:
+    """x, y, z, L, M, N as contiguous float64 columns of one length (the inputs broadcast; a
+    single ray is a batch of one), or TraceError."""
+    arrs = _columns(origins, "origins") + _columns(directions, "directions")
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in arrs))
+    except ValueError as e:
+        raise TraceError(f"ray arrays do not broadcast to a common shape: {e}") from None
+    if len(shape) > 1:
+        raise TraceError(f"ray arrays must be 1-D (got shape {shape})")
+    n = int(shape[0]) if shape else 1
+    return [_f64(a, n) for a in arrs]
+
+
 #: what a valid ray start is, for the refusal (:func:`_refuse`)
 RAY_RULE = (
     "origins must be finite and directions must be nonzero, finite vectors pointing toward +z"
@@ -257,15 +271,8 @@ def trace_rays(
     from ..kernels import bulk
 
     packed = packed_lens(lens, wavelength)
-    arrs = _columns(origins, "origins") + _columns(directions, "directions")
-    try:
-        shape = np.broadcast_shapes(*(a.shape for a in arrs))
-    except ValueError as e:
-        raise TraceError(f"ray arrays do not broadcast to a common shape: {e}") from None
-    if len(shape) > 1:
-        raise TraceError(f"ray arrays must be 1-D (got shape {shape})")
-    n = int(shape[0]) if shape else 1
-    xs = [_f64(a, n) for a in arrs]
+    xs = _ray_columns(origins, directions)
+    n = xs[0].shape[0]
     out = [np.empty(n) for _ in range(6)]
     st = np.empty(n, dtype=np.int8)
     sf = np.empty(n, dtype=np.int32)
@@ -343,15 +350,8 @@ def ray_paths(
     from ..kernels.paths import trace_paths
 
     packed = packed_lens(lens, wavelength)
-    arrs = [np.atleast_1d(a) for a in _columns(origins, "origins") + _columns(directions, "dirs")]
-    try:
-        shape = np.broadcast_shapes(*(a.shape for a in arrs))
-    except ValueError as e:
-        raise TraceError(f"ray arrays do not broadcast to a common shape: {e}") from None
-    if len(shape) > 1:
-        raise TraceError(f"ray arrays must be 1-D (got shape {shape})")
-    n = int(shape[0])
-    xs = [_f64(a, n) for a in arrs]
+    xs = _ray_columns(origins, directions)
+    n = xs[0].shape[0]
     if n and _bad_starts(xs).any():  # few rays: every start is tested
         raise _refuse(xs, "ray_paths")
     ns = packed.n_lens_surfaces
