@@ -410,3 +410,24 @@ def test_a_warning_raised_again_is_printed_once(capsys):
         # N-SK16 (surfaces 1 and 5, one material) and the model glass of surface 3
         lines = [ln for ln in err.splitlines() if "evaluated at 2600 nm, outside" in ln]
         assert rc == 0 and len(lines) == 2 and len(set(lines)) == 2, err
+
+
+def test_a_flood_of_distinct_warnings_is_cut_short(capsys):
+    # an optimization fitting model glasses outside their range warns with a new nd/vd (a new
+    # text) at every evaluation: the command line shows ten of a kind, then says it stops
+    import orthoscope.cli as cli
+    from raytrace.materials import OutOfRangeWarning
+
+    cli._PRINTED.clear()
+    cli._PER_CATEGORY.clear()
+    for k in range(15):
+        cli._one_line_warning(f"model glass 1.5/{50 + k} ...", OutOfRangeWarning, "f.py", 1)
+        cli._one_line_warning(f"model glass 1.5/{50 + k} ...", OutOfRangeWarning, "f.py", 1)
+    cli._one_line_warning("another kind", UserWarning, "f.py", 1)
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 12
+    assert lines[9] == "orthoscope: warning: model glass 1.5/59 ..."
+    assert lines[10] == (
+        "orthoscope: warning: more warnings like these (OutOfRangeWarning) are not shown"
+    )
+    assert lines[11] == "orthoscope: warning: another kind"

@@ -284,6 +284,7 @@ def _run(argv: Sequence[str] | None) -> int:
     command = "orthoscope"
     warnings.showwarning = _one_line_warning
     _PRINTED.clear()
+    _PER_CATEGORY.clear()
     _ascii_safe_streams()
     # the command line only writes figures to files (no window): a broken MPLBACKEND must not
     # stop it
@@ -395,14 +396,26 @@ def _bad_environment() -> str | None:
 #: the warnings printed in this run (a warning raised again, e.g. for each evaluation of the
 #: lens at an extrapolated wavelength, is printed once)
 _PRINTED: set[str] = set()
+#: distinct texts printed per warning category; past :data:`WARNINGS_PER_CATEGORY` one line says
+#: the rest are not shown (an optimization that fits model glasses outside their range makes a
+#: new nd/vd, so a new text, at every evaluation)
+_PER_CATEGORY: dict[str, int] = {}
+WARNINGS_PER_CATEGORY = 10
 
 
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Warnings on the command line: one line, no source path, each text once per run."""
+    """Warnings on the command line: one line, no source path, each text once per run, at most
+    :data:`WARNINGS_PER_CATEGORY` texts of one category."""
     text = str(message)
     if text in _PRINTED:
         return
     _PRINTED.add(text)
+    kind = getattr(category, "__name__", str(category))
+    seen = _PER_CATEGORY[kind] = _PER_CATEGORY.get(kind, 0) + 1
+    if seen > WARNINGS_PER_CATEGORY + 1:
+        return
+    if seen == WARNINGS_PER_CATEGORY + 1:
+        text = f"more warnings like these ({kind}) are not shown"
     print(f"orthoscope: warning: {text}", file=sys.stderr)
 
 
