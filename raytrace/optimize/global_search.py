@@ -461,7 +461,15 @@ _WORKER: dict = {}
 
 
 def _init_worker(event, q) -> None:
+    import warnings
+
+    from ..materials import OutOfRangeWarning
+
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides when to stop
+    # a glass evaluated outside its range warns in the parent, once, when the best design is
+    # evaluated there; in the workers it would warn at every evaluation of every start (a new
+    # text for each fitted model glass), in raw multi-line form on the parent's stderr
+    warnings.simplefilter("ignore", OutOfRangeWarning)
     _WORKER["event"], _WORKER["queue"] = event, q
 
 
