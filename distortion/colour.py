@@ -313,26 +313,22 @@ def focal_shift(
 def _check_rings(rings) -> int:
     """``rings`` as an int: TraceError unless it is an integer >= 1 whose hexapolar grid
     (1 + 3 k (k + 1) rays) stays within :data:`raytrace.limits.MAX_SAMPLES`."""
-    import operator
-
     from raytrace.limits import MAX_SAMPLES
+    from raytrace.trace.pupil import pupil_count
+    from raytrace.units import is_whole
 
-    try:
-        if isinstance(rings, bool):
-            raise TypeError
-        k = operator.index(rings)
-    except TypeError:
-        raise TraceError(
-            f"rings must be a whole number of pupil rings (>= 1), got {rings!r}"
-        ) from None
+    if not is_whole(rings):
+        raise TraceError(f"rings must be a whole number of pupil rings (>= 1), got {rings!r}")
+    k = int(rings)
     if k < 1:
         raise TraceError(
             f"rings={k}: the best-focus pupil grid needs at least 1 ring (6 rays around the axis)"
         )
-    if 1 + 3 * k * (k + 1) > MAX_SAMPLES:
+    n = pupil_count("hexapolar", k)
+    if n > MAX_SAMPLES:
         raise TraceError(
-            f"rings={k} makes {1 + 3 * k * (k + 1)} rays per wavelength, more than "
-            f"{MAX_SAMPLES}; a few rings (the default 8) are enough for the RMS focus"
+            f"rings={k} makes {n} rays per wavelength, more than {MAX_SAMPLES}; a few rings (the "
+            "default 8) are enough for the RMS focus"
         )
     return k
 
@@ -340,15 +336,10 @@ def _check_rings(rings) -> int:
 def _pupil_rays(par, rings: int) -> tuple[np.ndarray, ...]:
     """Rays from the axial object point over a hexapolar grid of the paraxial entrance pupil
     (reference wavelength): origins and directions, (n,) arrays each."""
-    r = [0.0]
-    t = [0.0]
-    for k in range(1, rings + 1):
-        for j in range(6 * k):
-            r.append(k / rings)
-            t.append(2.0 * math.pi * j / (6 * k))
-    rho = np.array(r) * 0.5 * par.epd
-    th = np.array(t)
-    px, py = rho * np.cos(th), rho * np.sin(th)
+    from raytrace.trace.pupil import pupil_points
+
+    u, v = pupil_points("hexapolar", rings)
+    px, py = u * (0.5 * par.epd), v * (0.5 * par.epd)
     n = px.size
     if par.infinite:
         z0 = min(par.z_E0, 0.0) - 1.0

@@ -463,7 +463,7 @@ def check_search(nd, vd, n, max_price) -> tuple[float, float, int, float]:
     """The arguments of :func:`search_glass` as (float, float, int, float), or a
     :class:`GlassSearchError` naming the one that cannot be (with the likely slip when nd
     looks like an Abbe number)."""
-    import operator
+    from ..units import is_whole
 
     try:
         nd, vd, max_price = float(nd), float(vd), float(max_price)
@@ -487,12 +487,9 @@ def check_search(nd, vd, n, max_price) -> tuple[float, float, int, float]:
         raise GlassSearchError(
             f"max_price {max_price:g}: a positive relative price (N-BK7 = 1), or inf for no limit"
         )
-    try:
-        if isinstance(n, bool):
-            raise TypeError
-        count = operator.index(n)
-    except TypeError:
-        raise GlassSearchError(f"n must be a whole number of glasses (>= 1), got {n!r}") from None
+    if not is_whole(n):
+        raise GlassSearchError(f"n must be a whole number of glasses (>= 1), got {n!r}")
+    count = int(n)
     if count < 1:
         raise GlassSearchError(f"n = {count}: ask for at least 1 glass")
     return nd, vd, count, max_price
