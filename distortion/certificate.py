@@ -374,18 +374,23 @@ def _traceable_limit(lens, par, clip, azimuth, ok_dense, dense, theta_corner) ->
     return float(f[miss[0] - 1]) if miss.size and miss[0] > 0 else lo
 
 
+def _table_steps(theta_max: float, step: float) -> tuple[int, bool]:
+    """(n, edge): the tabulated fields are step, 2 step, ..., n step, then ``theta_max`` itself
+    when ``edge`` (it lies more than 5 % of a step beyond n step)."""
+    n = int(math.floor(theta_max / step + 1e-9))
+    return n, theta_max - n * step > 0.05 * step
+
+
 def _table_count(theta_max: float, step: float) -> int:
     """The number of tabulated fields of :func:`_table_fields`, without making them."""
-    n = int(math.floor(theta_max / step + 1e-9))
-    return n + (1 if theta_max - n * step > 0.05 * step else 0)
+    n, edge = _table_steps(theta_max, step)
+    return n + int(edge)
 
 
 def _table_fields(theta_max: float, step: float) -> np.ndarray:
-    n = int(math.floor(theta_max / step + 1e-9))
+    n, edge = _table_steps(theta_max, step)
     f = step * np.arange(1, n + 1)
-    if theta_max - (f[-1] if f.size else 0.0) > 0.05 * step:
-        f = np.append(f, theta_max)
-    return f
+    return np.append(f, theta_max) if edge else f
 
 
 def _check_work(theta_max: float, step: float, n_diagonals: int, allow_large: bool) -> None:
