@@ -10,7 +10,7 @@ import numpy as np
 
 from distortion.characteristic import ChromaticDistortion
 from distortion.colour import FocalShift, LateralColour
-from raytrace.trace.results import status_name
+from raytrace.trace.results import field_unit, status_name
 
 from .text import format_columns
 
@@ -40,7 +40,7 @@ def untraced_note(status: np.ndarray, fields: np.ndarray, wavelengths, kind: str
     bad = int(np.count_nonzero(st != 0))
     if not bad:
         return []
-    unit = " mm" if kind == "height" else " deg"
+    unit = " " + field_unit(kind)
     parts = []
     for j, f in enumerate(fields):
         col = st[:, j]
