@@ -995,14 +995,18 @@ def _r(x: float) -> str:
     return repr(float(x))
 
 
+def _agf_name(name: str) -> str:
+    """A catalog glass's name as a .zmx file writes it: OpticStudio's catalogs spell names
+    without spaces (Ohara's S-LAL 8 is S-LAL8 in OHARA.AGF), and a space would end the name."""
+    return name.replace(" ", "")
+
+
 def _glas(m: Material) -> str | None:
     if m.is_air:
         return None
     if m.kind == "catalog":
-        # OpticStudio stores the catalog's nd/vd after a catalog name; readers ignore them. Its
-        # catalogs spell names without spaces (Ohara's S-LAL 8 is S-LAL8 in OHARA.AGF), and a
-        # space would end the name
-        return f"GLAS {m.name.replace(' ', '')} 0 0 {_r(m.nd)} {_r(m.vd)} 0 0 0 0 0 0"
+        # OpticStudio stores the catalog's nd/vd after a catalog name; readers ignore them
+        return f"GLAS {_agf_name(m.name)} 0 0 {_r(m.nd)} {_r(m.vd)} 0 0 0 0 0 0"
     vd = 0.0 if m.kind == "index" else m.vd
     return f"GLAS ___BLANK 1 0 {_r(m.nd)} {_r(vd)} 0 0 0 0 0 0"
 
@@ -1034,7 +1038,7 @@ def _gcat(lens: Lens) -> list[str]:
     # after[c][d]: the glass of catalog c whose name d also has, so c must come before d
     after: dict[str, dict[str, str]] = {c: {} for c in cats}
     for name, cat in glasses:
-        written = name.replace(" ", "")  # as _glas writes it
+        written = _agf_name(name)
         own = find_glass(written, [cat])
         if not own or (own[0].catalog, own[0].name) != (cat, name):
             other = f"as {own[0].name}" if own else "as no glass of it"
