@@ -12,9 +12,10 @@ to ≤ 1e-9 mm.
   by surface ("decenter and return"); optiland gets the same decenters and tilts through its
   coordinate systems, ray-optics through ``DecenterData("dec and return", ...)``.
 
-The comparisons run when the referee imports (ray-optics is not a declared extra: install it with
-``pip install --no-deps rayoptics==0.9.8`` plus its small dependencies; optiland is in the
-``bench`` extra). The harness is benchmarks/referees.py (also a script).
+The comparisons run when the referee imports; the README's test line installs both (optiland
+through the ``bench`` extra; ray-optics with ``pip install --no-deps rayoptics==0.9.8
+opticalglass==1.1.1`` after the ``referees`` extra, which holds their dependencies without the Qt
+GUI they declare). The harness is benchmarks/referees.py (also a script).
 """
 
 from __future__ import annotations

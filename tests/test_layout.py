@@ -97,6 +97,18 @@ def test_every_package_is_installed():
     assert found - listed == set(), f"packages missing from pyproject.toml: {found - listed}"
 
 
+def test_readme_test_line_installs_every_extra():
+    """CI runs the README's second set-up line (.ci/run); every optional extra has tests, so the
+    line installs them all, and the referees whose Qt GUI no extra may carry."""
+    cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    line = text.split("```sh\n", 1)[1].splitlines()[1]
+    named = set(re.search(r"pip install -e '\.\[([^\]]*)\]'", line).group(1).split(","))
+    assert named == set(cfg["project"]["optional-dependencies"])
+    assert "pip install --no-deps rayoptics==0.9.8 opticalglass==1.1.1" in line
+    assert "pytest" in line
+
+
 def test_quick_start_api_runs_and_documents_units():
     import numpy as np
 
