@@ -449,7 +449,7 @@ def grid_from_fields(
     """:func:`distortion_grid` for fields already resolved: ``fields_x``, ``fields_y`` (same
     shape, any set of points: degrees or mm) of ``field_kind`` "angle" | "height", for the
     object and wavelength of ``par``."""
-    from raytrace.paraxial import image_planes, orthoscopy_abscissa, pestrecov_constants, plane_z
+    from raytrace.paraxial import image_planes, orthoscopy_abscissa, orthoscopy_constants, plane_z
     from raytrace.trace.chief2d import aim_2d
 
     if reference_point not in REFERENCE_POINTS:
@@ -465,7 +465,7 @@ def grid_from_fields(
     )
     z = plane_z(par, planes)
     sp = np.asarray(par.s_prime_of(z), dtype=float)
-    K0 = np.array([pestrecov_constants(par, float(v)).scale for v in sp])
+    K0 = orthoscopy_constants(par, sp)
     cc = K0 if infinite else K0 * par.p0
     X = orthoscopy_abscissa(par, FX, field_kind)
     Y = orthoscopy_abscissa(par, FY, field_kind)

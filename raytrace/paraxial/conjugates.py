@@ -144,7 +144,13 @@ def plane_z(par: ParaxialResult, planes: list[ImagePlane]) -> np.ndarray:
     """Absolute z of ``planes``; refuses a plane on or before the last vertex (along the light:
     after an odd number of mirrors the image space runs toward −z, ``n_image < 0``; every
     distance stays signed along +z, as the thicknesses of Zemax and CODE V)."""
-    z = np.array([p.z(par) for p in planes], dtype=float)
+    kinds = {p.kind for p in planes}
+    if len(kinds) == 1 and kinds <= {"s_prime", "from_last_vertex", "defocus"}:
+        # distances from one origin (a sweep of planes): z = origin + distance, in one numpy pass
+        origin = ImagePlane(planes[0].kind).z(par)
+        z = origin + np.array([p.value for p in planes], dtype=float)
+    else:
+        z = np.array([p.z(par) for p in planes], dtype=float)
     if not np.all(np.isfinite(z)):
         raise TraceError("the Gaussian image is at infinity; give the image plane explicitly")
     direction = -1.0 if par.n_image < 0.0 else 1.0

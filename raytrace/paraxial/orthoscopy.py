@@ -78,7 +78,9 @@ def exit_pupil_to_gaussian_image(
     raise ValueError("give m0 and p0 (finite conjugates) or f (object at infinity)")
 
 
-def orthoscopy_constant_finite(p0p: float, m_e: float, p0: float) -> float:
+def orthoscopy_constant_finite(
+    p0p: float | np.ndarray, m_e: float, p0: float
+) -> float | np.ndarray:
     """Constant of orthoscopy in ANY image plane, finite conjugates, Eq. (8):
     ``M0 = p0' / (m_e p0)``."""
     if p0 == 0.0 or m_e == 0.0:
@@ -86,7 +88,7 @@ def orthoscopy_constant_finite(p0p: float, m_e: float, p0: float) -> float:
     return p0p / (m_e * p0)
 
 
-def orthoscopy_constant_infinite(p0p: float, m_e: float) -> float:
+def orthoscopy_constant_infinite(p0p: float | np.ndarray, m_e: float) -> float | np.ndarray:
     """Constant of orthoscopy in ANY image plane, object at infinity, Eq. (8):
     ``F0 = p0' / m_e``."""
     if m_e == 0.0:
@@ -216,19 +218,22 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float) -> PestrecovConstan
         ``scale`` = M0 (finite conjugates, dimensionless, signed) or F0 (object at infinity, mm)
         and ``infinite``.
     """
-    p0p = float(s_prime) - par.HpE0p
+    sp = float(s_prime)
+    return PestrecovConstants(sp, par.p0, sp - par.HpE0p, float(_scale(par, sp)), par.infinite)
+
+
+def _scale(par: ParaxialResult, s_prime):
+    """K0 of Eq. (8) in the plane(s) ``s_prime`` (mm from H'; a float or an array, elementwise):
+    the one implementation behind :func:`pestrecov_constants` and :func:`orthoscopy_constants`,
+    with the image-telecentric limit of :func:`pestrecov_constants`."""
+    p0p = s_prime - par.HpE0p
     if math.isinf(par.m_e) and math.isfinite(par.chief_height_last):
-        z = float(s_prime) + par.z_Hp
+        z = s_prime + par.z_Hp
         h = par.chief_height_last + (z - par.z_last) * par.chief_slope_image
-        scale = h if par.infinite else h / par.p0
-        return PestrecovConstants(float(s_prime), par.p0, p0p, scale, par.infinite)
+        return h if par.infinite else h / par.p0
     if par.infinite:
-        return PestrecovConstants(
-            float(s_prime), par.p0, p0p, orthoscopy_constant_infinite(p0p, par.m_e), True
-        )
-    return PestrecovConstants(
-        float(s_prime), par.p0, p0p, orthoscopy_constant_finite(p0p, par.m_e, par.p0), False
-    )
+        return orthoscopy_constant_infinite(p0p, par.m_e)
+    return orthoscopy_constant_finite(p0p, par.m_e, par.p0)
 
 
 def orthoscopy_abscissa(par: ParaxialResult, fields, field_kind: str) -> np.ndarray:
@@ -255,7 +260,7 @@ def orthoscopy_constants(par: ParaxialResult, s_prime) -> np.ndarray:
     a finite one; :attr:`PestrecovConstants.scale`) in each plane at ``s_prime`` (mm from H'):
     (planes,), the planes flattened."""
     sp = np.asarray(s_prime, dtype=float)
-    return np.array([pestrecov_constants(par, float(v)).scale for v in sp.ravel()])
+    return np.asarray(_scale(par, sp.ravel()), dtype=float)
 
 
 def ideal_heights(par: ParaxialResult, x, s_prime) -> np.ndarray:
