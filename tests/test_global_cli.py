@@ -204,3 +204,57 @@ def test_progress_plain_lines_without_tqdm(monkeypatch):
     p = GlobalProgress(2, False, stream=stream)
     p(_event("start", 1, 3.5))
     assert "start 1 done" in stream.getvalue() and "best 3.5" in stream.getvalue()
+
+
+def test_progress_says_a_start_cut_short_is_not_done(monkeypatch):
+    # a start that Ctrl-C or the time budget ended: its best merit by then, not "done"
+    monkeypatch.setitem(sys.modules, "tqdm", None)
+    stream = io.StringIO()
+    p = GlobalProgress(8, False, stream=stream)
+    p(SearchProgress("start", 2, 0, 6.59, 6.2, 3, 8, 4.0, "interrupted"))
+    p(SearchProgress("start", 5, 0, 7.1, 6.2, 4, 8, 5.0, "time"))
+    lines = stream.getvalue().splitlines()
+    assert lines[0].startswith("start 2 cut short (interrupted; 3/8 ended): merit 6.59, best 6.2")
+    assert lines[1].startswith("start 5 cut short (time budget spent; 4/8 ended): merit 7.1")
+    assert not any("done" in x for x in lines)
+
+
+def test_interrupted_global_counts_the_starts_cut_short(
+    refocus: Path, tmp_path: Path, monkeypatch, capsys
+):
+    # Ctrl-C (in this process: one worker) during start 1's first local run: start 0 finished,
+    # start 1 is cut short with its best so far; the log and the notes tell them apart
+    out = tmp_path / "out.toml"
+    real, hit = GlobalProgress.__call__, []
+
+    def call(self, ev):
+        real(self, ev)
+        if ev.event == "local" and ev.start == 1 and not hit:
+            hit.append(ev)
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(GlobalProgress, "__call__", call)
+    argv = ["optimize", str(refocus), "-o", str(out), "--global", "--seed", "9", "--starts", "3"]
+    assert main([*argv, "--json"]) == 130  # --json: no progress lines (the text run below)
+    cap = capsys.readouterr()
+    d = json.loads(cap.out)
+    assert d["stopped"] == "interrupted" and d["starts_done"] == 2 and d["starts_stopped"] == 1
+    assert "1/3 starts finished and 1 cut short" in d["message"]
+    notes = read_lens(out).notes
+    assert "best of 1/3 starts finished and 1 cut short (start " in notes
+    assert "Search stopped early (interrupted)" in notes
+    hit.clear()
+    out.unlink()
+    assert main(argv) == 130
+    err = capsys.readouterr().err.splitlines()
+    assert "start 0 done (1/3)" in err[0]
+    assert err[1].startswith("start 1 cut short (interrupted; 2/3 ended): merit ")
+    assert err[-1] == "orthoscope optimize: interrupted; the best design found was kept"
+
+
+def test_help_says_method_works_with_global(capsys):
+    assert main(["optimize", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    method = text.split("--method {least_squares,minimax} ")[1].split("--max-evaluations N")[0]
+    assert "not with --global" not in method  # --global --method minimax runs minimax locally
+    assert "with --global, the method of every local run" in method

@@ -326,6 +326,28 @@ def test_ctrl_c_keeps_the_best_design():
     assert merit(evaluate(res.lens, spec.operands)) == pytest.approx(res.merit, rel=1e-12)
 
 
+def test_starts_cut_short_are_counted_apart():
+    # Ctrl-C (here: from the progress callback) in start 1's first local run: start 0 finished,
+    # start 1 ends with its best so far; the result and the start event say it was cut short
+    seen = []
+
+    def progress(ev):
+        seen.append(ev)
+        if ev.event == "local" and ev.start == 1:
+            raise KeyboardInterrupt
+
+    res = global_optimize(singlet(), SINGLET_SPEC, seed=11, progress=progress)
+    assert res.stopped == "interrupted"
+    assert res.starts_done == 2 and res.starts_stopped == 1 and res.starts_finished == 1
+    assert "from start " in res.message and "of 1/4 starts finished and 1 cut short" in res.message
+    ends = [(ev.start, ev.stopped) for ev in seen if ev.event == "start"]
+    assert ends == [(0, ""), (1, "interrupted")]
+    # a run that is not stopped counts its starts as before
+    whole = global_optimize(singlet(), replace(SINGLET_SPEC, search=replace(
+        SINGLET_SPEC.search, starts=2)), seed=11)  # fmt: skip
+    assert whole.starts_stopped == 0 and "of 2/2 starts (seed 11)" in whole.message
+
+
 @pytest.mark.parametrize("where", [["--workers", "2"], ["--dask", "local:2"]], ids=["pool", "dask"])
 def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path, where):
     # A real Ctrl-C: SIGINT to the whole process group (parent and workers), as a terminal does.
@@ -487,3 +509,20 @@ def test_a_worker_does_not_print_range_warnings():
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert r.stdout.strip() == "ok"
     assert r.stderr.count("OutOfRangeWarning") == 1 and "1.6/40" in r.stderr
+
+
+def test_a_worker_does_not_print_kernel_cache_warnings():
+    # no writable kernel cache: the parent says so in one line; each worker repeated it in raw
+    # two-line form (run in a child process: the initializer ignores SIGINT)
+    code = (
+        "import warnings\n"
+        "from raytrace.kernels.jit import KernelCacheWarning\n"
+        "from raytrace.optimize.global_search import _init_worker\n"
+        "warnings.warn('no cache (before)', KernelCacheWarning)\n"
+        "_init_worker(None, None)\n"
+        "warnings.warn('no cache (in a worker)', KernelCacheWarning)\n"
+        "print('ok')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.strip() == "ok"
+    assert r.stderr.count("KernelCacheWarning") == 1 and "(before)" in r.stderr

@@ -244,3 +244,22 @@ def test_a_misspelt_key_is_one_problem_not_two(tmp_path):
     assert lines[0].endswith("2 problems:")
     assert "variables[2]: unknown key 'sufrace' (did you mean 'surface'?)" in lines[1]
     assert "unknown key 'feild' for operand distortion (did you mean 'field'?)" in lines[2]
+
+
+def test_cli_a_missing_spec_path_names_the_bundled_spec_of_that_name(tmp_path, monkeypatch, capsys):
+    # the docs' path lenses/specs/twinplex-like-55-525.toml, typed outside the repository
+    from orthoscope.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    spec = "lenses/specs/twinplex-like-55-525.toml"
+    assert main(["optimize", spec, "-o", "out.toml"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line == (
+        f"orthoscope optimize: error: {spec}: no such spec file; the bundled spec of that name "
+        "is `orthoscope optimize twinplex-like-55-525`"
+    )
+    # a name no bundled spec has: the plain error
+    assert main(["optimize", "lenses/specs/no-such-design.toml", "-o", "out.toml"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.endswith("no-such-design.toml: no such spec file")
+    assert not (tmp_path / "out.toml").exists()

@@ -63,8 +63,8 @@ class _Progress:
 
 class GlobalProgress:
     """Progress of the global search on stderr: a tqdm bar over the starts on a terminal when
-    tqdm is installed, plain lines otherwise (one per finished start, and the best merit every
-    ``every`` seconds while a start runs)."""
+    tqdm is installed, plain lines otherwise (one per ended start: "done", or "cut short" by a
+    stop, and the best merit every ``every`` seconds while a start runs)."""
 
     def __init__(self, starts: int, quiet: bool, *, stream=None, every: float = 10.0) -> None:
         self.stream = stream or sys.stderr
@@ -91,7 +91,13 @@ class GlobalProgress:
             self.bar.set_postfix_str(f"best merit {ev.best:.6g}", refresh=True)
             return
         now = time.monotonic()
-        if ev.event == "start":
+        if ev.event == "start" and ev.stopped:  # its merit: its best design by then
+            line = (
+                f"start {ev.start} cut short ({STOP_WORDS.get(ev.stopped, ev.stopped)}; "
+                f"{ev.starts_done}/{ev.starts} ended): merit {ev.merit:.6g}, best {ev.best:.6g}, "
+                f"{ev.elapsed_s:.1f} s"
+            )
+        elif ev.event == "start":
             line = (
                 f"start {ev.start} done ({ev.starts_done}/{ev.starts}): merit {ev.merit:.6g}, "
                 f"best {ev.best:.6g}, {ev.elapsed_s:.1f} s"
@@ -124,23 +130,35 @@ OUTPUTS = [("-o", ".toml")]
 
 #: how the CLI names the merit of each method (OptimizationResult.merit)
 MERIT_NAMES = {"least_squares": "merit", "minimax": "max weighted residual"}
+#: why a run or a start was cut short (``stopped``), in words
+STOP_WORDS = {"interrupted": "interrupted", "time": "time budget spent"}
 
 
 def provenance_notes(lens, spec, res, start_name: str) -> str:
-    """Notes of a designed lens: provenance line first (see raytrace.files.native)."""
+    """Notes of a designed lens: provenance line first (see raytrace.files.native); a run cut
+    short (``res.stopped``, Ctrl-C) says so, as the global search's notes do."""
     date = _dt.date.today().isoformat()
     how = " --method minimax" if res.method == "minimax" else ""
-    return (
+    text = (
         "provenance: derived\n"
         f"Designed with 'orthoscope optimize {Path(spec.path).name}{how}' from the start lens "
         f"{start_name}; {MERIT_NAMES[res.method]} {res.merit:.9g} (start "
         f"{res.merit_start:.9g}) after {res.evaluations} evaluations; {date}."
     )
+    if res.stopped:
+        text += (
+            f" Run stopped early ({res.stopped}) before converging: the best design evaluated "
+            "by then."
+        )
+    return text
 
 
 def global_provenance_notes(spec, res, start_name: str, dask: str | None = None) -> str:
     """Notes of a lens designed by the global search: provenance line first, then how to
-    reproduce it (seed, starts) and what it found (``dask``: the --dask cluster it ran on)."""
+    reproduce it (seed, starts) and what it found (``dask``: the --dask cluster it ran on); the
+    starts cut short by a stop are counted apart from those that finished."""
+    from raytrace.optimize.global_search import starts_count
+
     date = _dt.date.today().isoformat()
     glasses = "; ".join(f"S{g.surface} {g.name} ({g.catalog})" for g in res.glasses)
     text = (
@@ -150,7 +168,7 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
         f"({spec.search.hops} hops per start, local method "
         f"{res.method}) from the start lens {start_name}; {res.merit_is} "
         f"{res.merit:.9g} (start {res.merit_start:.9g}), best of "
-        f"{res.starts_done}/{res.starts} starts ("
+        f"{starts_count(res.starts_finished, res.starts_stopped, res.starts)} ("
         + (f"start {res.best_start}" if res.best_start >= 0 else "the start lens, kept")
         + f"), {res.evaluations} evaluations, {res.seconds:.0f} s with {res.workers} worker(s)"
         + (f" on Dask ({dask})" if dask else "")
@@ -221,9 +239,27 @@ def _search_overrides(args) -> dict:
     return over
 
 
+def _read_spec(text: str):
+    """The spec SPEC.toml; a path that does not exist but names a bundled spec says how to run
+    that one (a spec path copied from the docs, run outside the repository)."""
+    from raytrace.files.library import bundled_file
+    from raytrace.optimize import SpecError, read_spec
+
+    try:
+        return read_spec(text)
+    except SpecError as e:
+        p = Path(text)
+        b = None if p.exists() or p.suffix.lower() != ".toml" else bundled_file("specs", p.stem)
+        if b is None:
+            raise
+        raise SpecError(
+            f"{e}; the bundled spec of that name is `orthoscope optimize {b.stem}`"
+        ) from None
+
+
 def cmd_optimize(args) -> int:
     from raytrace.files.output import check_output
-    from raytrace.optimize import read_spec, start_lens
+    from raytrace.optimize import start_lens
 
     if not args.global_search:
         refuse_flags(
@@ -241,7 +277,7 @@ def cmd_optimize(args) -> int:
     if args.dask is not None and args.workers is not None:
         raise CliError("--workers is for local processes; with --dask the cluster has its own")
     check_dask(args.dask)
-    spec = read_spec(args.spec)
+    spec = _read_spec(args.spec)
     if args.method is not None:
         spec = replace(spec, method=args.method)
     if args.max_evaluations is not None:
@@ -284,7 +320,8 @@ def _run_split_scan(args, spec, lens, out, inputs) -> int:
             what = f"merit {t.merit:.6g}" if t.result is not None else f"no run: {t.error}"
             print(f"--split {t.surface}: {what}", file=sys.stderr, flush=True)
 
-    trials = scan_splits(lens, spec, progress=said)
+    trials = scan_splits(lens, spec, progress=said)  # a Ctrl-C ends it with the trials so far
+    stopped = next((t.result.stopped for t in trials if t.result and t.result.stopped), "")
     done = [t for t in trials if t.result is not None]
     if not done:
         raise CliError(
@@ -297,13 +334,15 @@ def _run_split_scan(args, spec, lens, out, inputs) -> int:
         f"{t.surface}: {t.merit:.4g}" if t.result is not None else f"{t.surface}: no run"
         for t in trials
     )
+    if stopped:
+        tried += f"; {STOP_WORDS.get(stopped, stopped)} at element {trials[-1].surface}"
     lens, spec = split_design(lens, spec, best.surface)
     spec = replace(
         spec,
         start=f"{spec.start} edited by --split {best.surface} (best of --split auto, merits "
         f"by element {tried})",
     )
-    return _run_local(args, spec, lens, out, inputs, res=best.result)
+    return _run_local(args, spec, lens, out, inputs, res=best.result, stopped=stopped)
 
 
 def _edit_elements(args, lens, spec):
@@ -367,16 +406,20 @@ def _glass_material(text: str):
     return lookup_glass(text).material
 
 
-def _write_design(args, res, spec, out, inputs, notes, source: str) -> bool:
-    """Write the optimized lens ``res.lens`` to ``out`` when it converged (or with
-    ``--write-anyway``, its notes then marked NOT CONVERGED); ``notes()`` gives its provenance
-    notes and ``source`` its origin. Returns whether it was written."""
+def _write_design(
+    args, res, spec, out, inputs, notes, source: str, *, stopped: str = "", said: bool = False
+) -> bool:
+    """Write the optimized lens ``res.lens`` to ``out`` when it converged, or was interrupted
+    (``stopped``: the best design found is kept), or with ``--write-anyway``; one that did not
+    converge has its notes marked NOT CONVERGED unless they say so already (``said``: a local
+    run cut short). ``notes()`` gives its provenance notes and ``source`` its origin. Returns
+    whether it was written."""
     from raytrace.files.native import write_lens
 
-    written = res.converged or args.write_anyway
+    written = res.converged or args.write_anyway or stopped == "interrupted"
     if written:
         designed = replace(res.lens, name=spec.name or res.lens.name, notes=notes(), source=source)
-        if not res.converged:
+        if not (res.converged or said):
             designed = replace(designed, notes=designed.notes + " NOT CONVERGED: " + res.message)
         write_lens(designed, out, inputs=inputs, overwrite=args.force, flag="--force")
     return written
@@ -402,23 +445,35 @@ def _result_json(spec, res, out, written, table, before=None, after=None) -> dic
     }
 
 
-def _run_local(args, spec, lens, out, inputs, res=None) -> int:
-    """A local run (or its result ``res``, already computed) reported and written."""
+def _run_local(args, spec, lens, out, inputs, res=None, stopped: str = "") -> int:
+    """A local run (or its result ``res``, already computed; ``stopped``: why the work that
+    gave it was cut short) reported and written. Ctrl-C during the run ends it with the best
+    design evaluated so far, written and marked as interrupted (exit status 130), as --global
+    does; a Ctrl-C before the start lens is evaluated keeps nothing."""
     from raytrace.optimize import optimize
 
     name = MERIT_NAMES[spec.method]
     if res is None:
         prog = _Progress(args.quiet or args.json, "max|r|" if spec.method == "minimax" else "merit")
-        res = optimize(lens, spec, progress=prog)
-        prog.done()
+        try:
+            res = optimize(lens, spec, progress=prog)
+        finally:
+            prog.done()
+    stopped = res.stopped or stopped
     table = _operand_table(res.operands)
     written = _write_design(
         args, res, spec, out, inputs,
         lambda: provenance_notes(lens, spec, res, spec.start),
         f"derived by orthoscope optimize from {spec.start} with {Path(spec.path).name}",
+        stopped=stopped, said=bool(res.stopped),
     )  # fmt: skip
     if args.json:
-        extra = {"method": res.method, "merit_is": name, "violation": res.violation}
+        extra = {
+            "method": res.method,
+            "merit_is": name,
+            "violation": res.violation,
+            "stopped": stopped or None,
+        }
         print_json(_result_json(spec, res, out, written, table, after=extra))
     else:
         print(f"{spec.name}: {res.message}")
@@ -440,6 +495,9 @@ def _run_local(args, spec, lens, out, inputs, res=None) -> int:
             else "NOT CONVERGED: no lens written (--write-anyway "
             "writes it, marked as not converged)"
         )
+    if stopped == "interrupted":
+        print("orthoscope optimize: interrupted; the best design found was kept", file=sys.stderr)
+        return EXIT_INTERRUPTED
     return 0 if res.converged else EXIT_NOT_CONVERGED
 
 
@@ -457,6 +515,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         args, res, spec, out, inputs,
         lambda: global_provenance_notes(spec, res, spec.start, args.dask),
         f"derived by orthoscope optimize --global from {spec.start} with {Path(spec.path).name}",
+        stopped=res.stopped,
     )  # fmt: skip
     if args.glass_map is not None:
         from raytrace.optimize import glass_pool
@@ -479,6 +538,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
             "seed": res.seed,
             "starts": res.starts,
             "starts_done": res.starts_done,
+            "starts_stopped": res.starts_stopped,
             "best_start": res.best_start,
             "start_merits": [None if m != m else float(m) for m in res.start_merits],
             "workers": res.workers,
@@ -561,11 +621,13 @@ def register(sub: argparse._SubParsersAction) -> None:
             "the local method (damped least squares or minimax), glass substitution, in "
             "parallel worker processes; seeded "
             "and deterministic (the same seed gives the same lens whatever --workers); a "
-            "progress bar on a terminal (tqdm) or plain lines; --time or Ctrl-C stops it and "
-            "keeps the best design found (Ctrl-C: exit status 130). The lens is written with its "
+            "progress bar on a terminal (tqdm) or plain lines; --time stops it and keeps the "
+            "best design found. The lens is written with its "
             "provenance (start lens, spec, seed, merit, date) when the run converged / met the "
             "spec's merit_goal (exit status 0); otherwise the exit status is 1 and nothing is "
-            "written (--write-anyway writes it, marked)."
+            "written (--write-anyway writes it, marked). Ctrl-C stops a run, local or --global, "
+            "and writes the best design evaluated so far, its notes marked as interrupted "
+            "(exit status 130; nothing is written when no design was evaluated yet)."
         ),
         epilog="Examples: orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
         "-o my-twinplex.toml;  orthoscope optimize lenses/specs/twinplex-like-55-525.toml "
@@ -584,7 +646,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         choices=("least_squares", "minimax"),
         help="Override the spec's method: damped least squares (merit: sum of squared weighted "
         "residuals) or minimax (merit: the largest |weighted residual| of the target operands, "
-        "the operands with min / max as constraints; not with --global).",
+        "the operands with min / max as constraints); with --global, the method of every local "
+        "run.",
     )
     q.add_argument(
         "--max-evaluations",

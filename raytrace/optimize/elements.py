@@ -265,7 +265,8 @@ def scan_splits(
     tuple of SplitTrial
         One per element (:func:`raytrace.elements.elements`), in surface order; the best is
         ``min(trials, key=lambda t: t.merit)``. The runs are deterministic: the same lens and
-        spec give the same trials.
+        spec give the same trials. A run interrupted by Ctrl-C (its result's ``stopped`` is
+        ``"interrupted"``: the best design it evaluated) ends the scan: that trial is the last.
     """
     check_spec(lens, spec, need_continuous=False)
     out = []
@@ -278,4 +279,6 @@ def scan_splits(
         out.append(t)
         if progress is not None:
             progress(t)
+        if t.result is not None and t.result.stopped:  # Ctrl-C: no more elements
+            break
     return tuple(out)

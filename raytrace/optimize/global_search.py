@@ -32,7 +32,8 @@ number) is polished with the spec's ``max_evaluations``.
 
 Stopping: a time budget (``time_budget_s``) or Ctrl-C (KeyboardInterrupt in the calling process)
 stops every start at its next merit evaluation; the result is the best design found so far, with
-``stopped`` saying why. Workers ignore SIGINT themselves; the caller's process tells them.
+``stopped`` saying why: the starts cut short compete with their best design by then, and
+``starts_stopped`` counts them. Workers ignore SIGINT themselves; the caller's process tells them.
 """
 
 from __future__ import annotations
@@ -102,8 +103,10 @@ class SearchProgress:
     event: ``"local"`` (a local run of a start ended), ``"start"`` (a start ended) or
     ``"polish"`` (the final polish ended); start: the start's number; hop: the basin hop (-1 for
     the start's first local runs); merit: that start's best merit so far; best: the best merit
-    reported so far in the whole search; starts_done / starts: finished / requested starts;
-    elapsed_s: seconds since the search began.
+    reported so far in the whole search; starts_done / starts: ended (finished or cut short) /
+    requested starts; elapsed_s: seconds since the search began; stopped: for a ``"start"``
+    event, ``""`` when the start ran to its end, else why it was cut short (``"time"``,
+    ``"interrupted"``: its merit is then that of its best design by then).
     """
 
     event: str
@@ -114,6 +117,7 @@ class SearchProgress:
     starts_done: int
     starts: int
     elapsed_s: float
+    stopped: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -146,8 +150,10 @@ class GlobalResult:
     bound violations, the max weighted residual when every bound is met); violation: the largest
     weighted bound violation of the design (0 when all are met); merit_start:
     the start lens's merit; start_merits: the best merit of each start (``nan`` for a start that
-    did not run); best_start: the start the design came from (-1: the start lens, when no
-    finished start is better); seed: the root seed; glasses: the glass of each glass variable;
+    did not run); starts_stopped: how many of those starts were cut short by the stop (their
+    merit is that of their best design by then; :attr:`starts_finished` ran to their end);
+    best_start: the start the design came from (-1: the start lens, when no finished start is
+    better); seed: the root seed; glasses: the glass of each glass variable;
     operands: every operand on the best design; evaluations: merit evaluations in all starts and
     the polish; seconds: wall time; workers: processes used (on Dask: the cluster's workers);
     stopped: ``""``, ``"time"`` (budget spent), ``"interrupted"`` or ``"cluster"`` (the Dask
@@ -172,6 +178,7 @@ class GlobalResult:
     message: str
     method: str = "least_squares"
     violation: float = 0.0
+    starts_stopped: int = 0
 
     @property
     def merit_is(self) -> str:
@@ -184,14 +191,29 @@ class GlobalResult:
 
     @property
     def starts_done(self) -> int:
+        """Starts that gave a design: finished, or cut short (:attr:`starts_stopped`)."""
         return int(np.count_nonzero(np.isfinite(self.start_merits)))
+
+    @property
+    def starts_finished(self) -> int:
+        """Starts that ran to their end."""
+        return self.starts_done - self.starts_stopped
 
     def __repr__(self) -> str:
         return (
             f"GlobalResult(merit {self.merit:.6g} from start {self.best_start}, "
-            f"{self.starts_done}/{self.starts} starts, seed {self.seed}, "
+            f"{starts_count(self.starts_finished, self.starts_stopped, self.starts)}, "
+            f"seed {self.seed}, "
             f"{self.seconds:.1f} s{', stopped: ' + self.stopped if self.stopped else ''})"
         )
+
+
+def starts_count(finished: int, stopped: int, starts: int) -> str:
+    """How many starts gave a design: "3/8 starts", or with starts cut short by a stop "3/8
+    starts finished and 1 cut short"."""
+    if not stopped:
+        return f"{finished}/{starts} starts"
+    return f"{finished}/{starts} starts finished and {stopped} cut short"
 
 
 # ----------------------------------------------------------------------------- the design
@@ -463,6 +485,7 @@ _WORKER: dict = {}
 def _init_worker(event, q) -> None:
     import warnings
 
+    from ..kernels.jit import KernelCacheWarning
     from ..materials import OutOfRangeWarning
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides when to stop
@@ -470,6 +493,9 @@ def _init_worker(event, q) -> None:
     # evaluated there; in the workers it would warn at every evaluation of every start (a new
     # text for each fitted model glass), in raw multi-line form on the parent's stderr
     warnings.simplefilter("ignore", OutOfRangeWarning)
+    # no writable kernel cache: the parent has said so in one line; each worker would say it
+    # again, in raw two-line form
+    warnings.simplefilter("ignore", KernelCacheWarning)
     _WORKER["event"], _WORKER["queue"] = event, q
 
 
@@ -556,20 +582,28 @@ def global_optimize(
     stopped = ""
     n_workers, lost = s.workers, ""  # on Dask: the cluster's workers; what ended the cluster
 
-    def emit(kind: str, k: int, hop: int, m: float) -> None:
+    def emit(kind: str, k: int, hop: int, m: float, stopped: str = "") -> None:
         if m < best[0]:
             best[0] = m
         if progress is not None:
             progress(
                 SearchProgress(
-                    kind, k, hop, m, best[0], len(outcomes), s.starts, time.perf_counter() - t0
+                    kind,
+                    k,
+                    hop,
+                    m,
+                    best[0],
+                    len(outcomes),
+                    s.starts,
+                    time.perf_counter() - t0,
+                    stopped,
                 )
             )
 
     def finished(o: StartOutcome) -> None:
         outcomes[o.index] = o
         if math.isfinite(o.merit):  # not a start stopped before its first design
-            emit("start", o.index, o.hops - 1, o.merit)
+            emit("start", o.index, o.hops - 1, o.merit, o.stopped)
 
     try:
         if s.workers == 1 and executor is None:
@@ -645,17 +679,18 @@ def global_optimize(
     # as a minimax run: a design that breaks a bound has not converged
     feasible = spec.method != "minimax" or bounds_met(viol, m)
     converged = feasible and (spec.merit_goal is None or m <= spec.merit_goal)
-    n_done = len(done)
+    n_cut = sum(1 for o in done if o.stopped)  # cut short by the stop, with a design
+    count = starts_count(len(done) - n_cut, n_cut, s.starts)
     if best_k < 0:
+        if not n_cut:
+            count = count.replace(" starts", " starts finished")
         msg = (
-            f"{MERIT_NAMES[spec.method]} {m:.6g}: the start lens, kept ({n_done}/{s.starts} "
-            f"starts finished, none better; seed {s.seed})"
+            f"{MERIT_NAMES[spec.method]} {m:.6g}: the start lens, kept ({count}, none better; "
+            f"seed {s.seed})"
         )
     else:
-        msg = (
-            f"best {MERIT_NAMES[spec.method]} {m:.6g} from start {best_k} of {n_done}/"
-            f"{s.starts} starts (seed {s.seed})"
-        )
+        name = MERIT_NAMES[spec.method]
+        msg = f"best {name} {m:.6g} from start {best_k} of {count} (seed {s.seed})"
     if stopped:
         why = {"time": "time budget spent", "interrupted": "interrupted"}
         msg += f"; stopped: {why.get(stopped, f'the Dask cluster was lost ({lost})')}"
@@ -680,6 +715,7 @@ def global_optimize(
         message=msg,
         method=spec.method,
         violation=viol,
+        starts_stopped=n_cut,
     )
 
 

@@ -27,8 +27,10 @@ Each iteration (after Madsen's and Fletcher's SL1QP-type methods):
 
 The run stops when the LP predicts no decrease (converged), when D falls below
 :data:`MIN_RADIUS` (no further progress: converged at the precision of the differences), at the
-evaluation limit, or when ``stop()`` asks (time budget, Ctrl-C in a caller). Every accepted step
-lowers φ, so the current design is always the best found.
+evaluation limit, or when ``stop()`` asks (time budget, Ctrl-C in a caller) or a KeyboardInterrupt
+(Ctrl-C) arrives once the start is evaluated. Every accepted step lowers φ, so the current design
+is the best of the iterates; a stopped run returns the best design evaluated, by φ (a
+finite-difference probe can be marginally better than the iterate).
 
 P is the spec's ``penalty`` (default 100): it must exceed the Lagrange multipliers of the active
 constraints (how much F would fall per unit of weighted relaxation of a bound) for the
@@ -231,7 +233,9 @@ def minimax(
         (Jacobian evaluations included), as :func:`raytrace.optimize.optimize` calls it.
     stop : callable, optional
         Asked before each evaluation; a non-empty reason ends the run at once with the best
-        design so far (the current iterate) and ``stopped`` set.
+        design evaluated so far (by φ) and ``stopped`` set. A KeyboardInterrupt (Ctrl-C,
+        or raised by ``progress``) once the start lens is evaluated does the same, with
+        ``stopped == "interrupted"``.
     max_evaluations : int, optional
         Overrides ``spec.max_evaluations`` (an iteration costs 2n + 1 or more evaluations).
 
@@ -252,6 +256,11 @@ def minimax(
     n = len(x)
     log = EvaluationLog()
     t0 = time.perf_counter()
+    first: list = []  # (e, g, vals) of the start lens, once it is evaluated
+    # (φ, x, e, g, vals) of the best design evaluated (a Jacobian probe can beat the iterate),
+    # one object so that a Ctrl-C between two statements never mixes two designs: a stop
+    # returns it
+    best: list = [None]
 
     def ev(xv: np.ndarray, start: bool = False):
         try:
@@ -268,6 +277,11 @@ def minimax(
                 bad = next(o for o in vals if not math.isfinite(o.residual))
                 raise SpecError(f"the start lens: operand {bad.operand.label()} is not finite")
             raise _Failed("an operand is not finite")
+        fv = phi(e, g)
+        if best[0] is None or fv < best[0][0]:
+            best[0] = (fv, xv.copy(), e, g, vals)
+        if start:
+            first[:] = (e, g, vals)
         if progress is not None:
             progress(log.n, _max_abs(e), max(vals, key=lambda o: abs(o.residual)))
         return e, g, vals
@@ -275,13 +289,13 @@ def minimax(
     def phi(e, g) -> float:
         return exact_penalty(e, g, P)
 
-    e, g, vals = ev(x, start=True)
-    m0 = _max_abs(e)
-    f = phi(e, g)
     radius = 1.0
     stopped, status, message = "", "", ""
     h = DIFF_STEP * sc
+    vals = None  # the current iterate's operands
     try:
+        e, g, vals = ev(x, start=True)
+        f = phi(e, g)
         while True:
             if log.n + 2 * n + 1 > limit:
                 status, message = "limit", f"stopped at the evaluation limit ({limit})"
@@ -360,7 +374,14 @@ def minimax(
                 break
     except Stopped as err:
         stopped = err.reason
-        message = f"stopped ({err.reason}): the best design so far"
+    except KeyboardInterrupt:  # Ctrl-C: as a stop, once the start is evaluated
+        if not first:
+            raise
+        stopped = "interrupted"
+    if stopped:
+        _, x, e, g, vals = best[0]
+        message = f"stopped ({stopped}): the best design so far"
+    m0 = _max_abs(first[0])
     final = apply(lens, spec, x)
     m = _max_abs(e)
     viol = max_violation(vals)

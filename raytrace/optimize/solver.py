@@ -343,6 +343,9 @@ def optimize(
 
     ``stop()`` is asked before each evaluation; when it returns a reason (a non-empty string)
     the run ends at once and returns the best design evaluated so far with ``stopped`` set.
+    A KeyboardInterrupt (Ctrl-C, or raised by ``progress``) once the start lens is evaluated
+    does the same, with ``stopped == "interrupted"``; one during the start's evaluation
+    propagates (there is no design to return).
     ``max_evaluations`` overrides the spec's limit (a whole number ≥ 1). Least squares counts it
     as scipy's ``max_nfev`` (the evaluations of its steps; the finite-difference Jacobians, n
     evaluations each for n variables, come on top), minimax counts every evaluation
@@ -398,11 +401,11 @@ def optimize(
     lo, hi = bounds(spec)
     x0 = start_values(lens, spec)  # a start value outside its bounds starts on the nearest bound
     sc = variable_scales(lens, spec)
-    start_vals = evaluate(apply(lens, spec, x0), spec.operands, check=False)  # check_spec ran
-    m0 = merit(start_vals)
     log = EvaluationLog()
-    best = [m0, x0.copy()]
-    big = math.sqrt(m0 + 1.0) * 1e3
+    # (merit, x) of the best design evaluated so far, one object so that a Ctrl-C between two
+    # statements never pairs a merit with another design's x; None until the start is evaluated
+    best: list = [None]
+    big = math.inf
     t0 = time.perf_counter()
 
     def fun(xs):
@@ -413,14 +416,18 @@ def optimize(
             return np.full(len(spec.operands), big)
         r = np.array([o.residual for o in vals])
         m = float(r @ r)
-        if m < best[0]:
-            best[0], best[1] = m, xs * sc
+        if m < best[0][0]:
+            best[0] = (m, xs * sc)
         if progress is not None:
             progress(log.n, m, max(vals, key=lambda o: abs(o.residual)))
         return r
 
     stopped = ""
     try:
+        start_vals = evaluate(apply(lens, spec, x0), spec.operands, check=False)  # checked
+        m0 = merit(start_vals)
+        big = math.sqrt(m0 + 1.0) * 1e3
+        best[0] = (m0, x0.copy())
         sol = least_squares(
             fun,
             x0 / sc,
@@ -436,7 +443,12 @@ def optimize(
         x_final, status, message = sol.x * sc, sol.status, sol.message
     except Stopped as e:
         stopped = e.reason
-        x_final, status, message = best[1], -99, f"stopped ({e.reason}): the best design so far"
+        x_final, status, message = best[0][1], -99, f"stopped ({e.reason}): the best design so far"
+    except KeyboardInterrupt:  # Ctrl-C: as a stop, once the start is evaluated
+        if best[0] is None:
+            raise
+        stopped = "interrupted"
+        x_final, status, message = best[0][1], -99, "stopped (interrupted): the best design so far"
     final = apply(lens, spec, x_final)
     vals = evaluate(final, spec.operands, check=False)
     m = merit(vals)
