@@ -397,6 +397,75 @@ def test_ctrl_c_inside_llvm_is_delivered_again_later(monkeypatch):
         _sigint_handler(signal.SIGINT, sys._getframe())
 
 
+def test_ctrl_c_held_by_a_long_compile_ends_the_run_within_the_hold(tmp_path):
+    # The first run on a new machine compiles kernels for about a minute with numba's compiler
+    # on the stack all along: the Ctrl-C was held back over and over and the command then ran
+    # to its end with status 0. Here a child spends 20 s in a function of a module named like
+    # numba's compiler; a Ctrl-C must end it within about SIGINT_HOLD_S, one line, status 130.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from support import default_sigint
+
+    from orthoscope.cli import SIGINT_HOLD_S
+
+    code = (
+        "import sys, time\n"
+        "from orthoscope.cli import _sigint_outside_llvm\n"
+        "_sigint_outside_llvm()\n"
+        "ns = {'__name__': 'numba.core.compiler'}\n"
+        "exec('def compile_for_a_while():\\n    import time\\n    t = time.monotonic()\\n'\n"
+        "     '    while time.monotonic() - t < 20:\\n        sum(range(1000))', ns)\n"
+        "print('compiling', file=sys.stderr, flush=True)\n"
+        "ns['compile_for_a_while']()\n"
+        "print('finished', flush=True)\n"
+    )
+    p = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=default_sigint,
+    )
+    assert p.stderr.readline().strip() == "compiling"
+    time.sleep(0.3)
+    t0 = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=15)
+    took = time.monotonic() - t0
+    assert p.returncode == 130 and out == ""
+    assert err.strip() == "orthoscope: interrupted"
+    assert took < SIGINT_HOLD_S + 3.0  # the 20 s "compile" did not run to its end
+
+
+def test_a_plot_with_a_read_only_home_prints_no_matplotlib_lines(tmp_path):
+    # matplotlib printed "mkdir -p failed for path ..." and "Matplotlib created a temporary cache
+    # directory ..." on every plot when HOME cannot be written; the command gives it a
+    # temporary folder first and removes it at exit
+    import os
+    import subprocess
+    import sys
+
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("HOME", "XDG_CONFIG_HOME", "XDG_CACHE_HOME", "MPLCONFIGDIR")
+    }
+    env.update(HOME="/proc/no-home", TMPDIR=str(tmp_path))
+    png = tmp_path / "d.png"
+    r = subprocess.run(
+        [sys.executable, "-m", "orthoscope", "distortion", "cooke-triplet-f4", "--fields",
+         "0,10,20", "--plot", str(png)],
+        env=env, capture_output=True, text=True, cwd=tmp_path,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert png.stat().st_size > 0
+    assert "matplotlib" not in r.stderr.lower() and "mkdir" not in r.stderr, r.stderr
+    assert not list(tmp_path.glob("*matplotlib*"))  # the temporary folder is gone
+
+
 def test_a_warning_raised_again_is_printed_once(capsys):
     # N-SK16 at 2600 nm (its data end at 2325.42 nm): the extrapolation warning came once per
     # evaluation of the lens, three times for one trace; and again in the next run

@@ -53,6 +53,24 @@ def test_unwritable_cache_falls_back_to_uncached_with_one_warning(tmp_path):
     assert abs(h - 8.1121) < 6e-4
 
 
+def test_an_unwritable_numba_cache_dir_is_named(tmp_path):
+    # numba passes over a NUMBA_CACHE_DIR it cannot write without a word (and the no-cache
+    # warning then told the user to set the variable they had set): one warning names it and
+    # where the cache went instead
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("a file")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CACHE")}
+    env["NUMBA_CACHE_DIR"] = str(blocker)
+    r = subprocess.run(
+        [sys.executable, "-c", CHILD], cwd=tmp_path, env=env, capture_output=True, text=True
+    )
+    assert r.returncode == 0, r.stderr
+    warned = [ln for ln in r.stderr.splitlines() if "KernelCacheWarning" in ln]
+    assert len(warned) == 1, r.stderr
+    assert f"NUMBA_CACHE_DIR ({blocker}) is not a writable folder" in warned[0]
+    assert "instead" in warned[0]
+
+
 def test_cache_stamp_covers_every_kernel_module():
     from raytrace.kernels.jit import KERNEL_STAMP
 
@@ -60,22 +78,41 @@ def test_cache_stamp_covers_every_kernel_module():
     assert names == {p.name for p in (ROOT / "raytrace" / "kernels").glob("*.py")}
 
 
-def test_compile_notice_only_when_no_tracing_kernel_is_cached(monkeypatch, capsys):
-    """The "compiling" line means a first run: once any tracing command has cached its kernels,
-    a command that compiles one more kernel stays quiet (a warm `distortion` run, whose aim
-    kernel is cached, printed the notice on every run because the bulk kernel was not)."""
+def test_compile_notice_when_a_kernel_compiles_and_only_then(monkeypatch, capsys):
+    """The "compiling" line comes with numba's compile event (a cache miss) of a project kernel,
+    once per run: `report` after `distortion` compiled its own kernels for 30 s in silence (the
+    old notice looked at the cache of two kernels only). A cache hit fires no event, a compile
+    of someone else's function says nothing, and an uncached run (its KernelCacheWarning said
+    so) says nothing more."""
+    from types import SimpleNamespace
+
+    from numba.core import event
+
     import raytrace.kernels.jit as jit
     from orthoscope import cli
     from raytrace.kernels import aim
 
-    for warm, expect in (({"aim_chief"}, False), (set(), True), ({"aim_chief", "x"}, False)):
-        monkeypatch.setattr(
-            jit, "cache_is_warm", lambda *ds, w=warm: all(d.__name__ in w for d in ds)
-        )
+    ours = SimpleNamespace(py_func=aim.aim_chief.py_func)
+    other = SimpleNamespace(py_func=lambda: None)
+
+    def compile_(d):
+        with event.trigger_event("numba:compile", data={"dispatcher": d}):
+            pass
+
+    for uncached, events, expect in (
+        (False, [other], 0),
+        (False, [ours, ours], 1),
+        (False, [other, ours], 1),
+        (True, [ours], 0),
+        (False, [], 0),
+    ):
+        monkeypatch.setattr(jit, "_warned", uncached)
         cli._compile_notice()
+        for d in events:
+            compile_(d)
         err = capsys.readouterr().err
-        assert ("compiling the ray-tracing kernels" in err) is expect, (warm, err)
-    assert aim.aim_chief.__name__ == "aim_chief"
+        assert err.count(cli.COMPILE_NOTICE) == expect, (uncached, events, err)
+    assert sum(type(ls).__name__ == "Notice" for ls in event._registered["numba:compile"]) == 1
 
 
 def _array_types(sig):

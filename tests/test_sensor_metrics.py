@@ -35,6 +35,7 @@ from distortion.characteristic import characteristic_distortion
 from distortion.errors import DataError
 from distortion.grid import distortion_grid
 from distortion.sensor_metrics import sensor_metrics, sensor_metrics_from_points
+from orthoscope.cli import COMPILE_NOTICE
 from raytrace.files.library import load_lens
 
 
@@ -203,5 +204,5 @@ def test_cli_sensor_metrics_json_equals_the_api(cooke):
 )
 def test_cli_refuses_with_one_line(argv, words):
     rc, out, err = run_cli(["distortion", "cooke-triplet-f4", *argv])
-    lines = [ln for ln in err.splitlines() if "compiling the ray-tracing kernels" not in ln]
+    lines = [ln for ln in err.splitlines() if COMPILE_NOTICE not in ln]
     assert rc == 2 and len(lines) == 1 and words in lines[0] and ": error:" in lines[0], err

@@ -228,6 +228,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 1 a run that did not succeed, 2 a
     usage or input error, 130 interrupted)."""
     restore = _sigint_outside_llvm()
+    _HELD.update(since=None, command="orthoscope")
     try:
         return _run(argv)
     except KeyboardInterrupt:  # before the command is known (while the engine is imported)
@@ -257,20 +258,39 @@ def _sigint_outside_llvm():
     return lambda: signal.signal(signal.SIGINT, old)
 
 
+#: seconds a Ctrl-C is held back while numba works before the run ends at once
+SIGINT_HOLD_S = 1.0
+#: (monotonic time of the first Ctrl-C held back, the running command's name for its one line)
+_HELD: dict[str, object] = {"since": None, "command": "orthoscope"}
+
+
 def _sigint_handler(signum, frame) -> None:
     """KeyboardInterrupt, unless the main thread is inside llvmlite or numba's compiler: then
-    SIGINT again in 50 ms (:func:`_sigint_outside_llvm`)."""
+    SIGINT again in 50 ms (:func:`_sigint_outside_llvm`). Loading a cached kernel takes
+    milliseconds, so the Ctrl-C soon lands outside and the command stops the usual way (keeping
+    what it has finished); compiling kernels on a new machine keeps numba on the stack for about
+    a minute, so a Ctrl-C held back for more than :data:`SIGINT_HOLD_S` ends the process at once
+    (one line, status 130), with nothing finished to keep."""
     import signal
     import threading
+    import time
 
     f = frame
     while f is not None:
         if f.f_globals.get("__name__", "").startswith(("llvmlite", "numba.core")):
+            now = time.monotonic()
+            if _HELD["since"] is None:
+                _HELD["since"] = now
+            elif now - _HELD["since"] > SIGINT_HOLD_S:
+                sys.stdout.flush()
+                print(f"{_HELD['command']}: interrupted", file=sys.stderr, flush=True)
+                os._exit(EXIT_INTERRUPTED)
             t = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT))
             t.daemon = True
             t.start()
             return
         f = f.f_back
+    _HELD["since"] = None
     raise KeyboardInterrupt
 
 
@@ -304,11 +324,13 @@ def _run(argv: Sequence[str] | None) -> int:
         except SystemExit as e:  # --help, --version, or a usage error already printed
             return e.code if isinstance(e.code, int) else EXIT_USAGE
         command = f"orthoscope {args.command}"
+        _HELD["command"] = command
         if args.threads is not None:
             _set_threads(args.threads)
         if args.command not in NO_KERNELS:
             _numba_without_blas_probe()
             _compile_notice()
+        _before_matplotlib()
         with warnings.catch_warnings():
             if getattr(args, "strict", False):  # a glass evaluated outside its range fails
                 from raytrace.materials import OutOfRangeWarning
@@ -476,23 +498,97 @@ def _numba_without_blas_probe() -> None:
     sys.meta_path.insert(0, _NoBlasProbe())
 
 
+#: what the CLI says when a kernel compiles (a cache miss), once per run
+COMPILE_NOTICE = (
+    "orthoscope: compiling ray-tracing kernels (the first time this machine runs a command "
+    "that needs them; up to about a minute)"
+)
+
+
 def _compile_notice() -> None:
-    """One line on stderr when the ray-tracing kernels are not in the numba cache yet."""
-    from raytrace.kernels import aim
-    from raytrace.kernels.jit import cache_is_warm
+    """One line on stderr when this run starts to compile one of the project's kernels: numba's
+    ``numba:compile`` event fires on a cache miss only (a first run, or the first command that
+    needs a kernel no earlier command used: ``report`` after ``distortion`` compiles for 30 s),
+    never when machine code loads from the cache. Quiet when no cache folder can be written
+    (the :class:`~raytrace.kernels.jit.KernelCacheWarning` line has said that every run
+    compiles)."""
+    from numba.core import event
 
-    # the first run of any tracing command compiles its kernels; a later command that needs one
-    # more kernel compiles only that one (seconds), which is not worth a notice
-    if cache_is_warm(aim.aim_chief):
+    if _NOTICE:  # main() run again in one process: the listener is registered, say it anew
+        _NOTICE[0].said = False
         return
-    from raytrace.kernels import bulk
 
-    if cache_is_warm(bulk.trace_batch_serial):
+    from raytrace.kernels.jit import uncached
+
+    class Notice(event.Listener):
+        said = False
+
+        def on_start(self, ev) -> None:
+            func = getattr(ev.data.get("dispatcher"), "py_func", None)
+            if self.said or not getattr(func, "__module__", "").startswith("raytrace."):
+                return
+            self.said = True
+            if not uncached():
+                print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+
+        def on_end(self, ev) -> None:
+            return None
+
+    _NOTICE.append(Notice())
+    event.register("numba:compile", _NOTICE[0])
+
+
+_NOTICE: list = []
+
+
+def _before_matplotlib() -> None:
+    """Run :func:`_matplotlib_folder` when this run first imports matplotlib (a plot), through a
+    finder at the head of ``sys.meta_path`` that takes itself out at once."""
+    if "matplotlib" in sys.modules or any(isinstance(f, _BeforeMatplotlib) for f in sys.meta_path):
         return
-    print(
-        "orthoscope: compiling the ray-tracing kernels (first run only, about a minute)",
-        file=sys.stderr,
-    )
+    sys.meta_path.insert(0, _BeforeMatplotlib())
+
+
+class _BeforeMatplotlib:
+    def find_spec(self, name, path=None, target=None):
+        if name == "matplotlib":
+            sys.meta_path.remove(self)
+            _matplotlib_folder()
+        return None  # the usual finders import it
+
+
+def _matplotlib_folder() -> None:
+    """A plot with a read-only home made matplotlib print two lines of its own ("mkdir -p failed
+    for path ...", "Matplotlib created a temporary cache directory ..."): where its config or
+    cache folder cannot be made writable (its own test: mkdir, then ``os.access(W_OK)``), give
+    it a temporary folder, removed at exit, as it would make itself, without the lines."""
+    if "MPLCONFIGDIR" in os.environ:
+        return
+    from pathlib import Path
+
+    try:
+        home = Path.home()
+    except RuntimeError:  # no HOME and no password entry
+        home = Path("/nonexistent")
+    for folder in (
+        Path(os.environ.get("XDG_CONFIG_HOME") or home / ".config") / "matplotlib",
+        Path(os.environ.get("XDG_CACHE_HOME") or home / ".cache") / "matplotlib",
+    ):
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            break
+        if not (folder.is_dir() and os.access(folder, os.W_OK)):
+            break
+    else:
+        return
+    import atexit
+    import shutil
+    import tempfile
+
+    tmp = tempfile.mkdtemp(prefix="orthoscope-matplotlib-")
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)
+    os.environ["MPLCONFIGDIR"] = tmp
 
 
 def _set_threads(n: int) -> None:

@@ -105,6 +105,7 @@ def _install_locator() -> bool:
 
 _LOCATOR = _install_locator()
 _warned = False
+_moved = False
 
 
 def _kernel_cache_class() -> type | None:
@@ -159,13 +160,48 @@ def _warn_uncached() -> None:
     global _warned
     if not _warned:
         _warned = True
+        asked = numba.config.CACHE_DIR
+        where = (
+            f"NUMBA_CACHE_DIR ({asked}), the install folder and {os.path.expanduser('~')} "
+            "cannot be written"
+            if asked
+            else f"the install folder and {os.path.expanduser('~')} are read-only"
+        )
         warnings.warn(
-            "no writable folder for the numba kernel cache (install folder and "
-            f"{os.path.expanduser('~')} are read-only): kernels compile on every run; "
-            "set NUMBA_CACHE_DIR to a writable folder",
+            f"no writable folder for the numba kernel cache ({where}): kernels compile on every "
+            f"run (about a minute); set NUMBA_CACHE_DIR to a writable folder",
             KernelCacheWarning,
             stacklevel=4,
         )
+
+
+def _check_asked_folder(cache) -> None:
+    """One :class:`KernelCacheWarning` when NUMBA_CACHE_DIR is set but the cache went elsewhere
+    (numba passes over a folder it cannot write without a word)."""
+    global _moved
+    asked = numba.config.CACHE_DIR
+    path = getattr(cache, "_cache_path", None)
+    if _moved or not asked or path is None:
+        return
+    try:
+        inside = Path(path).resolve().is_relative_to(Path(asked).resolve())
+    except OSError:  # pragma: no cover
+        return
+    if not inside:
+        _moved = True
+        warnings.warn(
+            f"NUMBA_CACHE_DIR ({asked}) is not a writable folder: the numba kernel cache is in "
+            f"{path} instead; set NUMBA_CACHE_DIR to a writable folder (or unset "
+            "it)",
+            KernelCacheWarning,
+            stacklevel=5,
+        )
+
+
+def uncached() -> bool:
+    """True once a kernel found no writable cache folder (it compiles on every run; the
+    :class:`KernelCacheWarning` has said so)."""
+    return _warned
 
 
 class _LazyKernelCache:
@@ -184,6 +220,7 @@ class _LazyKernelCache:
         if self._made is None:
             try:
                 self._made = _KERNEL_CACHE(self._py_func)
+                _check_asked_folder(self._made)
             except RuntimeError as e:
                 if "cannot cache" not in str(e):
                     raise
@@ -216,13 +253,3 @@ def kernel(**options: Any) -> Callable:
             return numba.njit(cache=False, **options)(func)
 
     return decorate
-
-
-def cache_is_warm(*dispatchers) -> bool:
-    """True when every kernel in ``dispatchers`` has a cached compilation for the current sources
-    (so the first call loads machine code instead of compiling). Uses numba's cache index; when
-    that cannot be inspected the answer is True (nothing is claimed)."""
-    try:
-        return all(bool(d._cache._cache_file._load_index()) for d in dispatchers)
-    except Exception:  # noqa: BLE001 - a private numba API: never fail because of it
-        return True
