@@ -54,7 +54,13 @@ The provenance is kept as the first line of ``Lens.notes`` (``"provenance: paten
 survives :func:`dumps` / :func:`loads`; :func:`provenance` reads it back.
 
 Every problem raises :class:`~raytrace.errors.PrescriptionError` naming the file, the line and,
-where it applies, the surface (1-based).
+where it applies, the surface (1-based). Glass keys the medium would ignore are refused too:
+``catalog`` / ``model`` / ``formula`` / ``coefficients`` / ``range_nm`` without a ``glass`` name,
+beside ``n`` or ``"air"``, and all but ``model`` beside an ``"nd/vd"`` glass. A ``catalog`` is
+read as the ``.zmx`` reader reads a ``GCAT`` name
+(:func:`raytrace.glass.catalog.canonical_catalog`: any case, a dated Zemax name such as
+``"SCHOTT_2017"``). A broken ``[[configurations]]`` block is refused with the message
+:func:`raytrace.files.configurations.read_configured` gives.
 """
 
 from __future__ import annotations
@@ -130,7 +136,8 @@ _TOP_KEYS = (
     "surfaces",
     "image",
     # [[configurations]] (thicknesses per focus / zoom position) are read by
-    # raytrace.files.configurations; the lens read here is the base configuration.
+    # raytrace.files.configurations; the lens read here is the base configuration, and a
+    # broken block is refused here too (_check_configurations).
     "configurations",
 )
 _OBJECT_KEYS = ("distance", "glass", "catalog", "model", "n", "formula", "coefficients", "range_nm")
@@ -321,6 +328,92 @@ def _number(
     return v
 
 
+_GLASS_KEYS = ("catalog", "model", "formula", "coefficients", "range_nm")
+_PRIVATE_EXAMPLE = (
+    'glass = "NAME", catalog = "private", formula = <id>, coefficients = [...] for a glass '
+    "defined in the file"
+)
+
+
+def _keys_text(keys: list[str]) -> tuple[str, str, str]:
+    """("catalog and model", "do", "them") for naming the keys in a refusal."""
+    if len(keys) == 1:
+        return keys[0], "does", "it"
+    return ", ".join(keys[:-1]) + " and " + keys[-1], "do", "them"
+
+
+def _stray_glass_keys(
+    src: _Source,
+    glass: Any,
+    n: Any,
+    extra: dict[str, Any],
+    line: int | None,
+    surface: int | None,
+    place: str,
+) -> None:
+    """Refuse glass keys (catalog, model, formula, coefficients, range_nm) that the medium
+    written would ignore: none without a glass name, none beside n or air, and only model beside
+    an nd/vd model glass (a glass defined in the file takes the private keys with its name)."""
+    if not extra:
+        return
+    keys = list(extra)
+    names, does, them = _keys_text(keys)
+    first = keys[0]
+    if glass is None and n is None:
+        if first == "model":
+            example = f'glass = "1.5168/64.17", model = "{extra[first]}"'
+        elif first == "catalog" and str(extra[first]).strip().lower() != "private":
+            example = f'glass = "N-BK7", catalog = "{extra[first]}"'
+        else:
+            example = _PRIVATE_EXAMPLE
+        raise src.error(
+            f"{first} = {extra[first]!r} needs a glass name {place} (e.g. {example}); without "
+            f"glass the medium is air: add the glass, or drop {names}",
+            line,
+            surface,
+        )
+    if n is not None:
+        raise src.error(
+            f"{names} {does} not apply to a fixed index n = {n!r}: drop {them}, or give the "
+            'glass by name instead of n (glass = "N-BK7", catalog = "Schott"; glass = '
+            '"nd/vd" for a model glass)',
+            line,
+            surface,
+        )
+    if isinstance(glass, str) and glass.strip().lower() == "air":
+        raise src.error(f'{names} {does} not apply to glass = "air": drop {them}', line, surface)
+    if _nd_vd(glass) is not None:
+        keys = [k for k in keys if k != "model"]  # model picks an nd/vd glass's dispersion law
+        if keys:
+            names, does, them = _keys_text(keys)
+            if "catalog" in keys and str(extra["catalog"]).strip().lower() != "private":
+                instead = 'give the catalog glass by name (glass = "N-BK7", catalog = "Schott")'
+            else:
+                instead = "define the glass by name: " + _PRIVATE_EXAMPLE
+            raise src.error(
+                f"{names} {does} not apply to the model glass {glass!r} (nd/vd): drop "
+                f"{them}, or {instead}",
+                line,
+                surface,
+            )
+
+
+def _nd_vd(glass: Any) -> tuple[float, float] | None:
+    """(nd, vd) of an ``"nd/vd"`` glass string (any finite numbers), else None."""
+    if not isinstance(glass, str):
+        return None
+    parts = glass.strip().split("/")
+    if len(parts) != 2:
+        return None
+    try:
+        nd, vd = float(parts[0]), float(parts[1])
+    except ValueError:
+        return None
+    if math.isfinite(nd) and math.isfinite(vd):
+        return nd, vd
+    return None
+
+
 def _material(
     src: _Source,
     glass: Any,
@@ -330,6 +423,7 @@ def _material(
     catalog: Any = None,
     model: Any = None,
     private: dict[str, Any] | None = None,
+    place: str = "on the same line",
 ) -> Material:
     if glass is not None and n is not None:
         raise src.error('give either glass = "..." or n = <index>, not both', line, surface)
@@ -337,6 +431,10 @@ def _material(
         raise src.error(f"catalog must be a string, got {catalog!r}", line, surface)
     if model is not None and not isinstance(model, str):
         raise src.error(f"model must be a string, got {model!r}", line, surface)
+    given = {k: v for k, v in (private or {}).items() if v is not None}
+    extra = {"catalog": catalog, "model": model, **given}
+    extra = {k: extra[k] for k in _GLASS_KEYS if extra.get(k) is not None}
+    _stray_glass_keys(src, glass, n, extra, line, surface, place)
     if n is not None:
         v = _number(src, n, "n (fixed refractive index)", line, surface)
         if v < 1.0:
@@ -353,39 +451,49 @@ def _material(
     text = glass.strip()
     if text.lower() == "air":
         return AIR
-    parts = text.split("/")
-    if len(parts) == 2:
+    ndvd = _nd_vd(text)
+    if ndvd is not None:
+        nd, vd = ndvd
+        if nd < 1.0 or vd <= 0.0:
+            raise src.error(
+                f"glass {glass!r}: nd must be >= 1 and vd > 0 (got nd={nd!r}, vd={vd!r})",
+                line,
+                surface,
+            )
+        if model is None:
+            return model_glass(nd, vd)
         try:
-            nd, vd = float(parts[0]), float(parts[1])
-        except ValueError:
-            nd = vd = math.nan
-        if math.isfinite(nd) and math.isfinite(vd):
-            if nd < 1.0 or vd <= 0.0:
-                raise src.error(
-                    f"glass {glass!r}: nd must be >= 1 and vd > 0 (got nd={nd!r}, vd={vd!r})",
-                    line,
-                    surface,
-                )
-            if model is None:
-                return model_glass(nd, vd)
-            try:
-                return Material("model", nd, vd, model=model)
-            except ValueError as e:
-                raise src.error(f"glass {glass!r}: {e}", line, surface) from None
+            return Material("model", nd, vd, model=model)
+        except ValueError as e:
+            raise src.error(f"glass {glass!r}: {e}", line, surface) from None
     if model is not None:
         raise src.error(f"model = {model!r} applies to an nd/vd model glass only", line, surface)
-    given = {k: v for k, v in (private or {}).items() if v is not None}
     if given or (catalog or "").strip().lower() == "private":
         return _private(src, text, catalog, given, line, surface)
-    from ..glass import lookup_glass
+    from ..glass.catalog import CATALOGS, canonical_catalog, lookup_glass
 
+    vendor = None
+    if catalog is not None:
+        # the catalog names the .zmx reader's GCAT accepts: any case, a dated Zemax file name
+        vendor = canonical_catalog(catalog)
+        if vendor is None:
+            raise src.error(
+                f"unknown catalog {catalog!r}: the shipped catalogs are {', '.join(CATALOGS)} "
+                '(any case; a dated name such as "SCHOTT_2017" means its vendor), or "private" '
+                "for a glass defined in the file",
+                line,
+                surface,
+            )
     try:
-        g = lookup_glass(text, [catalog] if catalog else None, first_catalog_wins=bool(catalog))
+        g = lookup_glass(text, [vendor] if vendor else None, first_catalog_wins=bool(vendor))
     except PrescriptionError as e:
         raise src.error(e.reason, line, surface) from None
-    if catalog and g.catalog.lower() != catalog.strip().lower():
+    if vendor and g.catalog != vendor:
         raise src.error(
-            f"glass {text!r} is not in the {catalog} catalog (found in {g.catalog})", line, surface
+            f"glass {text!r} is not in the {vendor} catalog (found in {g.catalog}): give "
+            f'catalog = "{g.catalog}", or check the glass name',
+            line,
+            surface,
         )
     return g.material
 
@@ -606,14 +714,16 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
                     f'first vertex) or "inf", got {object_distance!r}',
                     line,
                 )
+        medium_key = next((k for k in ("glass", "n", *_GLASS_KEYS) if k in obj), "glass")
         object_material = _material(
             src,
             obj.get("glass"),
             obj.get("n"),
-            src.key_line("object", "glass"),
+            src.key_line("object", medium_key),
             catalog=obj.get("catalog"),
             model=obj.get("model"),
             private={k: obj.get(k) for k in ("formula", "coefficients", "range_nm")},
+            place="in [object]",
         )
 
     aperture = _choice(src, data, "aperture", _APERTURE_KEYS, Aperture)
@@ -667,7 +777,38 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
             raise src.error(
                 f"field {kind} = {height!r}: {e}", src.key_line("field", kind)
             ) from None
+    if "configurations" in data:
+        _check_configurations(src, data, lens)
     return lens
+
+
+def _check_configurations(src: _Source, data: dict[str, Any], lens: Lens) -> None:
+    """Refuse a broken ``[[configurations]]`` block (read by :mod:`.configurations`) with the
+    message :func:`~raytrace.files.configurations.read_configured` gives, at the line of the
+    configuration at fault (the lens itself does not use the block)."""
+    from .configurations import Configurations, check_surfaces, configurations_from_toml
+
+    tables = data["configurations"]
+    try:
+        confs = configurations_from_toml(data, path=src.path)
+        check_surfaces(lens, confs)
+    except PrescriptionError as e:
+        headers = [
+            i
+            for i, raw in enumerate(src.lines, start=1)
+            if re.match(r"^\s*\[\[\s*configurations\s*\]\]", raw)
+        ]
+        line = src.key_line("", "configurations") or src.key_line("configurations")
+        if isinstance(tables, list) and len(headers) == len(tables):
+            # the first table that fails on its own is the one at fault (each is independent)
+            for t, header in zip(tables, headers, strict=True):
+                try:
+                    one = configurations_from_toml({"configurations": [t]}, path=src.path)
+                    check_surfaces(lens, Configurations(one.configurations, 1, src.path or ""))
+                except PrescriptionError:
+                    line = header
+                    break
+        raise src.error(e.reason, line) from None
 
 
 def _field(src: _Source, data: dict[str, Any], finite: bool) -> tuple[Field, Any]:
