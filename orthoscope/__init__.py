@@ -23,8 +23,8 @@ Names load on first use, so ``import orthoscope`` is cheap and the command line 
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+import importlib as _importlib
+from typing import TYPE_CHECKING
 
 #: public name -> module that defines it
 _API: dict[str, str] = {
@@ -213,7 +213,7 @@ def _version() -> str:
         return "0+unknown"
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     if name == "__version__":
         v = _version()
         globals()["__version__"] = v
@@ -221,13 +221,20 @@ def __getattr__(name: str) -> Any:
     mod = _API.get(name)
     if mod is None:
         raise AttributeError(f"module 'orthoscope' has no attribute {name!r}")
-    value = getattr(importlib.import_module(mod), name)
+    value = getattr(_importlib.import_module(mod), name)
     globals()[name] = value
     return value
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_API))
+    """The public API (:data:`__all__`), the module's dunder names and its subpackages that are
+    loaded (``plots``, ``report``, ``cli``): not the helpers of this file (``TYPE_CHECKING``,
+    ``annotations``, ...)."""
+    import types
+
+    names = {n for n in globals() if n.startswith("__") and n.endswith("__")}
+    names |= {n for n, v in globals().items() if isinstance(v, types.ModuleType) and n[0] != "_"}
+    return sorted(names | set(__all__))
 
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load lazily

@@ -8,6 +8,7 @@ digit.
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -395,3 +396,42 @@ def test_table_reader_infers_constant_and_roundtrips(tmp_path, table1):
     rows = format_curve(table1, layout="rows")
     # Table I as printed: F0 = 153.706 mm, D0 = +0.355 mm at 40 deg
     assert "153.706" in paper and "+0.355" in paper and len(rows.splitlines()) == 14
+
+
+# ---------------------------------------------------------------- the bundled Table I
+
+
+def test_bundled_table1_is_the_test_table_and_calibrate_takes_its_name(tmp_path, monkeypatch):
+    """lenses/pestrecov-1958-table1-topogon.csv ships Table I with the package, so that
+    ``orthoscope calibrate pestrecov-1958-table1-topogon`` (the help's example) works from any
+    folder: the same rows as tests/data/pestrecov_table1.csv, the same result by name as by
+    path, and an existing file of that name wins over the bundled one."""
+    from support import run_cli
+
+    from orthoscope.cli.calibrate import PESTRECOV_TABLE_I
+    from raytrace.files.library import library_dir
+
+    shipped = library_dir() / f"{PESTRECOV_TABLE_I}.csv"
+    # a copy, source lines included (the reader keeps them as the curve's source)
+    assert shipped.read_bytes() == (DATA / "pestrecov_table1.csv").read_bytes()
+
+    def cal(table):
+        return ["calibrate", table, "--method", "two-point", "--at", "37.5,45", "--json"]
+
+    def result(out):
+        d = json.loads(out)
+        assert d["characteristic"].pop("name") in ("pestrecov_table1", PESTRECOV_TABLE_I)
+        return d
+
+    rc, by_path, err = run_cli(cal(str(DATA / "pestrecov_table1.csv")))
+    assert rc == 0, err
+    monkeypatch.chdir(tmp_path)
+    for word in (PESTRECOV_TABLE_I, f"{PESTRECOV_TABLE_I}.csv"):
+        rc, by_name, err = run_cli(cal(word))
+        assert rc == 0, err
+        assert result(by_name) == result(by_path)
+    changed = shipped.read_text().replace("42.5, 140.846, +0.330, +0.234\n", "")
+    (tmp_path / f"{PESTRECOV_TABLE_I}.csv").write_text(changed)
+    rc, local, err = run_cli(cal(f"{PESTRECOV_TABLE_I}.csv"))
+    assert rc == 0, err
+    assert len(json.loads(local)["Dc_mm"]) == len(json.loads(by_path)["Dc_mm"]) - 1

@@ -9,6 +9,7 @@ for the files written; the synthetic calibrations of tests/data/camera (make_mea
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -337,3 +338,92 @@ def test_camera_id_chooses_a_camera_of_a_colmap_file(tmp_path, monkeypatch):
     assert rc == 0, err
     src = json.loads(out)["conversion"]["source"]
     assert src["model"] == "colmap:SIMPLE_RADIAL" and src["image_width_px"] == 4000
+
+
+# ------------------------------------------------------------- each form's help, bundled examples
+def _examples(page: str) -> list[str]:
+    lines = page.split("Examples:", 1)[1].splitlines()
+    return [ln.strip() for ln in lines if ln.strip().startswith("orthoscope ")]
+
+
+@pytest.mark.parametrize(
+    "form,has,lacks",
+    [
+        ("compare", ["--plot", "--object-distance", "--focus-s", "--grid", "--strict"],
+         ["--picture", "--maps", "--model", "--calibrated-at", "--format"]),
+        ("convert", ["--model", "--coefficients", "--format", "--camera-id"],
+         ["--grid", "--focus", "--plot", "--picture", "--calibrated-at", "--csv"]),
+        ("variation", ["--calibrated-at", "--focal-length", "--method", "--g", "--focus",
+                       "--object-distances"],
+         ["--model", "--grid", "--wavelength", "--plot", "--picture", "--strict"]),
+    ],
+)  # fmt: skip
+def test_each_form_prints_its_own_help(form, has, lacks):
+    """`orthoscope camera compare --help` (convert, variation) is that form's page, not the
+    command's general page (a review found all three printing the general one)."""
+    rc, general, _ = run(["camera", "--help"])
+    assert rc == 0 and "--picture" in general and general.count("orthoscope camera") >= 4
+    for argv in (["camera", form, "--help"], ["camera", form, "x", "-h"]):
+        rc, page, err = run(argv)
+        assert rc == 0, err
+        assert page.startswith(f"usage: orthoscope camera {form} ") and page != general
+        flags = set(re.findall(r"(?<![\w-])(--[a-z][a-z-]*)", page.split("Examples:")[0]))
+        assert set(has) <= flags, set(has) - flags
+        assert not set(lacks) & flags, set(lacks) & flags
+    # its examples are the general page's (tests/test_docs.py runs those) and use this form
+    examples = _examples(page)
+    assert examples and all(e.startswith(f"orthoscope camera {form} ") for e in examples)
+    assert set(examples) <= set(_examples(general))
+
+
+def test_every_flag_a_form_page_shows_is_parsed():
+    """A form's page is for the help only; the command's one parser must accept what it shows,
+    with the same choices, default, type and count of values (the metavar may differ)."""
+    from orthoscope.cli import build_parser
+    from orthoscope.cli.camera import ACTIONS, action_parser
+
+    sub = build_parser("camera")._subparsers._group_actions[0].choices["camera"]
+    real = {o: a for a in sub._actions for o in a.option_strings}
+    for form in ACTIONS:
+        for a in action_parser(form)._actions:
+            for o in a.option_strings:
+                if o in ("-h", "--help"):
+                    continue
+                assert o in real, (form, o)
+                keys = ("choices", "default", "type", "nargs", "const")
+                assert [getattr(real[o], k) for k in keys] == [getattr(a, k) for k in keys], o
+
+
+def test_bundled_calibrations_are_the_test_data(tmp_path, monkeypatch):
+    """lenses/calibrations/ ships the synthetic calibrations of tests/data/camera under names
+    that work from any folder (the help's examples use them): the same numbers, and the same
+    command result by name as by path; an existing file wins over a name."""
+    from orthoscope.cli.camera import BUNDLED_CALIBRATIONS
+    from raytrace.files.library import library_dir
+
+    folder = library_dir() / "calibrations"
+    assert sorted(p.stem for p in folder.glob("*.yml")) == sorted(BUNDLED_CALIBRATIONS)
+    for name in BUNDLED_CALIBRATIONS:
+        d = name.rsplit("-", 1)[1]
+        shipped, test = folder / f"{name}.yml", DATA / f"cooke-measured-{d}.yml"
+        assert read_calibration(shipped) == read_calibration(test)
+        body = [ln for ln in shipped.read_text().splitlines() if not ln.startswith("#")]
+        assert body == test.read_text().splitlines()
+        assert "Synthetic, not a measurement" in shipped.read_text()
+
+    def convert(word):
+        return ["camera", "convert", word, "--model", "australis", "--sensor", "24x16", "--json"]
+
+    rc, by_path, err = run(convert(str(DATA / "cooke-measured-2m.yml")))
+    assert rc == 0, err
+    for word in ("cooke-triplet-f4-synthetic-2m", "cooke-triplet-f4-synthetic-2m.yml"):
+        rc, by_name, err = run(convert(word), tmp_path, monkeypatch)
+        assert rc == 0, err
+        assert by_name == by_path
+    (tmp_path / "cooke-triplet-f4-synthetic-2m.yml").write_bytes(
+        (DATA / "cooke-measured-5m.yml").read_bytes()
+    )
+    rc, local, err = run(convert("cooke-triplet-f4-synthetic-2m.yml"), tmp_path, monkeypatch)
+    assert rc == 0 and local != by_path
+    rc, _, err = run(["camera", "convert", "no-such-calibration", "--model", "opencv"])
+    assert rc == 2 and "no-such-calibration" in err

@@ -143,12 +143,35 @@ def test_every_public_function_documents_its_parameters():
     missing = []
     for name in osc.__all__:
         obj = getattr(osc, name)
-        if inspect.isfunction(obj) and list(inspect.signature(obj).parameters):
-            doc = inspect.getdoc(obj) or ""
-            returns = inspect.signature(obj).return_annotation not in (None, "None")
-            if "Parameters" not in doc or (returns and "Returns" not in doc):
-                missing.append(name)
+        if not inspect.isfunction(obj):
+            continue
+        doc = inspect.getdoc(obj) or ""
+        sig = inspect.signature(obj)
+        returns = sig.return_annotation not in (None, "None")
+        # a function without parameters still says what it returns (list_lenses did not)
+        if (list(sig.parameters) and "Parameters" not in doc) or (returns and "Returns" not in doc):
+            missing.append(name)
     assert missing == []
+
+
+def test_dir_of_the_package_is_its_api():
+    """dir(orthoscope): the public names, dunders and loaded subpackages; not the helpers of
+    orthoscope/__init__.py (a review saw Any, TYPE_CHECKING, annotations and importlib)."""
+    import types
+
+    import orthoscope as osc
+
+    extra = [
+        n
+        for n in dir(osc)
+        if n not in osc.__all__
+        and not (n.startswith("__") and n.endswith("__"))
+        and not isinstance(getattr(osc, n), types.ModuleType)
+    ]
+    assert extra == []
+    assert set(osc.__all__) <= set(dir(osc))
+    for helper in ("Any", "TYPE_CHECKING", "annotations", "importlib", "_API", "_version"):
+        assert helper not in dir(osc)
 
 
 @pytest.mark.parametrize("pkg", sorted(LAYERS))

@@ -17,9 +17,13 @@ from .common import (
 )
 from .distortion import add_calibration_args
 
+#: the bundled copy of Pestrecov's Table I (lenses/pestrecov-1958-table1-topogon.csv)
+PESTRECOV_TABLE_I = "pestrecov-1958-table1-topogon"
+
 TABLE_HELP = (
     "Distortion table CSV: a header with the field column (alpha_deg or y_mm), y0p_mm, D0_mm and "
-    "optionally Dr_pct; '#' lines are comments (see README)."
+    "optionally Dr_pct; '#' lines are comments (see README). Or the name of a bundled table: "
+    f"{PESTRECOV_TABLE_I} (Pestrecov 1958, Table I); an existing file wins over a name."
 )
 
 
@@ -30,6 +34,21 @@ SAMPLES = [["calibrate", "{data}/pestrecov_table1.csv", "--method", "two-point",
 OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png")]
 
 
+def table_path(word: str) -> str:
+    """TABLE as given: an existing file as it is; otherwise a bare name (with or without ``.csv``)
+    of a table bundled in the lens library (``lenses/NAME.csv``, installed with the package, so
+    the name works from any folder); anything else unchanged (the reader says what is wrong)."""
+    from pathlib import Path
+
+    p = Path(word)
+    if p.exists() or p.name != word or not word.strip():
+        return word
+    from raytrace.files.library import library_dir
+
+    bundled = library_dir() / f"{word.strip().lower().removesuffix('.csv')}.csv"
+    return str(bundled) if bundled.is_file() else word
+
+
 def cmd_calibrate(args) -> int:
     from distortion.calibration import calibrate
     from distortion.tablefile import read_distortion_table
@@ -38,10 +57,11 @@ def cmd_calibrate(args) -> int:
 
     if args.method is None:
         raise CliError(f"the following argument is required: --method {{{','.join(METHODS)}}}")
-    args._inputs = [args.table]
+    table = table_path(args.table)
+    args._inputs = [table]
     for flag in ("plot", "plot_rotation"):
         check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
-    curve = read_distortion_table(args.table, constant=args.constant)
+    curve = read_distortion_table(table, constant=args.constant)
     res = calibrate(
         curve, args.method, at=at_fields(args.at), value=args.value, k=args.exaggeration
     )
@@ -70,8 +90,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Drc on the axis. F0 (M0) is inferred from y0'/tan(alpha) (y0'/y) unless --constant "
             "gives it."
         ),
-        epilog="Example: orthoscope calibrate tests/data/pestrecov_table1.csv --method two-point "
-        "--at 37.5,45",
+        epilog=f"Example: orthoscope calibrate {PESTRECOV_TABLE_I} --method two-point --at 37.5,45",
     )
     q.add_argument("table", metavar="TABLE.csv", help=TABLE_HELP)
     add_calibration_args(q, required=True)

@@ -21,7 +21,6 @@ import argparse
 import math
 
 from .common import (
-    OBJECT_HELP,
     CliError,
     add_force_arg,
     add_object_args,
@@ -61,9 +60,32 @@ OUTPUTS = [("-o", ".yml"), ("--plot", ".png")]
 ACTIONS = ("compare", "convert", "variation")
 MODEL_WORDS = ("opencv", "fisheye", "colmap", "colmap-fisheye", "metashape", "australis")
 PATTERNS = ("grid", "checkerboard")
+#: the calibrations bundled with the lens library (lenses/calibrations/NAME.yml): synthetic
+#: examples for compare / convert / variation that work from any folder
+BUNDLED_CALIBRATIONS = (
+    "cooke-triplet-f4-synthetic-1m",
+    "cooke-triplet-f4-synthetic-2m",
+    "cooke-triplet-f4-synthetic-5m",
+)
 
 
 # ---------------------------------------------------------------------------------- helpers
+def calibration_path(word: str) -> str:
+    """A CALIBRATION as given: an existing file as it is; otherwise a bare name (with or without
+    ``.yml``) of a calibration bundled with the lens library (``lenses/calibrations/NAME.yml``,
+    installed with the package, so the name works from any folder); anything else unchanged
+    (the reader says what is wrong)."""
+    from pathlib import Path
+
+    p = Path(word)
+    if p.exists() or p.name != word or not word.strip():
+        return word
+    from raytrace.files.library import library_dir
+
+    bundled = library_dir() / "calibrations" / f"{word.strip().lower().removesuffix('.yml')}.yml"
+    return str(bundled) if bundled.is_file() else word
+
+
 def _write(path, data, args) -> None:
     from raytrace.files.output import write_atomic
 
@@ -322,11 +344,12 @@ def _npz(maps) -> bytes:
     return buf.getvalue()
 
 
-def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
+def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     from distortion.camera import compare_calibration, read_calibration
 
     from ..report.camera import comparison_csv, comparison_to_dict, format_comparison
 
+    cal_path = calibration_path(cal_word)
     lens = load(lens_name, strict=getattr(args, "strict", False))
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
@@ -334,7 +357,7 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
     cal = read_calibration(cal_path, camera_id=args.camera_id)
     sensor = _sensor(args, cal)
     setup = _setup(args, sensor)
-    cmp = compare_calibration(lens, cal, setup, label=f"measured ({cal_path})")
+    cmp = compare_calibration(lens, cal, setup, label=f"measured ({cal_word})")
     if args.output:
         from ..report.jsonout import dumps
 
@@ -354,13 +377,14 @@ def _cmd_compare(args, lens_name: str, cal_path: str) -> int:
     return 0
 
 
-def _cmd_convert(args, cal_path: str) -> int:
+def _cmd_convert(args, cal_word: str) -> int:
     from distortion.camera import convert_camera_model, read_calibration, smallest_exact
     from distortion.camera.models import CameraModel
     from distortion.errors import DataError
 
     from ..report.camera import conversion_to_dict, format_conversion
 
+    cal_path = calibration_path(cal_word)
     args._inputs = [p for p in (cal_path, args.camera) if p]
     check_output_path(args.output, args)
     cal = read_calibration(cal_path, camera_id=args.camera_id)
@@ -392,9 +416,10 @@ def _cmd_convert(args, cal_path: str) -> int:
     return 0
 
 
-def _cmd_variation(args, cal1: str, cal2: str) -> int:
+def _cmd_variation(args, word1: str, word2: str) -> int:
     from distortion.camera import calibrated_models_by_distance, read_calibration
 
+    cal1, cal2 = calibration_path(word1), calibration_path(word2)
     args._inputs = [cal1, cal2]
     check_output_path(args.output, args)
     if args.calibrated_at is None or args.focal_length is None or args.focus is None:
@@ -423,7 +448,7 @@ def _cmd_variation(args, cal1: str, cal2: str) -> int:
         method=args.method,
         g=args.g,
         pixel_size_mm=ps,
-        name=f"{cal1} and {cal2}",
+        name=f"{word1} and {word2}",
     )
     _model_table_out(args, table)
     return 0
@@ -434,18 +459,15 @@ def cmd_camera(args) -> int:
     head = words[0]
     if head == "compare":
         if len(words) != 3:
-            raise CliError("usage: orthoscope camera compare LENS CALIBRATION [flags]")
+            raise CliError(f"usage: {USAGE['compare']}")
         return _cmd_compare(args, words[1], words[2])
     if head == "convert":
         if len(words) != 2:
-            raise CliError("usage: orthoscope camera convert CALIBRATION --model TARGET [-o FILE]")
+            raise CliError(f"usage: {USAGE['convert']}")
         return _cmd_convert(args, words[1])
     if head == "variation":
         if len(words) != 3:
-            raise CliError(
-                "usage: orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 "
-                "--focal-length F --focus S --object-distances D1,D2,... --sensor WxH"
-            )
+            raise CliError(f"usage: {USAGE['variation']}")
         return _cmd_variation(args, words[1], words[2])
     if len(words) != 1:
         raise CliError(
@@ -455,188 +477,387 @@ def cmd_camera(args) -> int:
     return _cmd_lens(args, head)
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    q = sub.add_parser(
-        "camera",
-        help="Camera models (OpenCV, fisheye, COLMAP, Metashape, Australis) from a lens; "
-        "compare, convert, vary with distance.",
-        usage=(
-            "orthoscope camera LENS --sensor WxH --pixels CxR [--model M] [flags]\n"
-            "       orthoscope camera compare LENS CALIBRATION --sensor WxH [flags]\n"
-            "       orthoscope camera convert CALIBRATION --model M [-o FILE]\n"
-            "       orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 --focal-length F "
-            "--focus S --object-distances D1,D2,... --sensor WxH (or --pitch)"
-        ),
-        description=(
-            "Real chief rays (through the centre of the real stop) traced onto a sensor give "
-            "the correspondences ideal direction <-> image point that a camera model is fitted "
-            "to by least squares, with its residual in pixels. The ideal direction is the "
-            "object-space chief ray's (object at infinity) or the direction from the projection "
-            "centre - the paraxial entrance pupil at the reference wavelength - to the object "
-            "point; the image point is the chief ray's intercept with the sensor plane, in the "
-            "sensor's pixels (OpenCV: pixel centres at integers). The focus setting puts the "
-            "sensor in the Gaussian image plane of the focused object (unit focusing, at the "
-            "reference wavelength); default: focused on the object. 'compare' fits the "
-            "calibration's own model to the traced lens and compares distortion profiles and "
-            "the difference over the sensor; 'convert' turns one model into another (exact "
-            "algebra or a refit with its residual); 'variation' predicts models per object "
-            "distance from two calibrations (Brown Eqs. 1-4; Fraser & Shortis Eq. 6)."
-        ),
-        epilog=(
-            "Examples:\n"
-            "  orthoscope camera cooke-triplet-f4 --sensor 24x16 --pixels 3000x2000 "
-            "--model colmap -o cameras.txt\n"
-            "  orthoscope camera topogon-like-pestrecov --sensor 200x200 --pixels 2000x2000 "
-            "--model fisheye --grid 13x13\n"
-            "  orthoscope camera cooke-triplet-f4 --sensor 24x16 --pixels 1200x800 --focus 2m "
-            "--object-distances 1m,2m,5m,inf --grid 13x9\n"
-            "  orthoscope camera compare cooke-triplet-f4 tests/data/camera/cooke-measured-2m.yml "
-            "--sensor 24x16 --focus 2m --object-distance 2m --plot compare.png\n"
-            "  orthoscope camera convert tests/data/camera/cooke-measured-2m.yml --model "
-            "metashape -o cooke.xml"
-        ),
+# ---------------------------------------------------------------------------------- the parser
+#: the usage line of each form of the command: its help page's and its usage error's
+USAGE = {
+    "lens": "orthoscope camera LENS --sensor WxH --pixels CxR [--model M] [flags]",
+    "compare": "orthoscope camera compare LENS CALIBRATION --sensor WxH [flags]",
+    "convert": "orthoscope camera convert CALIBRATION --model M [-o FILE]",
+    "variation": "orthoscope camera variation CAL1 CAL2 --calibrated-at S1,S2 --focal-length F "
+    "--focus S --object-distances D1,D2,... --sensor WxH (or --pitch)",
+}
+
+CAL_HELP = (
+    "A calibration file: OpenCV .yml/.yaml/.json, COLMAP cameras.txt, Metashape or PhotoScan "
+    f".xml, Australis .aus; or a bundled example by name, {BUNDLED_CALIBRATIONS[1]} (also -1m, "
+    "-5m: synthetic calibrations of the bundled Cooke triplet, not measurements). An existing "
+    "file wins over a name."
+)
+
+#: the examples of each form (the general page shows them all; tests/test_docs.py runs them)
+EXAMPLES = {
+    "lens": [
+        "orthoscope camera cooke-triplet-f4 --sensor 24x16 --pixels 3000x2000 --model colmap "
+        "-o cameras.txt",
+        "orthoscope camera topogon-like-pestrecov --sensor 200x200 --pixels 2000x2000 --model "
+        "fisheye --grid 13x13",
+        "orthoscope camera cooke-triplet-f4 --sensor 24x16 --pixels 1200x800 --focus 2m "
+        "--object-distances 1m,2m,5m,inf --grid 13x9",
+    ],
+    "compare": [
+        "orthoscope camera compare cooke-triplet-f4 cooke-triplet-f4-synthetic-2m --sensor 24x16 "
+        "--focus 2m --object-distance 2m --plot compare.png",
+    ],
+    "convert": [
+        "orthoscope camera convert cooke-triplet-f4-synthetic-2m --model metashape -o cooke.xml",
+    ],
+    "variation": [
+        "orthoscope camera variation cooke-triplet-f4-synthetic-1m cooke-triplet-f4-synthetic-5m "
+        "--calibrated-at 1m,5m --focal-length 50 --focus 2m --object-distances 1m,2m,5m "
+        "--sensor 24x16",
+    ],
+}
+
+DESCRIPTION = {
+    "compare": (
+        "A measured calibration against the prescription's prediction at the same focus and "
+        "object distance: real chief rays of the lens traced onto the calibration's sensor, the "
+        "calibration's own model fitted to them (the prediction), and the two compared - "
+        "radial distortion profiles and the difference over the sensor in pixels. The sensor is "
+        "the calibration's pixel count with --sensor or --pitch; the focus setting puts it in "
+        "the Gaussian image plane of the focused object (default: focused on the object)."
+    ),
+    "convert": (
+        "One camera model into another over the calibration's sensor: exact algebra where the "
+        "target holds the model, otherwise a least-squares refit with its residual in pixels. "
+        "--model names a family (the smallest model of it that holds the calibration exactly) "
+        "or one model."
+    ),
+    "variation": (
+        "Camera models per object distance from two measured calibrations of one lens at two "
+        "focus distances: the radial distortion profile at each object distance for a lens "
+        "focused at --focus, by Brown's Eqs. 1-4 or Fraser & Shortis' Eq. 6 (with g_ss')."
+    ),
+}
+
+EXPLAIN = (
+    "Real chief rays (through the centre of the real stop) traced onto a sensor give the "
+    "correspondences ideal direction <-> image point that a camera model is fitted to by least "
+    "squares, with its residual in pixels. The ideal direction is the object-space chief ray's "
+    "(object at infinity) or the direction from the projection centre - the paraxial entrance "
+    "pupil at the reference wavelength - to the object point; the image point is the chief ray's "
+    "intercept with the sensor plane, in the sensor's pixels (OpenCV: pixel centres at integers). "
+    "The focus setting puts the sensor in the Gaussian image plane of the focused object (unit "
+    "focusing, at the reference wavelength); default: focused on the object. 'compare' fits the "
+    "calibration's own model to the traced lens and compares distortion profiles and the "
+    "difference over the sensor; 'convert' turns one model into another (exact algebra or a "
+    "refit with its residual); 'variation' predicts models per object distance from two "
+    "calibrations (Brown Eqs. 1-4; Fraser & Shortis Eq. 6)."
+)
+
+
+def _epilog(forms) -> str:
+    lines = [f"  {e}" for form in forms for e in EXAMPLES[form]]
+    return "Examples:\n" + "\n".join(lines)
+
+
+class _CameraHelp(argparse.Action):
+    """``-h``/``--help``: the help page of the form the words before it name (``orthoscope camera
+    compare --help`` prints compare's), otherwise the command's general page."""
+
+    def __init__(
+        self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None
+    ):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        words = getattr(namespace, "words", None) or []
+        if words and words[0] in ACTIONS:
+            parser = action_parser(words[0])
+        parser.print_help()
+        parser.exit()
+
+
+def action_parser(action: str) -> argparse.ArgumentParser:
+    """The help page of ``orthoscope camera ACTION`` (compare, convert, variation): its usage,
+    what it does, the flags it reads and its examples. Only for the help: the command's one
+    parser (:func:`register`) parses every form."""
+    from . import Parser
+
+    q = Parser(
+        prog=f"orthoscope camera {action}",
+        usage=USAGE[action],
+        description=DESCRIPTION[action],
+        epilog=_epilog([action]) + "\n\nRun 'orthoscope camera --help' for every form.",
+        add_help=False,
     )
-    q.add_argument(
-        "words",
-        nargs="+",
-        metavar="LENS",
-        help="A lens (file or bundled name); or 'compare LENS CALIBRATION', 'convert "
-        "CALIBRATION', 'variation CAL1 CAL2'.",
-    )
+    q.add_argument("-h", "--help", action="help", help="Show this help and exit.")
+    _add_arguments(q, action)
+    return q
+
+
+def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
+    """The flags of ``orthoscope camera``: all of them (``action`` None, the parser), or those
+    ``action`` reads (its help page; the texts say them for that form)."""
+
+    def on(*forms: str) -> bool:
+        return action is None or action in forms
+
+    def say(general: str, **per_action: str) -> str:
+        return per_action.get(action, general) if action else general
+
+    if action is None:
+        q.add_argument(
+            "words",
+            nargs="+",
+            metavar="LENS",
+            help="A lens (file or bundled name); or 'compare LENS CALIBRATION', 'convert "
+            "CALIBRATION', 'variation CAL1 CAL2' (each with its own --help).",
+        )
+    elif action == "compare":
+        q.add_argument("lens", metavar="LENS", help="A lens file or bundled lens name.")
+        q.add_argument("calibration", metavar="CALIBRATION", help=CAL_HELP)
+    elif action == "convert":
+        q.add_argument("calibration", metavar="CALIBRATION", help=CAL_HELP)
+    else:
+        q.add_argument("cal1", metavar="CAL1", help="The calibration focused at S1. " + CAL_HELP)
+        q.add_argument("cal2", metavar="CAL2", help="The calibration focused at S2 (likewise).")
     g = q.add_argument_group(
         "sensor",
-        "Two of --sensor, --pixels and --pitch (all three: checked); with a calibration its "
-        "pixel count and one of --sensor / --pitch. --camera reads a TOML camera spec "
-        "(docs/design.md, 'Camera models from a prescription'): sensor flags replace its "
-        "sensor, the other flags what they name.",
+        say(
+            "Two of --sensor, --pixels and --pitch (all three: checked); with a calibration its "
+            "pixel count and one of --sensor / --pitch. --camera reads a TOML camera spec "
+            "(docs/design.md, 'Camera models from a prescription'): sensor flags replace its "
+            "sensor, the other flags what they name.",
+            compare="The calibration gives the pixel count; give --sensor or --pitch (or "
+            "--camera, a TOML camera spec whose sensor the sensor flags replace).",
+            convert="The pixel size, where the calibration file does not hold it and the target "
+            "model is in mm (Australis): --sensor or --pitch, or --camera SPEC.toml.",
+            variation="The pixel size, where the calibration files do not hold it (the profiles "
+            "are in mm): --sensor or --pitch, or --camera SPEC.toml.",
+        ),
     )
     g.add_argument("--sensor", metavar="WxH", help="Sensor size in mm, e.g. 36x24.")
-    g.add_argument("--pixels", metavar="CxR", help="Pixel count, columns x rows, e.g. 6000x4000.")
+    if on("compare"):
+        g.add_argument(
+            "--pixels",
+            metavar="CxR",
+            help=say(
+                "Pixel count, columns x rows, e.g. 6000x4000.",
+                compare="Pixel count, columns x rows: checked against the calibration's.",
+            ),
+        )
     g.add_argument("--pitch", metavar="UM", help="Pixel pitch in micrometres (or '0.006mm').")
-    g.add_argument(
-        "--principal-point",
-        metavar="DX,DY",
-        help="Where the lens axis meets the sensor, mm from its centre, x right, y up.",
-    )
+    if on("compare"):
+        g.add_argument(
+            "--principal-point",
+            metavar="DX,DY",
+            help="Where the lens axis meets the sensor, mm from its centre, x right, y up.",
+        )
     g.add_argument("--camera", metavar="SPEC.toml", help="A TOML camera spec (sensor, focus...).")
-    m = q.add_argument_group("model")
-    m.add_argument(
-        "--model",
-        default="opencv",
-        metavar="M",
-        help="opencv, fisheye (OpenCV fisheye / Kannala-Brandt), colmap, colmap-fisheye, "
-        "metashape, australis - as many terms as the stated criterion needs - or one model name "
-        "such as colmap:OPENCV.",
-    )
-    m.add_argument(
-        "--coefficients",
-        type=int,
-        metavar="N",
-        help="Fix the number of coefficients: OpenCV 4, 5, 8, 12 or 14; fisheye 1-4.",
-    )
-    m.add_argument(
-        "--grid", metavar="CxR", help="Chief rays over the sensor, columns x rows (default 25x17)."
-    )
-    m.add_argument(
-        "--no-clip", action="store_true", help="Ignore the lens's semi-diameters (no vignetting)."
-    )
-    add_object_args(q)
-    f = q.add_argument_group(
-        "focus (give at most one; default: focused on the object)",
-        "The focused object in the words of the object plane ("
-        + OBJECT_HELP.split(",")[0]
-        + ") - the sensor sits in its Gaussian image plane - or the sensor plane itself.",
-    )
-    f.add_argument(
-        "--focus",
-        metavar="D",
-        help="Focused object: mm from the first vertex (or 2m, inf, 12x). 'variation': the "
-        "focus distance from the lens.",
-    )
-    f.add_argument("--focus-s", metavar="S", help="Focused object: Pestrecov's s (mm from H).")
-    f.add_argument("--focus-scale", metavar="N", help="Focused object: image scale N (Nx).")
-    f.add_argument("--s-prime", metavar="S'", help="Sensor plane: mm from H'.")
-    f.add_argument("--from-last-vertex", metavar="D", help="Sensor plane: mm from the last vertex.")
-    f.add_argument(
-        "--defocus", metavar="DZ", help="Sensor plane: mm from the object's Gaussian plane."
-    )
-    f.add_argument("--gaussian", action="store_true", help="Focused on the object (the default).")
-    add_wavelength_arg(q)
-    t = q.add_argument_group("per object distance")
-    t.add_argument(
-        "--object-distances",
-        metavar="D1,D2,...",
-        help="A table of models, one per object distance (mm from the first vertex; 2m, inf, "
-        "12x); 'variation': distances from the lens.",
-    )
-    v = q.add_argument_group("variation (two measured calibrations)")
-    v.add_argument(
-        "--calibrated-at",
-        metavar="S1,S2",
-        help="Focus distances of the two calibrations, from the lens (mm, or 1m).",
-    )
-    v.add_argument("--focal-length", metavar="F", help="f of Brown's formulas (mm).")
-    v.add_argument(
-        "--method",
-        choices=("brown", "fraser-shortis"),
-        default="brown",
-        help="Brown's Eq. 1, or Fraser & Shortis' Eq. 6 with --g.",
-    )
-    v.add_argument("--g", type=float, metavar="G", help="g_ss' of Fraser & Shortis' Eq. 6.")
+    m = q.add_argument_group(say("model", compare="chief rays"))
+    if on("convert"):
+        m.add_argument(
+            "--model",
+            default="opencv",
+            metavar="M",
+            help=say(
+                "opencv, fisheye (OpenCV fisheye / Kannala-Brandt), colmap, colmap-fisheye, "
+                "metashape, australis - as many terms as the stated criterion needs - or one model "
+                "name such as colmap:OPENCV.",
+                convert="The target: opencv, fisheye (OpenCV fisheye / Kannala-Brandt), colmap, "
+                "colmap-fisheye, metashape, australis - the smallest model of the family that "
+                "holds the calibration exactly, else a refit - or one model name such as "
+                "colmap:OPENCV.",
+            ),
+        )
+        m.add_argument(
+            "--coefficients",
+            type=int,
+            metavar="N",
+            help=say(
+                "Fix the number of coefficients: OpenCV 4, 5, 8, 12 or 14; fisheye 1-4.",
+                convert="--model opencv: fix the number of coefficients, 4, 5, 8, 12 or 14.",
+            ),
+        )
+    if on("compare"):
+        m.add_argument(
+            "--grid",
+            metavar="CxR",
+            help="Chief rays over the sensor, columns x rows (default 25x17).",
+        )
+        m.add_argument(
+            "--no-clip",
+            action="store_true",
+            help="Ignore the lens's semi-diameters (no vignetting).",
+        )
+        add_object_args(q)
+        f = q.add_argument_group(
+            "focus (give at most one; default: focused on the object)",
+            "The focused object in the words of the object plane (--focus as --object-distance, "
+            "--focus-s as --object-s, --focus-scale as --object-scale) - the sensor sits in its "
+            "Gaussian image plane - or the sensor plane itself.",
+        )
+        f.add_argument(
+            "--focus",
+            metavar="D",
+            help=say(
+                "Focused object: mm from the first vertex (or 2m, inf, 12x). 'variation': the "
+                "focus distance from the lens.",
+                compare="Focused object: mm from the first vertex (or 2m, inf, 12x).",
+            ),
+        )
+        f.add_argument("--focus-s", metavar="S", help="Focused object: Pestrecov's s (mm from H).")
+        f.add_argument("--focus-scale", metavar="N", help="Focused object: image scale N (Nx).")
+        f.add_argument("--s-prime", metavar="S'", help="Sensor plane: mm from H'.")
+        f.add_argument(
+            "--from-last-vertex", metavar="D", help="Sensor plane: mm from the last vertex."
+        )
+        f.add_argument(
+            "--defocus", metavar="DZ", help="Sensor plane: mm from the object's Gaussian plane."
+        )
+        f.add_argument(
+            "--gaussian", action="store_true", help="Focused on the object (the default)."
+        )
+        add_wavelength_arg(q)
+    if action is None:
+        t = q.add_argument_group("per object distance")
+        t.add_argument(
+            "--object-distances",
+            metavar="D1,D2,...",
+            help="A table of models, one per object distance (mm from the first vertex; 2m, inf, "
+            "12x); 'variation': distances from the lens.",
+        )
+    if on("variation"):
+        v = q.add_argument_group("variation (two measured calibrations)")
+        if action == "variation":
+            v.add_argument(
+                "--focus",
+                metavar="S",
+                help="The focus distance of the predicted models, from the lens (mm, or 2m).",
+            )
+            v.add_argument(
+                "--object-distances",
+                metavar="D1,D2,...",
+                help="The table's rows: object distances from the lens (mm, or 1m).",
+            )
+        v.add_argument(
+            "--calibrated-at",
+            metavar="S1,S2",
+            help="Focus distances of the two calibrations, from the lens (mm, or 1m).",
+        )
+        v.add_argument("--focal-length", metavar="F", help="f of Brown's formulas (mm).")
+        v.add_argument(
+            "--method",
+            choices=("brown", "fraser-shortis"),
+            default="brown",
+            help="Brown's Eq. 1, or Fraser & Shortis' Eq. 6 with --g.",
+        )
+        v.add_argument("--g", type=float, metavar="G", help="g_ss' of Fraser & Shortis' Eq. 6.")
     o = q.add_argument_group("outputs")
     o.add_argument(
         "-o",
         "--output",
         metavar="FILE",
-        help="Calibration file (.yml/.yaml/.json OpenCV, cameras.txt COLMAP, .xml Metashape, "
-        ".aus Australis); a table of models: .csv or .json; compare: .json or .csv.",
+        help=say(
+            "Calibration file (.yml/.yaml/.json OpenCV, cameras.txt COLMAP, .xml Metashape, "
+            ".aus Australis); a table of models: .csv or .json; compare: .json or .csv.",
+            compare="The comparison as .json or .csv.",
+            convert="The converted calibration (.yml/.yaml/.json OpenCV, cameras.txt COLMAP, "
+            ".xml Metashape, .aus Australis).",
+            variation="The table of models as .csv or .json.",
+        ),
     )
-    o.add_argument(
-        "--camera-id",
-        type=int,
-        metavar="N",
-        help="compare / convert / variation: the camera of a COLMAP cameras.txt that holds "
-        "several (its CAMERA_ID).",
-    )
-    o.add_argument("--format", metavar="FMT", help="The calibration file format, when the name "
-                   "does not say (opencv-yaml, opencv-json, colmap, metashape, photoscan, "
-                   "australis).")  # fmt: skip
-    o.add_argument(
-        "--plot",
-        metavar="FILE",
-        help="A chart (.png/.svg/.pdf): the fit residual over the sensor; compare: radial curves "
-        "beside the difference map.",
-    )
-    o.add_argument(
-        "--picture",
-        metavar="FILE.png",
-        help="A grid of the ideal image as the lens records it, at true scale (needs OpenCV).",
-    )
-    o.add_argument("--pattern", choices=PATTERNS, default="grid", help="Pattern of --picture.")
-    o.add_argument(
-        "--maps",
-        metavar="FILE.npz",
-        help="cv2.remap maps (map1, map2 float32, camera_matrix) of the full image.",
-    )
-    o.add_argument(
-        "--maps-direction",
-        choices=("undistort", "distort"),
-        default="undistort",
-        help="undistort: the ideal image from the camera's; distort: the camera's from an "
-        "ideal one.",
-    )
-    add_strict_arg(
-        o,
-        help="Exit with status 2 when a chief ray fails, when the lens file names a glass that "
-        "can only be read as a substitute (an N- successor, a parent glass, a model of nd/vd), "
-        "when a glass is evaluated outside its catalog data range (an nd/vd model glass outside "
-        "365-1014 nm), or when the sensor reaches "
-        "beyond the lens's image circle (before anything is written).",
-    )
+    if on("compare", "convert", "variation"):
+        which = "the camera of a COLMAP cameras.txt that holds several (its CAMERA_ID)."
+        o.add_argument(
+            "--camera-id",
+            type=int,
+            metavar="N",
+            help=say(
+                f"compare / convert / variation: {which}",
+                **dict.fromkeys(ACTIONS, which[0].upper() + which[1:]),
+            ),
+        )
+    if on("convert"):
+        o.add_argument("--format", metavar="FMT", help="The calibration file format, when the "
+                       "name does not say (opencv-yaml, opencv-json, colmap, metashape, photoscan, "
+                       "australis).")  # fmt: skip
+    if on("compare"):
+        o.add_argument(
+            "--plot",
+            metavar="FILE",
+            help=say(
+                "A chart (.png/.svg/.pdf): the fit residual over the sensor; compare: radial "
+                "curves beside the difference map.",
+                compare="A chart (.png/.svg/.pdf): radial curves beside the difference map.",
+            ),
+        )
+    if action is None:
+        o.add_argument(
+            "--picture",
+            metavar="FILE.png",
+            help="A grid of the ideal image as the lens records it, at true scale (needs OpenCV).",
+        )
+        o.add_argument("--pattern", choices=PATTERNS, default="grid", help="Pattern of --picture.")
+        o.add_argument(
+            "--maps",
+            metavar="FILE.npz",
+            help="cv2.remap maps (map1, map2 float32, camera_matrix) of the full image.",
+        )
+        o.add_argument(
+            "--maps-direction",
+            choices=("undistort", "distort"),
+            default="undistort",
+            help="undistort: the ideal image from the camera's; distort: the camera's from an "
+            "ideal one.",
+        )
+    if on("compare"):
+        add_strict_arg(
+            o,
+            help=say(
+                "Exit with status 2 when a chief ray fails, when the lens file names a glass that "
+                "can only be read as a substitute (an N- successor, a parent glass, a model of "
+                "nd/vd), when a glass is evaluated outside its catalog data range (an nd/vd model "
+                "glass outside 365-1014 nm), or when the sensor reaches beyond the lens's image "
+                "circle (before anything is written).",
+                compare="Exit with status 2 when the lens file names a glass that can only be "
+                "read as a substitute (an N- successor, a parent glass, a model of nd/vd), or "
+                "when a glass is evaluated outside its catalog data range (an nd/vd model glass "
+                "outside 365-1014 nm).",
+            ),
+        )
     add_force_arg(q)
-    add_output_args(
-        q,
-        csv_help="Print CSV: the traced points with the residual, the table, or the radial "
-        "profiles.",
+    if action == "convert":
+        add_output_args(q, csv=False)
+    else:
+        add_output_args(
+            q,
+            csv_help=say(
+                "Print CSV: the traced points with the residual, the table, or the radial "
+                "profiles.",
+                compare="Print CSV: the radial profiles.",
+                variation="Print CSV: the table.",
+            ),
+        )
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    q = sub.add_parser(
+        "camera",
+        help="Camera models (OpenCV, fisheye, COLMAP, Metashape, Australis) from a lens; "
+        "compare, convert, vary with distance.",
+        usage="\n       ".join(USAGE.values()),
+        description=EXPLAIN,
+        epilog=_epilog(EXAMPLES)
+        + "\n\nRun 'orthoscope camera compare --help' (convert, variation) for the flags of each.",
+        add_help=False,
     )
+    q.add_argument(
+        "-h",
+        "--help",
+        action=_CameraHelp,
+        help="Show this help and exit (after compare, convert or variation: that form's help).",
+    )
+    _add_arguments(q, None)
     q.set_defaults(func=cmd_camera)

@@ -155,5 +155,12 @@ def lens_info(lens: Lens, name: str | None = None) -> LensInfo:
 
 
 def list_lenses() -> list[LensInfo]:
-    """All bundled lenses, sorted by name."""
+    """All bundled lenses, sorted by name (what ``orthoscope lenses`` lists).
+
+    Returns
+    -------
+    list of LensInfo
+        One per bundled lens: its name (what :func:`load_lens` takes), title, file, paraxial EFL
+        (mm) and f-number at the lens's own wavelength, field (degrees or mm), source and kind.
+    """
     return [lens_info(load_lens(n), n) for n in bundled_names()]
