@@ -116,6 +116,41 @@ def singlet_spec(**settings) -> DesignSpec:
     )
 
 
+def cooke_split_spec(max_evaluations: int) -> DesignSpec:
+    """The Cooke triplet's six curvatures against EFL 50 mm and the least RMS spot on axis: the
+    element-splitting problem of the optimizer tests."""
+    return replace(
+        singlet_spec(),
+        start="cooke-triplet-f4",
+        variables=tuple(Variable("curvature", k) for k in range(1, 7)),
+        operands=(
+            Operand("efl", 50.0, 100.0),
+            Operand("rms_spot", 0.0, 1000.0, {"field": 0.0, "plane": "best"}),
+        ),
+        max_evaluations=max_evaluations,
+    )
+
+
+def cooke_multimodal_spec_text(max_evaluations: int, tail: str = "") -> str:
+    """The TOML text of the multimodal Cooke problem of the optimizer tests: the six curvatures
+    against the EFL and three RMS spots (0, 14 and 20 degrees); ``tail``: more TOML after it (a
+    ``[global]`` table)."""
+    return (
+        f'name = "cooke-multimodal"\nstart = "cooke-triplet-f4"\nmax_evaluations = '
+        f"{max_evaluations}\nvariables = [\n"
+        + "".join(f'  {{ kind = "curvature", surface = {i} }},\n' for i in range(1, 7))
+        + "]\noperands = [\n"
+        '  { type = "efl", target = 50.0, weight = 10 },\n'
+        + "".join(
+            f'  {{ type = "rms_spot", field = {f}, plane = "file", aperture = {a}, '
+            "weight = 100 },\n"
+            for f, a in ((0, 1.0), (14, 1.0), (20, 0.8))
+        )
+        + "]\n"
+        + tail
+    )
+
+
 #: the sensor of the camera-model tests (px): odd and non-square
 CAMERA_W, CAMERA_H = 3001, 1999
 

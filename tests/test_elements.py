@@ -19,7 +19,7 @@ import sys
 from dataclasses import replace
 
 import pytest
-from support import singlet, singlet_spec
+from support import cooke_split_spec, singlet, singlet_spec
 
 from raytrace.elements import insert_element, split_element, surface_map
 from raytrace.errors import LensError
@@ -283,16 +283,7 @@ def test_scan_splits_tries_every_element_and_the_cli_keeps_the_best(tmp_path):
     from raytrace.optimize import scan_splits
 
     lens = load_lens("cooke-triplet-f4")
-    spec = replace(
-        singlet_spec(),
-        start="cooke-triplet-f4",
-        variables=tuple(Variable("curvature", k) for k in range(1, 7)),
-        operands=(
-            Operand("efl", 50.0, 100.0),
-            Operand("rms_spot", 0.0, 1000.0, {"field": 0.0, "plane": "best"}),
-        ),
-        max_evaluations=80,
-    )
+    spec = cooke_split_spec(80)
     trials = scan_splits(lens, spec)
     assert [t.surface for t in trials] == [1, 3, 5]
     assert all(t.result is not None and math.isfinite(t.merit) for t in trials)

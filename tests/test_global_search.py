@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import interrupt_group, singlet, singlet_spec
+from support import cooke_multimodal_spec_text, interrupt_group, singlet, singlet_spec
 
 from raytrace import AIR, Aperture, Field, Lens, Surface
 from raytrace.files.library import load_lens
@@ -357,17 +357,7 @@ def test_cli_sigint_to_the_process_group_writes_the_best_design(tmp_path: Path, 
         pytest.importorskip("distributed")
     spec = tmp_path / "cooke.toml"
     spec.write_text(
-        'name = "cooke-multimodal"\nstart = "cooke-triplet-f4"\nmax_evaluations = 200\n'
-        "variables = [\n"
-        + "".join(f'  {{ kind = "curvature", surface = {i} }},\n' for i in range(1, 7))
-        + "]\noperands = [\n"
-        '  { type = "efl", target = 50.0, weight = 10 },\n'
-        + "".join(
-            f'  {{ type = "rms_spot", field = {f}, plane = "file", aperture = {a}, '
-            "weight = 100 },\n"
-            for f, a in ((0, 1.0), (14, 1.0), (20, 0.8))
-        )
-        + "]\n[global]\nstarts = 40\nhops = 3\nlocal_evaluations = 20\n"
+        cooke_multimodal_spec_text(200, "[global]\nstarts = 40\nhops = 3\nlocal_evaluations = 20\n")
     )
     out = tmp_path / "best.toml"
     argv = ["optimize", str(spec), "-o", str(out), "--global", *where, "--seed", "1"]

@@ -8,11 +8,16 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from support import interrupt_group, singlet, singlet_spec
+from support import (
+    cooke_multimodal_spec_text,
+    cooke_split_spec,
+    interrupt_group,
+    singlet,
+    singlet_spec,
+)
 
 import raytrace.optimize.solver as solver
 from orthoscope.cli import main
@@ -20,7 +25,7 @@ from orthoscope.cli.optimize import _Progress
 from raytrace.files import save_lens
 from raytrace.files.library import load_lens
 from raytrace.files.native import read_lens
-from raytrace.optimize import Operand, Variable, evaluate, merit, optimize, read_spec, scan_splits
+from raytrace.optimize import evaluate, merit, optimize, read_spec, scan_splits
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -107,16 +112,7 @@ def _ctrl_c_in_the_second_run(monkeypatch) -> None:
 
 def test_scan_splits_ends_with_the_interrupted_trial(monkeypatch):
     lens = load_lens("cooke-triplet-f4")
-    spec = replace(
-        singlet_spec(),
-        start="cooke-triplet-f4",
-        variables=tuple(Variable("curvature", k) for k in range(1, 7)),
-        operands=(
-            Operand("efl", 50.0, 100.0),
-            Operand("rms_spot", 0.0, 1000.0, {"field": 0.0, "plane": "best"}),
-        ),
-        max_evaluations=20,
-    )
+    spec = cooke_split_spec(20)
     _ctrl_c_in_the_second_run(monkeypatch)
     trials = _kept(scan_splits, lens, spec)
     # the first element's run finished, the second was interrupted, the third never ran
@@ -201,19 +197,7 @@ def test_cli_sigint_during_a_local_run_writes_the_best_design(tmp_path: Path, me
     import time
 
     spec = tmp_path / "cooke.toml"
-    spec.write_text(
-        'name = "cooke-multimodal"\nstart = "cooke-triplet-f4"\nmax_evaluations = 100000\n'
-        "variables = [\n"
-        + "".join(f'  {{ kind = "curvature", surface = {i} }},\n' for i in range(1, 7))
-        + "]\noperands = [\n"
-        '  { type = "efl", target = 50.0, weight = 10 },\n'
-        + "".join(
-            f'  {{ type = "rms_spot", field = {f}, plane = "file", aperture = {a}, '
-            "weight = 100 },\n"
-            for f, a in ((0, 1.0), (14, 1.0), (20, 0.8))
-        )
-        + "]\n"
-    )
+    spec.write_text(cooke_multimodal_spec_text(100000))
     out = tmp_path / "best.toml"
     argv = ["optimize", str(spec), "-o", str(out), "--method", method]
 
