@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tomllib
 
 from distortion.variation.focus import (
     focus_configurations,
@@ -28,11 +29,13 @@ from raytrace.files.configurations import (
     Configuration,
     Configurations,
     apply_configuration,
+    configurations_from_toml,
     dumps_with_configurations,
     parse_seq_configurations,
     parse_toml_configurations,
     parse_zmx_configurations,
     read_configured,
+    write_lens_with_configurations,
 )
 from raytrace.files.library import load_lens
 from raytrace.files.native import loads
@@ -174,6 +177,59 @@ def test_toml_round_trip_exact(tmp_path: Path) -> None:
     p = tmp_path / "c.toml"
     p.write_text(text, encoding="utf-8")
     lens2, confs2 = read_configured(p)
+    assert lens2 == lens and confs2.configurations == confs.configurations
+
+
+def test_scale_to_efl_scales_the_configurations_with_the_lens(tmp_path: Path) -> None:
+    # the bundled inner-focus Tessar with scale_to_efl = 50: every configuration length is the
+    # unscaled one times the lens's factor ("inf" stays), so each focus position is the same
+    # conjugate scaled (before the fix the configurations kept the 100 mm lens's thicknesses:
+    # the "inf" position gave EFL 47.74 mm, not 50)
+    text = (ROOT / "lenses" / f"{INNER}.toml").read_text(encoding="utf-8")
+    scaled_text = text.replace('units      = "mm"\n', 'units      = "mm"\nscale_to_efl = 50.0\n')
+    assert scaled_text != text
+    p = tmp_path / "tessar50.toml"
+    p.write_text(scaled_text, encoding="utf-8")
+    lens0, confs0 = read_configured(INNER)
+    lens, confs = read_configured(p)
+    factor = lens.surfaces[0].thickness / lens0.surfaces[0].thickness
+    assert paraxial(lens).efl == pytest.approx(50.0, rel=1e-14)
+    assert factor == pytest.approx(50.0 / paraxial(lens0).efl, rel=1e-14)
+    # the infinity position is the scaled base lens itself, bit for bit
+    assert apply_configuration(lens, confs.configurations[0]) == lens
+    for c0, c in zip(confs0.configurations, confs.configurations, strict=True):
+        assert c.name == c0.name
+        assert [k for k, _ in c.thicknesses] == [k for k, _ in c0.thicknesses]
+        for (_, t0), (_, t) in zip(c0.thicknesses, c.thicknesses, strict=True):
+            assert t == pytest.approx(t0 * factor, rel=1e-14)
+        if math.isinf(c0.object_distance):
+            assert c.object_distance == math.inf
+        else:
+            assert c.object_distance == pytest.approx(c0.object_distance * factor, rel=1e-14)
+        cl0, cl = apply_configuration(lens0, c0), apply_configuration(lens, c)
+        par0, par = paraxial(cl0), paraxial(cl)
+        assert par.efl == pytest.approx(par0.efl * factor, rel=1e-12)
+        # the Gaussian image of the scaled object distance: the scaled image distance, on the
+        # scaled lens's image plane (the unscaled positions were solved to 1e-10 mm)
+        assert par.gaussian_image_distance == pytest.approx(
+            par0.gaussian_image_distance * factor, rel=1e-12
+        )
+        assert abs(par.gaussian_image_distance - cl.surfaces[-1].thickness) < 1e-9
+        if math.isfinite(cl.object_distance):
+            assert cl.object_distance + track_length(cl) == pytest.approx(
+                float(c.name.split()[0]) * 1000.0 * factor, rel=1e-13
+            )
+    # the lens-less readers scale the same way
+    assert parse_toml_configurations(scaled_text).configurations == confs.configurations
+    assert configurations_from_toml(tomllib.loads(scaled_text)).configurations == (
+        confs.configurations
+    )
+    # written back: the scaled numbers without scale_to_efl; read again, the same lens and
+    # configurations
+    out = tmp_path / "out.toml"
+    write_lens_with_configurations(lens, confs, out)
+    assert "scale_to_efl" not in tomllib.loads(out.read_text(encoding="utf-8"))
+    lens2, confs2 = read_configured(out)
     assert lens2 == lens and confs2.configurations == confs.configurations
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from raytrace.errors import PrescriptionError
 from raytrace.files import read_lens_file
-from raytrace.files.configurations import read_configured
+from raytrace.files.configurations import read_configurations, read_configured
 from raytrace.files.library import load_lens
 from raytrace.files.native import loads
 
@@ -202,6 +202,36 @@ def test_good_configurations_still_read(tmp_path):
     assert read_lens_file(p) == lens and confs.configurations[0].thickness(2) == 39.0
     lens, confs = read_configured(LENSES / "tessar-fr1066698-inner-focus.toml")
     assert len(confs) == 5
+
+
+def test_scale_to_efl_scales_the_configurations(tmp_path):
+    # scale_to_efl scales the block's lengths with the lens ("inf" stays); the lens-less reader
+    # (read_configurations) builds the lens for the factor and gives the same numbers
+    tail = (
+        "scale_to_efl = 100.0\n"
+        + CFG.format(th="0 = 1000.0, 2 = 39.0")
+        + CFG.format(th='0 = "inf"')
+    )
+    p = _write(tmp_path, 'glass = "N-BK7"', tail=tail)
+    lens, confs = read_configured(p)
+    factor = lens.surfaces[1].thickness / 40.0  # surface 2's t = 40.0 in the file
+    assert factor != pytest.approx(1.0)
+    near, far = confs.configurations
+    assert near.thickness(2) == pytest.approx(39.0 * factor, rel=1e-15)
+    assert near.object_distance == pytest.approx(1000.0 * factor, rel=1e-15)
+    assert far.object_distance == float("inf")
+    assert read_configurations(p).configurations == confs.configurations
+
+
+def test_broken_configurations_of_a_scaled_lens_are_refused_the_same_way(tmp_path):
+    tail = "scale_to_efl = 100.0\n" + CFG.format(th="0 = 1000.0") + CFG.format(th="9 = 3.0")
+    p = _write(tmp_path, 'glass = "N-BK7"', tail=tail)
+    e = _refused(p, r"configuration 'near' changes the thickness of surface 9")
+    assert e.line == 13
+    for read in (read_configured, read_configurations):
+        with pytest.raises(PrescriptionError) as e2:
+            read(p)
+        assert str(e2.value) == str(e)
 
 
 def test_every_bundled_lens_still_loads():

@@ -29,6 +29,11 @@ Sources read (only thicknesses; every other multi-configuration operand is liste
       name = "1 m"
       thickness = { 0 = 842.61, 2 = 9.53 }   # surface -> mm; 0 = object distance ("inf" allowed)
 
+  In a file with ``scale_to_efl`` (the lens scaled to that paraxial EFL) these lengths are
+  scaled by the lens's factor (:func:`raytrace.files.native.efl_scale`; ``"inf"`` stays), so
+  that the configurations are those of the scaled lens: its focus positions are the same
+  conjugates scaled.
+
 Every problem raises :class:`~raytrace.errors.PrescriptionError` naming the file and line.
 """
 
@@ -428,12 +433,18 @@ def parse_seq_configurations(
 
 
 def configurations_from_toml(
-    data: dict[str, Any], *, path: str | Path | None = None
+    data: dict[str, Any], *, path: str | Path | None = None, scale: float | None = None
 ) -> Configurations:
     """The ``[[configurations]]`` tables of a parsed TOML lens file (module docstring); none
-    gives one configuration with no changes."""
+    gives one configuration with no changes. Every length (thicknesses, finite object
+    distances) is multiplied by ``scale``; None = the factor of the file's ``scale_to_efl``
+    (:func:`raytrace.files.native.efl_scale`, which builds the lens; 1.0 without the key)."""
     spath = None if path is None else str(path)
     tables = data.get("configurations", [])
+    if scale is None:
+        from .native import efl_scale
+
+        scale = efl_scale(data, path=spath) if tables else 1.0
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
         raise _err("configurations must be an array of tables ([[configurations]])", spath, None)
     configs = []
@@ -482,6 +493,7 @@ def configurations_from_toml(
                     spath,
                     None,
                 )
+            v *= scale  # scale_to_efl: a length of the scaled lens ("inf" stays inf)
             if k == 0:
                 od = v
             else:
@@ -503,7 +515,12 @@ def parse_toml_configurations(
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise _err(f"TOML syntax error: {e}", spath, None) from None
-    return configurations_from_toml(data, path=spath)
+    scale = 1.0
+    if "scale_to_efl" in data and data.get("configurations"):
+        from .native import efl_scale
+
+        scale = efl_scale(data, text=text, path=spath)
+    return configurations_from_toml(data, path=spath, scale=scale)
 
 
 def _toml_number(v: float) -> str:
@@ -590,7 +607,8 @@ def read_configurations(path: str | Path) -> Configurations:
     path : str or Path
         A lens file path (bundled names: :func:`read_configured`): Zemax ``.zmx`` (``THIC``
         operands of the multi-configuration editor), CODE V ``.seq`` (``ZOO THI``), anything else
-        native TOML (``[[configurations]]``). Lengths in the file's unit, returned in mm.
+        native TOML (``[[configurations]]``). Lengths in the file's unit, returned in mm (a
+        TOML file's ``scale_to_efl`` scales them with the lens).
 
     Returns
     -------

@@ -14,7 +14,8 @@ The format (documented for users in ``lenses/README.md``)::
     # reference_wavelength = 587.5618
     # temperature_c = 25.0           # optional system environment (°C, atm): catalog glasses
     # pressure_atm = 1.0             #   follow it by Schott's dn/dT model
-    # scale_to_efl = 100.0           # optional: scale the whole lens to this paraxial EFL (mm)
+    # scale_to_efl = 100.0           # optional: scale the whole lens to this paraxial EFL (mm);
+    #                                #   [[configurations]] lengths are scaled with it
     object   = { distance = "inf" }  # mm from the object plane to the first vertex (> 0), or "inf"
     aperture = { fnumber = 4.0 }     # exactly one of fnumber / epd (mm) / na
     field    = { angle = 20.0 }      # exactly one of angle (max half-field, deg) / height (mm)
@@ -60,7 +61,9 @@ beside ``n`` or ``"air"``, and all but ``model`` beside an ``"nd/vd"`` glass. A 
 read as the ``.zmx`` reader reads a ``GCAT`` name
 (:func:`raytrace.glass.catalog.canonical_catalog`: any case, a dated Zemax name such as
 ``"SCHOTT_2017"``). A broken ``[[configurations]]`` block is refused with the message
-:func:`raytrace.files.configurations.read_configured` gives.
+:func:`raytrace.files.configurations.read_configured` gives. ``scale_to_efl`` scales the block's
+lengths too (thicknesses, object distances; ``"inf"`` stays), by the lens's factor
+(:func:`efl_scale`), so that the configurations describe the scaled lens.
 """
 
 from __future__ import annotations
@@ -652,10 +655,21 @@ def loads(text: str | bytes, *, path: str | Path | None = None) -> Lens:
         raise src.error(f"TOML syntax error: {msg}", line=line) from None
     if not data:
         raise src.error("the file holds no prescription (only comments or blank lines)", line=1)
-    return _build(src, data)
+    return _build(src, data)[0]
 
 
-def _build(src: _Source, data: dict[str, Any]) -> Lens:
+def efl_scale(data: dict[str, Any], *, text: str = "", path: str | Path | None = None) -> float:
+    """The factor ``scale_to_efl`` multiplies every length of the lens in parsed TOML ``data``
+    by (1.0 without the key): what :mod:`.configurations` scales the ``[[configurations]]``
+    lengths by, so that they describe the scaled lens. Builds the lens (its EFL gives the
+    factor); ``text`` (the file's text) and ``path`` place the errors, as :func:`loads` does."""
+    if "scale_to_efl" not in data:
+        return 1.0
+    return _build(_Source(text, None if path is None else str(path)), data)[1]
+
+
+def _build(src: _Source, data: dict[str, Any]) -> tuple[Lens, float]:
+    """The lens of ``data`` and the factor ``scale_to_efl`` scaled it by (1.0 without it)."""
     top = {k: (k,) for k in _TOP_KEYS}
     _check_keys(src, data, top, "the file", lambda k: src.key_line("", k))
     name = _string(src, data, "name", None)
@@ -764,8 +778,9 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
     )
     if solve:
         lens = _solve_gaussian(src, lens)
+    factor = 1.0
     if scale_to is not None:
-        lens = _scale_to_efl(src, lens, scale_to)
+        lens, factor = _scale_to_efl(src, lens, scale_to)
     if image_field is not None:
         from ..errors import TraceError
         from ..trace.image_field import field_for_image_height
@@ -778,19 +793,22 @@ def _build(src: _Source, data: dict[str, Any]) -> Lens:
                 f"field {kind} = {height!r}: {e}", src.key_line("field", kind)
             ) from None
     if "configurations" in data:
-        _check_configurations(src, data, lens)
-    return lens
+        _check_configurations(src, data, lens, factor)
+    return lens, factor
 
 
-def _check_configurations(src: _Source, data: dict[str, Any], lens: Lens) -> None:
+def _check_configurations(
+    src: _Source, data: dict[str, Any], lens: Lens, factor: float = 1.0
+) -> None:
     """Refuse a broken ``[[configurations]]`` block (read by :mod:`.configurations`) with the
     message :func:`~raytrace.files.configurations.read_configured` gives, at the line of the
-    configuration at fault (the lens itself does not use the block)."""
+    configuration at fault (the lens itself does not use the block). ``factor``: the
+    ``scale_to_efl`` factor, which the block's lengths are scaled by."""
     from .configurations import Configurations, check_surfaces, configurations_from_toml
 
     tables = data["configurations"]
     try:
-        confs = configurations_from_toml(data, path=src.path)
+        confs = configurations_from_toml(data, path=src.path, scale=factor)
         check_surfaces(lens, confs)
     except PrescriptionError as e:
         headers = [
@@ -803,7 +821,9 @@ def _check_configurations(src: _Source, data: dict[str, Any], lens: Lens) -> Non
             # the first table that fails on its own is the one at fault (each is independent)
             for t, header in zip(tables, headers, strict=True):
                 try:
-                    one = configurations_from_toml({"configurations": [t]}, path=src.path)
+                    one = configurations_from_toml(
+                        {"configurations": [t]}, path=src.path, scale=factor
+                    )
                     check_surfaces(lens, Configurations(one.configurations, 1, src.path or ""))
                 except PrescriptionError:
                     line = header
@@ -1227,7 +1247,8 @@ def _gaussian_refusal(d: float) -> str:
     )
 
 
-def _scale_to_efl(src: _Source, lens: Lens, target: float) -> Lens:
+def _scale_to_efl(src: _Source, lens: Lens, target: float) -> tuple[Lens, float]:
+    """The lens scaled to EFL ``target`` and the factor (every length multiplied by it)."""
     from ..paraxial import paraxial
 
     line = src.key_line("", "scale_to_efl")
@@ -1250,7 +1271,7 @@ def _scale_to_efl(src: _Source, lens: Lens, target: float) -> Lens:
     scaled = replace(scaled, notes=scaled.notes + "\n" + record if scaled.notes else record)
     if lens.image_solve == "gaussian":
         scaled = _solve_gaussian(src, scaled)
-    return scaled
+    return scaled, factor
 
 
 def provenance(lens: Lens) -> str | None:
