@@ -45,18 +45,46 @@ def check_executor(text: str) -> str:
     return text
 
 
+#: The warnings a worker process leaves to the parent, as (module, class name) (imported only
+#: when a worker starts: the kernels' module imports numba). The parent says each once, in one
+#: line; a worker would repeat it for every evaluation, in raw multi-line form on the parent's
+#: terminal. :func:`ignore_worker_warnings` applies the list in the workers of the global
+#: search's process pool (``raytrace.optimize.global_search._init_worker``) and of a Dask
+#: LocalCluster (:func:`dask_setup`).
+WORKER_QUIET_WARNINGS = (
+    # a glass evaluated outside its catalog data range: the parent warns when it evaluates the
+    # result (the best design of a global search, the nominal lens of a Monte Carlo) at the
+    # same wavelengths, once (with --strict it fails there)
+    ("raytrace.materials", "OutOfRangeWarning"),
+    # no writable numba kernel cache: the parent has said so in one line
+    ("raytrace.kernels.jit", "KernelCacheWarning"),
+)
+
+
+def ignore_worker_warnings() -> None:
+    """In a worker process: ignore the warning categories of :data:`WORKER_QUIET_WARNINGS`."""
+    import importlib
+    import warnings
+
+    for module, name in WORKER_QUIET_WARNINGS:
+        warnings.simplefilter("ignore", getattr(importlib.import_module(module), name))
+
+
 def dask_setup(worker) -> None:
     """Dask preload hook, run in each worker process that :func:`dask_client` starts: Ctrl-C in
     the terminal reaches the whole process group, and the workers leave it to this process
-    (which stops the work and keeps what finished) instead of dying with tracebacks; and the
+    (which stops the work and keeps what finished) instead of dying with tracebacks; the
     workers, which share this process's terminal, log nothing below CRITICAL (a task's error
     reaches this process as its exception; what they would log is the noise of a stopped run:
-    cancelled tasks, heartbeats to a scheduler already closed)."""
+    cancelled tasks, heartbeats to a scheduler already closed); and they leave the warnings of
+    :data:`WORKER_QUIET_WARNINGS` to this process (:func:`ignore_worker_warnings`, as the local
+    process pool's workers do)."""
     import logging
 
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     quiet_dask_logs(logging.CRITICAL)
+    ignore_worker_warnings()
 
 
 def quiet_dask_logs(level: int) -> None:
@@ -78,6 +106,7 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
     executor : str or distributed.Client
         ``"local"`` or ``"local:N"``: a Dask ``LocalCluster`` on this machine (N >= 1 worker
         processes, one thread each; ``"local"``: one per CPU), whose workers ignore Ctrl-C
+        and leave the warnings of :data:`WORKER_QUIET_WARNINGS` to this process
         (:func:`dask_setup`); ``"tcp://HOST:PORT"``: a running scheduler; a
         ``distributed.Client``: used as it is.
 

@@ -427,3 +427,82 @@ def test_bundled_calibrations_are_the_test_data(tmp_path, monkeypatch):
     assert rc == 0 and local != by_path
     rc, _, err = run(["camera", "convert", "no-such-calibration", "--model", "opencv"])
     assert rc == 2 and "no-such-calibration" in err
+
+
+# ------------------------------------------------------------- a flag of another form is refused
+_CAL = str(DATA / "cooke-measured-2m.yml")
+_FORM_ARGV = {
+    "lens": BASE,
+    "compare": ["camera", "compare", "cooke-triplet-f4", _CAL, "--sensor", "24x16",
+                "--grid", "9x7"],
+    "convert": ["camera", "convert", _CAL, "--model", "metashape", "-o", "{tmp}/out.xml"],
+    "variation": ["camera", "variation", str(DATA / "cooke-measured-1m.yml"),
+                  str(DATA / "cooke-measured-5m.yml"), "--calibrated-at", "1m,5m",
+                  "--focal-length", "50", "--focus", "2m", "--object-distances", "1m,2m,5m",
+                  "--sensor", "24x16", "-o", "{tmp}/table.csv"],
+}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "form,extra,words",
+    [
+        ("lens", ["--calibrated-at", "1m,5m"],
+         "--calibrated-at is not read by `camera LENS` (it is a flag of `camera variation`); "
+         "drop it"),
+        # given with its default value: still given
+        ("compare", ["--model", "opencv"],
+         "--model is not read by `camera compare` (it is a flag of `camera LENS` and `camera "
+         "convert`); drop it"),
+        ("convert", ["--grid", "9x7"],
+         "--grid is not read by `camera convert` (it is a flag of `camera LENS` and `camera "
+         "compare`); drop it"),
+        # an abbreviation with '=' is named by the flag's full name
+        ("convert", ["--gri=9x7"], "--grid is not read by `camera convert`"),
+        ("convert", ["--csv"], "--csv is not read by `camera convert`"),
+        ("variation", ["--pattern", "grid"],
+         "--pattern is not read by `camera variation` (it is a flag of `camera LENS`); drop it"),
+        ("variation", ["--no-clip", "--camera-id", "1", "--strict"],
+         "`camera variation` does not read --no-clip (a flag of `camera LENS` and `camera "
+         "compare`), --strict (a flag of `camera LENS` and `camera compare`); drop them"),
+    ],
+)  # fmt: skip
+def test_a_form_refuses_a_flag_it_does_not_read(form, extra, words, tmp_path):
+    """The command's one parser accepts every form's flags; a form refuses, before any work, a
+    flag it does not read (it was silently ignored: a review found `camera convert ... --grid`
+    running), naming the flag, the form and where the flag belongs."""
+    argv = [a.format(tmp=tmp_path) for a in _FORM_ARGV[form]]
+    rc, _, err = run([*argv, *extra])
+    assert rc == 2, err
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert len(lines) == 1 and words in lines[0], err
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_each_form_runs_with_its_own_flags(tmp_path):
+    """The refusal's baseline: each form's argv of the test above runs as it is (the foreign
+    flag is what fails it), also with a flag given at its default value (--method brown)."""
+    for form, argv in _FORM_ARGV.items():
+        argv = [a.format(tmp=tmp_path) for a in argv]
+        if form == "variation":
+            argv += ["--method", "brown"]
+        rc, _, err = run(argv)
+        assert rc == 0, (form, err)
+
+
+def test_form_flags_are_the_help_pages_and_cover_the_parser():
+    """One list: the flags a form accepts are those its help page shows (compare, convert,
+    variation), every flag of the command's parser is some form's, and every flag notes that
+    it was given (so none escapes the check)."""
+    from orthoscope.cli import build_parser
+    from orthoscope.cli.camera import ACTIONS, FORMS, _Noted, action_parser, form_flags
+
+    sub = build_parser("camera")._subparsers._group_actions[0].choices["camera"]
+    options = [a for a in sub._actions if a.option_strings and "--help" not in a.option_strings]
+    assert all(isinstance(a, _Noted) for a in options)
+    every = {o for a in options for o in a.option_strings}
+    assert set().union(*(form_flags(f) for f in FORMS)) == every
+    for form in ACTIONS:
+        page = {o for a in action_parser(form)._actions for o in a.option_strings}
+        assert page - {"-h", "--help"} == form_flags(form), form
+    assert {"--picture", "--grid", "--model", "--format"} <= form_flags("lens")
+    assert not {"--calibrated-at", "--camera-id", "--method"} & form_flags("lens")

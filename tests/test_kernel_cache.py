@@ -113,6 +113,13 @@ def test_compile_notice_when_a_kernel_compiles_and_only_then(monkeypatch, capsys
         err = capsys.readouterr().err
         assert err.count(cli.COMPILE_NOTICE) == expect, (uncached, events, err)
     assert sum(type(ls).__name__ == "Notice" for ls in event._registered["numba:compile"]) == 1
+    # after a run of main(), library use in the same process (a notebook, the next test) that
+    # compiles a kernel hears nothing from the command line
+    assert cli.main(["lenses"]) == 0
+    capsys.readouterr()
+    compile_(ours)
+    assert cli.COMPILE_NOTICE not in capsys.readouterr().err
+    assert not any(type(f).__name__ == "_BeforeMatplotlib" for f in sys.meta_path)
 
 
 def _array_types(sig):

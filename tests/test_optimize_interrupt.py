@@ -121,6 +121,33 @@ def test_scan_splits_ends_with_the_interrupted_trial(monkeypatch):
     assert trials[1].result.stopped == "interrupted" and math.isfinite(trials[1].merit)
 
 
+def test_scan_splits_keeps_finished_trials_when_ctrl_c_comes_between_runs(monkeypatch):
+    # a Ctrl-C outside a run's own loop (here: the second run's start evaluation, which
+    # propagates from optimize() by design) threw away the finished first trial
+    import raytrace.optimize.elements as elements
+
+    lens = load_lens("cooke-triplet-f4")
+    spec = cooke_split_spec(20)
+    real, runs = elements.optimize, []
+
+    def run(lens, spec, progress=None, **kw):
+        runs.append(1)
+        if len(runs) == 2:
+            raise KeyboardInterrupt
+        return real(lens, spec, progress, **kw)
+
+    monkeypatch.setattr(elements, "optimize", run)
+    trials = _kept(scan_splits, lens, spec)
+    assert [t.surface for t in trials] == [1, 3]
+    assert trials[0].result is not None and trials[0].stopped == ""
+    assert trials[1].result is None and trials[1].stopped == "interrupted"
+    # before any run finished there is nothing to keep: the Ctrl-C propagates
+    runs.clear()
+    runs.append(1)  # the next call is the "second"
+    with pytest.raises(KeyboardInterrupt):
+        scan_splits(lens, spec)
+
+
 # ----------------------------------------------------------------------------- the CLI
 @pytest.mark.parametrize("method", METHODS)
 def test_cli_interrupted_writes_the_best_design_marked(method, tmp_path, monkeypatch, capsys):

@@ -236,6 +236,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     finally:
         restore()
+        # the notice and the matplotlib finder belong to this run only (main() runs many times
+        # in one process in tests and notebooks; library use after it must not print)
+        if _NOTICE:
+            _NOTICE[0].quiet = True
+        sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _BeforeMatplotlib)]
 
 
 def _sigint_outside_llvm():
@@ -270,7 +275,9 @@ def _sigint_handler(signum, frame) -> None:
     milliseconds, so the Ctrl-C soon lands outside and the command stops the usual way (keeping
     what it has finished); compiling kernels on a new machine keeps numba on the stack for about
     a minute, so a Ctrl-C held back for more than :data:`SIGINT_HOLD_S` ends the process at once
-    (one line, status 130), with nothing finished to keep."""
+    (one line, status 130), with nothing finished to keep. That exit (``os._exit``) runs no
+    atexit handlers; every file a command writes is written atomically, so none is left half
+    written."""
     import signal
     import threading
     import time
@@ -515,19 +522,19 @@ def _compile_notice() -> None:
     from numba.core import event
 
     if _NOTICE:  # main() run again in one process: the listener is registered, say it anew
-        _NOTICE[0].said = False
+        _NOTICE[0].quiet = False  # main() sets it back when the run ends
         return
 
     from raytrace.kernels.jit import uncached
 
     class Notice(event.Listener):
-        said = False
+        quiet = False  # True once said, and outside a run of main()
 
         def on_start(self, ev) -> None:
             func = getattr(ev.data.get("dispatcher"), "py_func", None)
-            if self.said or not getattr(func, "__module__", "").startswith("raytrace."):
+            if self.quiet or not getattr(func, "__module__", "").startswith("raytrace."):
                 return
-            self.said = True
+            self.quiet = True
             if not uncached():
                 print(COMPILE_NOTICE, file=sys.stderr, flush=True)
 

@@ -11,6 +11,7 @@ from .common import (
     add_output_args,
     add_table_layout_arg,
     at_fields,
+    bundled_or_path,
     check_plot_path,
     print_result,
     save_plot,
@@ -35,18 +36,9 @@ OUTPUTS = [("--plot", ".png"), ("--plot-rotation", ".png")]
 
 
 def table_path(word: str) -> str:
-    """TABLE as given: an existing file as it is; otherwise a bare name (with or without ``.csv``)
-    of a table bundled in the lens library (``lenses/NAME.csv``, installed with the package, so
-    the name works from any folder); anything else unchanged (the reader says what is wrong)."""
-    from pathlib import Path
-
-    p = Path(word)
-    if p.exists() or p.name != word or not word.strip():
-        return word
-    from raytrace.files.library import library_dir
-
-    bundled = library_dir() / f"{word.strip().lower().removesuffix('.csv')}.csv"
-    return str(bundled) if bundled.is_file() else word
+    """TABLE as given, or the bundled table of that name (``lenses/NAME.csv``, e.g.
+    ``pestrecov-1958-table1-topogon``; :func:`~orthoscope.cli.common.bundled_or_path`)."""
+    return bundled_or_path(word, "", ".csv")
 
 
 def cmd_calibrate(args) -> int:

@@ -18,6 +18,7 @@ Four actions, chosen by the first word:
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 
 from .common import (
@@ -27,6 +28,7 @@ from .common import (
     add_output_args,
     add_strict_arg,
     add_wavelength_arg,
+    bundled_or_path,
     check_output_path,
     check_plot_path,
     first_repeat,
@@ -71,19 +73,9 @@ BUNDLED_CALIBRATIONS = (
 
 # ---------------------------------------------------------------------------------- helpers
 def calibration_path(word: str) -> str:
-    """A CALIBRATION as given: an existing file as it is; otherwise a bare name (with or without
-    ``.yml``) of a calibration bundled with the lens library (``lenses/calibrations/NAME.yml``,
-    installed with the package, so the name works from any folder); anything else unchanged
-    (the reader says what is wrong)."""
-    from pathlib import Path
-
-    p = Path(word)
-    if p.exists() or p.name != word or not word.strip():
-        return word
-    from raytrace.files.library import library_dir
-
-    bundled = library_dir() / "calibrations" / f"{word.strip().lower().removesuffix('.yml')}.yml"
-    return str(bundled) if bundled.is_file() else word
+    """A CALIBRATION as given, or the bundled calibration of that name
+    (``lenses/calibrations/NAME.yml``; :func:`~orthoscope.cli.common.bundled_or_path`)."""
+    return bundled_or_path(word, "calibrations", ".yml")
 
 
 def _write(path, data, args) -> None:
@@ -460,21 +452,97 @@ def cmd_camera(args) -> int:
     if head == "compare":
         if len(words) != 3:
             raise CliError(f"usage: {USAGE['compare']}")
+        _refuse_foreign_flags(args, "compare")
         return _cmd_compare(args, words[1], words[2])
     if head == "convert":
         if len(words) != 2:
             raise CliError(f"usage: {USAGE['convert']}")
+        _refuse_foreign_flags(args, "convert")
         return _cmd_convert(args, words[1])
     if head == "variation":
         if len(words) != 3:
             raise CliError(f"usage: {USAGE['variation']}")
+        _refuse_foreign_flags(args, "variation")
         return _cmd_variation(args, words[1], words[2])
     if len(words) != 1:
         raise CliError(
             f"orthoscope camera takes one LENS (or: {', '.join(ACTIONS)} ...); got "
             + " ".join(words)
         )
+    _refuse_foreign_flags(args, "lens")
     return _cmd_lens(args, head)
+
+
+# ------------------------------------------------------------------- the flags each form reads
+#: the forms of the command: ``camera LENS`` and the actions
+FORMS = ("lens", *ACTIONS)
+#: each form as its messages name it
+FORM_WORDS = {"lens": "`camera LENS`", **{a: f"`camera {a}`" for a in ACTIONS}}
+
+
+@functools.cache
+def form_flags(form: str) -> frozenset[str]:
+    """The option strings the form ``form`` (one of :data:`FORMS`) reads: those
+    :func:`_add_arguments` gives it, the list its help page shows (one list for the page and
+    for :func:`_refuse_foreign_flags`)."""
+    q = argparse.ArgumentParser(add_help=False)
+    _add_arguments(q, form)
+    return frozenset(o for a in q._actions for o in a.option_strings)
+
+
+def _refuse_foreign_flags(args, form: str) -> None:
+    """CliError naming each flag given (:func:`_note_given`) that ``form`` does not read, the
+    form, and the forms it belongs to: the one parser of the command accepts every form's
+    flags, and a flag the form does not read would otherwise be silently ignored."""
+    given = dict.fromkeys(getattr(args, GIVEN, ()))  # in the order given, each once
+    foreign = [flag for flag in given if flag not in form_flags(form)]
+    if not foreign:
+        return
+
+    def owners(flag: str) -> str:
+        names = [FORM_WORDS[f] for f in FORMS if flag in form_flags(f)]
+        return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+    where = FORM_WORDS[form]
+    if len(foreign) == 1:
+        flag = foreign[0]
+        raise CliError(f"{flag} is not read by {where} (it is a flag of {owners(flag)}); drop it")
+    each = ", ".join(f"{flag} (a flag of {owners(flag)})" for flag in foreign)
+    raise CliError(f"{where} does not read {each}; drop them")
+
+
+#: the namespace attribute in which the options of the command's parser note the option
+#: strings they were given by (:func:`_note_given`)
+GIVEN = "_given_flags"
+
+
+class _Noted:
+    """Mixin of an option of the command's parser: when given, it notes the option string it
+    was given by in the namespace (``GIVEN``), before doing what its action does. Given is told
+    apart from absent even when the value given is the default (``--model opencv``)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        noted = getattr(namespace, GIVEN, None)
+        if noted is None:
+            noted = []
+            setattr(namespace, GIVEN, noted)
+        noted.append(option_string or self.option_strings[0])
+        super().__call__(parser, namespace, values, option_string)
+
+
+_NOTED: dict[type, type] = {}
+
+
+def _note_given(q: argparse.ArgumentParser) -> None:
+    """Make every option of ``q`` but the help a :class:`_Noted` one (the same action, of a
+    subclass that notes it was given)."""
+    for a in q._actions:
+        if not a.option_strings or isinstance(a, (_CameraHelp, argparse._HelpAction)):
+            continue
+        cls = type(a)
+        if cls not in _NOTED:
+            _NOTED[cls] = type(f"Noted{cls.__name__}", (_Noted, cls), {})
+        a.__class__ = _NOTED[cls]
 
 
 # ---------------------------------------------------------------------------------- the parser
@@ -598,7 +666,8 @@ def action_parser(action: str) -> argparse.ArgumentParser:
 
 def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
     """The flags of ``orthoscope camera``: all of them (``action`` None, the parser), or those
-    ``action`` reads (its help page; the texts say them for that form)."""
+    the form ``action`` (one of :data:`FORMS`) reads: its help page (the texts say them for that
+    form) and the flags it accepts (:func:`form_flags`)."""
 
     def on(*forms: str) -> bool:
         return action is None or action in forms
@@ -614,6 +683,8 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
             help="A lens (file or bundled name); or 'compare LENS CALIBRATION', 'convert "
             "CALIBRATION', 'variation CAL1 CAL2' (each with its own --help).",
         )
+    elif action == "lens":
+        q.add_argument("lens", metavar="LENS", help="A lens file or bundled lens name.")
     elif action == "compare":
         q.add_argument("lens", metavar="LENS", help="A lens file or bundled lens name.")
         q.add_argument("calibration", metavar="CALIBRATION", help=CAL_HELP)
@@ -638,7 +709,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
         ),
     )
     g.add_argument("--sensor", metavar="WxH", help="Sensor size in mm, e.g. 36x24.")
-    if on("compare"):
+    if on("lens", "compare"):
         g.add_argument(
             "--pixels",
             metavar="CxR",
@@ -648,7 +719,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
             ),
         )
     g.add_argument("--pitch", metavar="UM", help="Pixel pitch in micrometres (or '0.006mm').")
-    if on("compare"):
+    if on("lens", "compare"):
         g.add_argument(
             "--principal-point",
             metavar="DX,DY",
@@ -656,7 +727,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
         )
     g.add_argument("--camera", metavar="SPEC.toml", help="A TOML camera spec (sensor, focus...).")
     m = q.add_argument_group(say("model", compare="chief rays"))
-    if on("convert"):
+    if on("lens", "convert"):
         m.add_argument(
             "--model",
             default="opencv",
@@ -680,7 +751,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
                 convert="--model opencv: fix the number of coefficients, 4, 5, 8, 12 or 14.",
             ),
         )
-    if on("compare"):
+    if on("lens", "compare"):
         m.add_argument(
             "--grid",
             metavar="CxR",
@@ -720,7 +791,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
             "--gaussian", action="store_true", help="Focused on the object (the default)."
         )
         add_wavelength_arg(q)
-    if action is None:
+    if on("lens"):
         t = q.add_argument_group("per object distance")
         t.add_argument(
             "--object-distances",
@@ -779,11 +850,11 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
                 **dict.fromkeys(ACTIONS, which[0].upper() + which[1:]),
             ),
         )
-    if on("convert"):
+    if on("lens", "convert"):
         o.add_argument("--format", metavar="FMT", help="The calibration file format, when the "
                        "name does not say (opencv-yaml, opencv-json, colmap, metashape, photoscan, "
                        "australis).")  # fmt: skip
-    if on("compare"):
+    if on("lens", "compare"):
         o.add_argument(
             "--plot",
             metavar="FILE",
@@ -793,7 +864,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
                 compare="A chart (.png/.svg/.pdf): radial curves beside the difference map.",
             ),
         )
-    if action is None:
+    if on("lens"):
         o.add_argument(
             "--picture",
             metavar="FILE.png",
@@ -812,7 +883,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
             help="undistort: the ideal image from the camera's; distort: the camera's from an "
             "ideal one.",
         )
-    if on("compare"):
+    if on("lens", "compare"):
         add_strict_arg(
             o,
             help=say(
@@ -860,4 +931,5 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Show this help and exit (after compare, convert or variation: that form's help).",
     )
     _add_arguments(q, None)
+    _note_given(q)
     q.set_defaults(func=cmd_camera)

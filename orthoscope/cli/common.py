@@ -135,6 +135,22 @@ def signed_list(text: str) -> str:
     return text
 
 
+def bundled_or_path(word: str, folder: str, suffix: str) -> str:
+    """A file argument as given: an existing file (or anything with a folder in it) as it is;
+    otherwise a bare name, with or without ``suffix``, of a file bundled with the lens library
+    (``lenses/FOLDER/NAME.SUFFIX``, installed with the package: the name works from any folder;
+    :func:`raytrace.files.library.bundled_file`); anything else unchanged (the reader says what
+    is wrong)."""
+    from pathlib import Path
+
+    if Path(word).exists() or Path(word).name != word or not word.strip():
+        return word
+    from raytrace.files.library import bundled_file
+
+    found = bundled_file(folder, word, suffix)
+    return word if found is None else str(found)
+
+
 def load(name: str, strict: bool = False):
     """Load a lens by bundled name or path (every reader the project has); ``strict``: refuse a
     glass that the file names but that is read only as a substitute (``--strict``)."""

@@ -321,7 +321,7 @@ def _run_split_scan(args, spec, lens, out, inputs) -> int:
             print(f"--split {t.surface}: {what}", file=sys.stderr, flush=True)
 
     trials = scan_splits(lens, spec, progress=said)  # a Ctrl-C ends it with the trials so far
-    stopped = next((t.result.stopped for t in trials if t.result and t.result.stopped), "")
+    stopped = next((t.stopped for t in trials if t.stopped), "")
     done = [t for t in trials if t.result is not None]
     if not done:
         raise CliError(

@@ -49,10 +49,13 @@ def library_dir() -> Path:
     return Path(str(importlib.resources.files(PACKAGE)))
 
 
-def bundled_file(folder: str, name: str | Path) -> Path | None:
-    """The bundled ``lenses/FOLDER/NAME.toml`` (``specs``, ``tolerances``) for a name as a person
-    types it (spaces around it, capitals), or None when there is none."""
-    p = library_dir() / folder / f"{Path(name).name.strip().lower()}.toml"
+def bundled_file(folder: str, name: str | Path, suffix: str = ".toml") -> Path | None:
+    """The bundled ``lenses/FOLDER/NAME.SUFFIX`` (``specs`` and ``tolerances`` .toml,
+    ``calibrations`` .yml; ``""`` the library itself, e.g. its .csv tables) for a name as a person
+    types it (spaces around it, capitals, with or without the suffix), or None when there is
+    none."""
+    stem = Path(name).name.strip().lower().removesuffix(suffix)
+    p = library_dir() / folder / f"{stem}{suffix}"
     return p if p.is_file() else None
 
 

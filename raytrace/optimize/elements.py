@@ -239,11 +239,14 @@ def insert_design(
 class SplitTrial:
     """One element of :func:`scan_splits`: its first ``surface`` (start-lens numbering), the
     local run's ``result`` on the lens with that element split (None when the split was refused
-    or the run failed: ``error`` says why)."""
+    or the run failed: ``error`` says why). ``stopped``: ``"interrupted"`` when a Ctrl-C ended
+    the scan in this trial (its ``result`` is then the best design it evaluated, or None when
+    it had evaluated none), else empty."""
 
     surface: int
     result: OptimizationResult | None
     error: str = ""
+    stopped: str = ""
 
     @property
     def merit(self) -> float:
@@ -265,20 +268,31 @@ def scan_splits(
     tuple of SplitTrial
         One per element (:func:`raytrace.elements.elements`), in surface order; the best is
         ``min(trials, key=lambda t: t.merit)``. The runs are deterministic: the same lens and
-        spec give the same trials. A run interrupted by Ctrl-C (its result's ``stopped`` is
-        ``"interrupted"``: the best design it evaluated) ends the scan: that trial is the last.
+        spec give the same trials. A Ctrl-C ends the scan: the trial it came in is the last,
+        with ``stopped == "interrupted"`` (its result the best design its run evaluated, or None
+        when none was); one before any run finished evaluating propagates.
     """
     check_spec(lens, spec, need_continuous=False)
-    out = []
+    out: list[SplitTrial] = []
     for k in elements(lens):
         try:
-            l2, s2 = split_design(lens, spec, k)
-            t = SplitTrial(k, optimize(l2, s2))
-        except (SpecError, *EVAL_FAILURES) as e:
-            t = SplitTrial(k, None, str(e))
-        out.append(t)
-        if progress is not None:
-            progress(t)
-        if t.result is not None and t.result.stopped:  # Ctrl-C: no more elements
+            try:
+                l2, s2 = split_design(lens, spec, k)
+                res = optimize(l2, s2)
+                t = SplitTrial(k, res, stopped=res.stopped)
+            except (SpecError, *EVAL_FAILURES) as e:
+                t = SplitTrial(k, None, str(e))
+            out.append(t)
+            if progress is not None:
+                progress(t)
+        except KeyboardInterrupt:  # between two runs, or before this one evaluated anything
+            if not any(o.result is not None for o in out):
+                raise  # nothing finished to keep
+            if not out or out[-1].surface != k:
+                out.append(SplitTrial(k, None, "interrupted", stopped="interrupted"))
+            else:
+                out[-1] = replace(out[-1], stopped="interrupted")
+            break
+        if t.stopped:  # Ctrl-C inside the run: no more elements
             break
     return tuple(out)

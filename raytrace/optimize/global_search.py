@@ -483,19 +483,12 @@ _WORKER: dict = {}
 
 
 def _init_worker(event, q) -> None:
-    import warnings
-
-    from ..kernels.jit import KernelCacheWarning
-    from ..materials import OutOfRangeWarning
+    from ..executors import ignore_worker_warnings
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides when to stop
-    # a glass evaluated outside its range warns in the parent, once, when the best design is
-    # evaluated there; in the workers it would warn at every evaluation of every start (a new
-    # text for each fitted model glass), in raw multi-line form on the parent's stderr
-    warnings.simplefilter("ignore", OutOfRangeWarning)
-    # no writable kernel cache: the parent has said so in one line; each worker would say it
-    # again, in raw two-line form
-    warnings.simplefilter("ignore", KernelCacheWarning)
+    # what the parent says once (a glass outside its range, no kernel cache) a worker would say
+    # at every evaluation, in raw multi-line form (raytrace.executors.WORKER_QUIET_WARNINGS)
+    ignore_worker_warnings()
     _WORKER["event"], _WORKER["queue"] = event, q
 
 

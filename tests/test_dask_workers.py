@@ -1,0 +1,99 @@
+"""The worker processes of a Dask LocalCluster (raytrace.executors.dask_client: the global
+search's starts, the Monte Carlo's chunks) leave to the parent the warnings the local process
+pool's workers leave to it (raytrace.executors.WORKER_QUIET_WARNINGS): a glass evaluated outside
+its range and a kernel cache that cannot be written. The parent says each once, in one line; a
+review found Dask's workers repeating them at every evaluation, in raw multi-line form, on the
+parent's terminal (the pool's initializer ignored them, the Dask preload did not).
+
+Each test runs in a child process: the preload hook ignores SIGINT, and the cluster's workers
+write to the child's stderr, which the test reads."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import warnings
+
+import pytest
+
+from raytrace.executors import WORKER_QUIET_WARNINGS, ignore_worker_warnings
+
+
+def test_the_list_names_warning_categories():
+    # a wrong name would fail every worker's start (the preload raises), not a test
+    import importlib
+
+    found = {getattr(importlib.import_module(m), n) for m, n in WORKER_QUIET_WARNINGS}
+    assert all(issubclass(c, Warning) for c in found)
+    from raytrace.kernels.jit import KernelCacheWarning
+    from raytrace.materials import OutOfRangeWarning
+
+    assert found == {OutOfRangeWarning, KernelCacheWarning}
+    with warnings.catch_warnings():  # the filters put back after the test
+        ignore_worker_warnings()
+        for c in found:
+            assert ("ignore", None, c, None, 0) in warnings.filters
+
+
+def test_the_preload_hook_ignores_what_workers_leave_to_the_parent():
+    # dask_setup as a worker runs it (no cluster): warned before it, silent after it; another
+    # warning still shows
+    code = (
+        "import warnings\n"
+        "from raytrace.executors import dask_setup\n"
+        "from raytrace.kernels.jit import KernelCacheWarning\n"
+        "from raytrace.materials import model_glass\n"
+        "model_glass(1.6, 40.0).index(1550.0)\n"  # before: warns
+        "warnings.warn('no cache (before)', KernelCacheWarning)\n"
+        "dask_setup(None)\n"
+        "model_glass(1.61, 41.0).index(1550.0)\n"
+        "warnings.warn('no cache (in a worker)', KernelCacheWarning)\n"
+        "warnings.warn('control (in a worker)', UserWarning)\n"
+        "print('ok')\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.strip() == "ok"
+    assert r.stderr.count("OutOfRangeWarning") == 1 and "1.6/40" in r.stderr
+    assert r.stderr.count("KernelCacheWarning") == 1 and "(before)" in r.stderr
+    assert "control (in a worker)" in r.stderr
+
+
+CLUSTER = """
+import warnings
+from raytrace.executors import dask_client
+from raytrace.kernels.jit import KernelCacheWarning
+from raytrace.materials import model_glass
+
+
+def glass():
+    return float(model_glass(1.6, 40.0).index(1550.0))
+
+
+if __name__ == "__main__":
+    client, close = dask_client("local:1")
+    try:
+        tasks = [
+            client.submit(glass, pure=False),
+            client.submit(warnings.warn, "no cache (in a worker)", KernelCacheWarning, pure=False),
+            client.submit(warnings.warn, "control (in a worker)", UserWarning, pure=False),
+        ]
+        for t in tasks:
+            t.result()
+    finally:
+        close()
+    print("ok")
+"""
+
+
+def test_local_cluster_workers_leave_the_warnings_to_the_parent(tmp_path):
+    # a real LocalCluster of one worker (about 3 s): its tasks warn; only the control warning
+    # reaches the terminal (which shows that the worker's warnings would)
+    pytest.importorskip("distributed")
+    script = tmp_path / "cluster.py"
+    script.write_text(CLUSTER)
+    r = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+    assert "control (in a worker)" in r.stderr, r.stderr
+    assert "OutOfRangeWarning" not in r.stderr and "KernelCacheWarning" not in r.stderr, r.stderr
