@@ -1,6 +1,6 @@
 """The worker processes of a Dask LocalCluster (raytrace.executors.dask_client: the global
-search's starts, the Monte Carlo's chunks) leave to the parent the warnings the local process
-pool's workers leave to it (raytrace.executors.WORKER_QUIET_WARNINGS): a glass evaluated outside
+search's starts, the Monte Carlo's chunks) and of the global search's process pool leave to the
+parent the same warnings (raytrace.executors.WORKER_QUIET_WARNINGS): a glass evaluated outside
 its range and a kernel cache that cannot be written. The parent says each once, in one line; a
 review found Dask's workers repeating them at every evaluation, in raw multi-line form, on the
 parent's terminal (the pool's initializer ignored them, the Dask preload did not).
@@ -35,17 +35,29 @@ def test_the_list_names_warning_categories():
             assert ("ignore", None, c, None, 0) in warnings.filters
 
 
-def test_the_preload_hook_ignores_what_workers_leave_to_the_parent():
-    # dask_setup as a worker runs it (no cluster): warned before it, silent after it; another
-    # warning still shows
+#: the set-up each kind of worker runs: the Dask preload hook and the process pool's initializer
+WORKER_SETUPS = {
+    "dask preload": ("from raytrace.executors import dask_setup", "dask_setup(None)"),
+    "process pool": (
+        "from raytrace.optimize.global_search import _init_worker",
+        "_init_worker(None, None)",
+    ),
+}
+
+
+@pytest.mark.parametrize("setup", sorted(WORKER_SETUPS))
+def test_a_worker_set_up_ignores_what_workers_leave_to_the_parent(setup):
+    # the set-up as a worker runs it (no cluster, no pool): warned before it, silent after it;
+    # another warning still shows
+    imp, call = WORKER_SETUPS[setup]
     code = (
         "import warnings\n"
-        "from raytrace.executors import dask_setup\n"
+        f"{imp}\n"
         "from raytrace.kernels.jit import KernelCacheWarning\n"
         "from raytrace.materials import model_glass\n"
         "model_glass(1.6, 40.0).index(1550.0)\n"  # before: warns
         "warnings.warn('no cache (before)', KernelCacheWarning)\n"
-        "dask_setup(None)\n"
+        f"{call}\n"
         "model_glass(1.61, 41.0).index(1550.0)\n"
         "warnings.warn('no cache (in a worker)', KernelCacheWarning)\n"
         "warnings.warn('control (in a worker)', UserWarning)\n"

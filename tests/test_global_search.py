@@ -480,39 +480,3 @@ def test_cli_dask_flags_are_checked(tmp_path: Path):
         )
         lines = [x for x in r.stderr.splitlines() if "compiling" not in x]
         assert r.returncode == 2 and len(lines) == 1 and msg in lines[0], r.stderr
-
-
-def test_a_worker_does_not_print_range_warnings():
-    # the parent warns once for the best design; a worker would warn at every evaluation, in
-    # raw multi-line form (run in a child process: the initializer ignores SIGINT)
-    import subprocess
-    import sys
-
-    code = (
-        "from raytrace.optimize.global_search import _init_worker\n"
-        "from raytrace.materials import model_glass\n"
-        "model_glass(1.6, 40.0).index(1550.0)\n"  # before: warns
-        "_init_worker(None, None)\n"
-        "model_glass(1.61, 41.0).index(1550.0)\n"
-        "print('ok')\n"
-    )
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert r.stdout.strip() == "ok"
-    assert r.stderr.count("OutOfRangeWarning") == 1 and "1.6/40" in r.stderr
-
-
-def test_a_worker_does_not_print_kernel_cache_warnings():
-    # no writable kernel cache: the parent says so in one line; each worker repeated it in raw
-    # two-line form (run in a child process: the initializer ignores SIGINT)
-    code = (
-        "import warnings\n"
-        "from raytrace.kernels.jit import KernelCacheWarning\n"
-        "from raytrace.optimize.global_search import _init_worker\n"
-        "warnings.warn('no cache (before)', KernelCacheWarning)\n"
-        "_init_worker(None, None)\n"
-        "warnings.warn('no cache (in a worker)', KernelCacheWarning)\n"
-        "print('ok')\n"
-    )
-    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert r.stdout.strip() == "ok"
-    assert r.stderr.count("KernelCacheWarning") == 1 and "(before)" in r.stderr
