@@ -67,7 +67,8 @@ BREAKDOWN: list[tuple[str, list[str]]] = [
     ("import numpy, numba", ["-c", "import numpy, numba"]),
 ]
 
-NOTICE = "compiling the ray-tracing kernels"
+#: the line a run that compiles a kernel prints (orthoscope.cli.COMPILE_NOTICE, its start)
+NOTICE = "orthoscope: compiling ray-tracing kernels"
 
 #: run in a child: one command in-process, then what it loaded
 PROBE = r"""

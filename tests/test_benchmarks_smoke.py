@@ -132,3 +132,8 @@ def test_startup_benchmark_one_round(tmp_path):
     assert 0 < r["cpu_median_s"] and 0 < r["wall_median_s"]
     assert r["loaded"]["kernels"] == {} and not r["loaded"]["imported"]["numba"]
     assert "<= 0.35" in "\n".join(mod.summarize(res))
+    # the warm-up knows a compiling run by the command line's notice (the notice's words changed
+    # once and the benchmark no longer saw it)
+    from orthoscope.cli import COMPILE_NOTICE
+
+    assert COMPILE_NOTICE.startswith(mod.NOTICE)
