@@ -294,6 +294,28 @@ def test_convert_keeps_to_the_model_and_coefficient_count_asked_for(tmp_path, mo
     fs.release()
 
 
+def test_the_table_of_models_refuses_the_one_distance_outputs(tmp_path, monkeypatch):
+    # with --object-distances, --plot / --picture / --maps / --format / --strict were accepted and
+    # ignored (exit 0, only the table written); -o of a comparison took any suffix and wrote JSON
+    # into a .png
+    monkeypatch.chdir(tmp_path)
+    base = ["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pixels", "1200x800",
+            "--grid", "9x7", "--object-distances", "1m,2m"]  # fmt: skip
+    for extra in (["--plot", "p.png"], ["--strict"], ["--maps", "m.npz", "--format", "colmap"]):
+        rc, out, err = run_cli([*base, *extra])
+        (line,) = err.strip().splitlines()
+        assert rc == 2 and "--object-distances" in line and extra[0] in line, err
+    assert not list(tmp_path.iterdir())
+    rc, out, err = run_cli([*base, "-o", "t.json"])
+    assert rc == 0 and (tmp_path / "t.json").is_file(), err
+    rc, out, err = run_cli(["camera", "compare", "cooke-triplet-f4",
+                            "cooke-triplet-f4-synthetic-2m", "--sensor", "24x16", "--grid", "9x7",
+                            "-o", "cmp.png"])  # fmt: skip
+    (line,) = err.strip().splitlines()
+    assert rc == 2 and "-o cmp.png: a comparison is written as .csv or .json" in line
+    assert not (tmp_path / "cmp.png").exists()
+
+
 def test_a_sensor_beyond_the_image_circle_is_said(tmp_path, monkeypatch):
     # the Cooke triplet images to r = 28 mm; a 60 x 40 sensor's corners are at 36 mm: the model
     # is extrapolated there (a warning), and --strict refuses before writing anything

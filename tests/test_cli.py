@@ -190,6 +190,12 @@ def test_compensate_identical_curves_leave_no_residual(capsys, tmp_path):
     assert rc == 0, err
     d = json.loads(out)
     assert max(abs(v) for v in d["residual_mm"]) < 2e-3
+    # the bundled copy of Table I by its name, as calibrate takes it (it was read as a lens name)
+    rc, out2, err = run(
+        capsys, "compensate", "pestrecov-1958-table1-topogon", str(printer), "--json"
+    )
+    assert rc == 0, err
+    assert json.loads(out2) == d
 
 
 @pytest.mark.parametrize(

@@ -246,6 +246,19 @@ def test_a_misspelt_key_is_one_problem_not_two(tmp_path):
     assert "unknown key 'feild' for operand distortion (did you mean 'field'?)" in lines[2]
 
 
+def test_a_path_with_a_folder_is_never_a_bundled_name(tmp_path, monkeypatch):
+    # nodir/twinplex-like-55-525 (a folder that does not exist) ran the bundled spec in silence
+    from raytrace.optimize import read_spec
+    from raytrace.tolerance.spec import resolve_spec_path
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SpecError, match="no such"):
+        read_spec("nodir/twinplex-like-55-525")
+    assert read_spec("twinplex-like-55-525").start  # the bare name still finds it
+    assert resolve_spec_path("nodir/cooke-triplet-f4") == Path("nodir/cooke-triplet-f4")
+    assert resolve_spec_path("cooke-triplet-f4").is_file()
+
+
 def test_cli_a_missing_spec_path_names_the_bundled_spec_of_that_name(tmp_path, monkeypatch, capsys):
     # the docs' path lenses/specs/twinplex-like-55-525.toml, typed outside the repository
     from orthoscope.cli import main

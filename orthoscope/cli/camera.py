@@ -212,6 +212,21 @@ def _emit(args, text: str, data: dict, csv: str | None = None, note: str | None 
         print(text)
 
 
+def _table_kind(path, what: str) -> str:
+    """``"csv"`` or ``"json"``, by the suffix of ``-o PATH``; a CliError for any other suffix
+    (``what``: what the command writes there)."""
+    suffix = str(path).lower().rsplit(".", 1)[-1]
+    if suffix not in ("csv", "json"):
+        raise CliError(f"-o {path}: {what} is written as .csv or .json")
+    return suffix
+
+
+#: the flags of ``camera LENS`` that only its one-distance run reads (not the table of models of
+#: --object-distances)
+ONE_DISTANCE_ONLY = ("--plot", "--picture", "--maps", "--maps-direction", "--pattern", "--format",
+                     "--strict")  # fmt: skip
+
+
 def _model_table_out(args, table, note: str | None = None) -> None:
     """A table of camera models per object distance: written to ``-o`` (.csv or .json) when
     given, and shown as text, JSON or CSV (:func:`_emit`, ``note`` as there)."""
@@ -221,9 +236,7 @@ def _model_table_out(args, table, note: str | None = None) -> None:
     if args.output:
         from ..report.jsonout import dumps
 
-        suffix = str(args.output).lower().rsplit(".", 1)[-1]
-        if suffix not in ("csv", "json"):
-            raise CliError(f"-o {args.output}: a table of models is written as .csv or .json")
+        suffix = _table_kind(args.output, "a table of models")
         text = model_table_csv(table) if suffix == "csv" else dumps(data) + "\n"
         _write(args.output, text, args)
     _emit(args, format_model_table(table), data, model_table_csv(table), note)
@@ -259,6 +272,15 @@ def _cmd_lens(args, lens_name: str) -> int:
     if args.object_distances is not None:
         if any(k is not None for k in (args.object_distance, args.object_s, args.object_scale)):
             raise CliError("--object-distances are the table's rows: leave out --object-distance")
+        unread = [f for f in dict.fromkeys(getattr(args, GIVEN, ())) if f in ONE_DISTANCE_ONLY]
+        if unread:
+            raise CliError(
+                f"with --object-distances the command writes the table of models per distance "
+                f"only: {', '.join(unread)} {'is' if len(unread) == 1 else 'are'} read for one "
+                f"object distance (--object-distance); drop {'it' if len(unread) == 1 else 'them'}"
+            )
+        if args.output:
+            _table_kind(args.output, "a table of models")  # before the trace
         objs = _distances(args.object_distances)
         table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
         _model_table_out(args, table, setup.resolve(lens).projection_centre)
@@ -346,6 +368,8 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
     check_output_path(args.output, args)
+    if args.output:
+        _table_kind(args.output, "a comparison")  # before the trace
     cal = read_calibration(cal_path, camera_id=args.camera_id)
     sensor = _sensor(args, cal)
     setup = _setup(args, sensor)
@@ -353,7 +377,7 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     if args.output:
         from ..report.jsonout import dumps
 
-        suffix = str(args.output).lower().rsplit(".", 1)[-1]
+        suffix = _table_kind(args.output, "a comparison")
         data = (
             comparison_csv(cmp)
             if suffix == "csv"

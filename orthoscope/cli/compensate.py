@@ -11,6 +11,7 @@ from .common import (
     add_alias,
     add_output_args,
     at_fields,
+    bundled_or_path,
     load,
     parse_list,
     print_result,
@@ -34,10 +35,11 @@ def _curve_from(arg: str, role: str, args, camera_curve=None):
     from distortion.characteristic import characteristic_distortion
     from distortion.tablefile import read_distortion_table
 
-    if Path(arg).suffix.lower() == ".csv":
+    table = bundled_or_path(arg, "", ".csv")  # a bundled table by name, as calibrate takes it
+    if Path(table).suffix.lower() == ".csv":
         if role == "camera" and args.fields:
             raise CliError(f"--fields goes with a CAMERA lens; the table {arg} has its own fields")
-        return read_distortion_table(arg)
+        return read_distortion_table(table)
     lens = load(arg)
     if role == "camera":
         if lens.field.kind != "angle" and not args.fields:

@@ -685,7 +685,7 @@ def read_spec(path: str | Path) -> DesignSpec:
         keys), one line each; also a missing file, a folder, text that is not UTF-8 or not TOML.
     """
     p = Path(path)
-    if not p.exists() and not p.suffix:  # a bundled spec by its name (lenses/specs/)
+    if not p.exists() and not p.suffix and len(p.parts) == 1:  # a bundled spec by its name
         from ..files.library import bundled_file
 
         p = bundled_file("specs", p) or p

@@ -478,7 +478,7 @@ def resolve_spec_path(path: str | Path) -> Path:
     """``path`` as given when it exists or has a suffix; else the bundled example of that name
     (``lenses/tolerances/NAME.toml``) when there is one; else ``path`` unchanged."""
     p = Path(path)
-    if p.exists() or p.suffix:
+    if p.exists() or p.suffix or len(p.parts) != 1:  # a path with a folder is never a name
         return p
     from ..files.library import bundled_file
 
