@@ -276,3 +276,49 @@ def test_cli_a_missing_spec_path_names_the_bundled_spec_of_that_name(tmp_path, m
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert line.endswith("no-such-design.toml: no such spec file")
     assert not (tmp_path / "out.toml").exists()
+
+
+def test_a_bare_spec_file_name_with_toml_finds_the_bundled_spec(tmp_path, monkeypatch):
+    # NAME.toml with no folder and no such local file: the bundled spec, as calibrate and camera
+    # find their bundled files by NAME.csv / NAME.yml (it was "no such spec file")
+    from raytrace.optimize import read_spec
+    from raytrace.tolerance.spec import resolve_spec_path
+
+    monkeypatch.chdir(tmp_path)
+    spec = read_spec("twinplex-like-55-525.toml")
+    assert Path(spec.path).parent.name == "specs"
+    assert spec.start == read_spec("twinplex-like-55-525").start
+    assert resolve_spec_path("cooke-triplet-f4.toml").is_file()
+    assert resolve_spec_path("nodir/cooke-triplet-f4.toml") == Path("nodir/cooke-triplet-f4.toml")
+    # a local file of that name is read first
+    (tmp_path / "twinplex-like-55-525.toml").write_text("start = 1\n")
+    with pytest.raises(SpecError, match="'start'"):
+        read_spec("twinplex-like-55-525.toml")
+
+
+def test_cli_a_lens_given_as_spec_says_so_in_one_line(tmp_path, monkeypatch, capsys):
+    # a bundled spec's start lens (lenses/specs/*-start.toml) by its name printed a 9-line
+    # "unknown key 'source'" error
+    from orthoscope.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    for name in ("twinplex-like-55-525-start", "twinplex-like-55-525-start.toml"):
+        assert main(["optimize", name, "-o", "out.toml"]) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert line == (
+            f"orthoscope optimize: error: {name} is a lens (a spec's start lens), not a design "
+            "spec: give a spec, e.g. `orthoscope optimize twinplex-like-55-525`"
+        )
+    # any lens file: no spec starts from it, so the bundled spec names
+    lens = Path(__file__).parents[1] / "lenses" / "cooke-triplet-f4.toml"
+    assert main(["optimize", str(lens), "-o", "out.toml"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(f"orthoscope optimize: error: {lens} is a lens, not a design spec")
+    assert "twinplex-like-55-525, " in line or line.endswith("twinplex-like-55-525")
+    # the docs' folder path of a start lens, typed outside the repository
+    spec = "lenses/specs/twinplex-like-55-525-start.toml"
+    assert main(["optimize", spec, "-o", "out.toml"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(f"orthoscope optimize: error: {spec}: no such spec file; ")
+    assert line.endswith("give a spec, e.g. `orthoscope optimize twinplex-like-55-525`")
+    assert not (tmp_path / "out.toml").exists()

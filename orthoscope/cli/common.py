@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -136,19 +137,15 @@ def signed_list(text: str) -> str:
 
 
 def bundled_or_path(word: str, folder: str, suffix: str) -> str:
-    """A file argument as given: an existing file (or anything with a folder in it) as it is;
-    otherwise a bare name, with or without ``suffix``, of a file bundled with the lens library
+    """A file argument as given, or the file of that name bundled with the lens library
     (``lenses/FOLDER/NAME.SUFFIX``, installed with the package: the name works from any folder;
-    :func:`raytrace.files.library.bundled_file`); anything else unchanged (the reader says what
-    is wrong)."""
-    from pathlib import Path
-
-    if Path(word).exists() or Path(word).name != word or not word.strip():
+    :func:`raytrace.files.library.bundled_or_given`), as the text the readers take."""
+    if not word.strip():
         return word
-    from raytrace.files.library import bundled_file
+    from raytrace.files.library import bundled_or_given
 
-    found = bundled_file(folder, word, suffix)
-    return word if found is None else str(found)
+    found = bundled_or_given(word, folder, suffix)
+    return word if found == Path(word) else str(found)
 
 
 def load(name: str, strict: bool = False):

@@ -239,19 +239,62 @@ def _search_overrides(args) -> dict:
     return over
 
 
+def _toml_table(path: Path) -> dict | None:
+    """The TOML table of the file ``path``, or None when it cannot be read as one."""
+    import tomllib
+
+    try:
+        return tomllib.loads(path.read_bytes().decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+
+
+def _is_lens(d: dict | None) -> bool:
+    """Whether a TOML table is a lens prescription (surfaces, no variables or operands)."""
+    return d is not None and "surfaces" in d and not ("variables" in d or "operands" in d)
+
+
+def _not_a_spec(what: str, lens: Path) -> str:
+    """One line for a lens prescription given as SPEC: the bundled spec whose start it is, else
+    the bundled spec names."""
+    from raytrace.files.library import library_dir
+
+    specs = {}  # bundled spec name -> its start lens (resolved path), when a file
+    for f in sorted((library_dir() / "specs").glob("*.toml"), key=lambda f: f.stem):
+        d = _toml_table(f)
+        if d is not None and not _is_lens(d) and isinstance(d.get("start"), str):
+            specs[f.stem] = (f.parent / d["start"]).resolve()
+    mine = [n for n, start in specs.items() if start == lens.resolve()]
+    if mine:
+        return (
+            f"{what} is a lens (a spec's start lens), not a design spec: give a spec, e.g. "
+            f"`orthoscope optimize {mine[0]}`"
+        )
+    return (
+        f"{what} is a lens, not a design spec: give a spec (docs/spec.md), e.g. a bundled one, "
+        f"`orthoscope optimize NAME` with NAME one of {', '.join(specs)}"
+    )
+
+
 def _read_spec(text: str):
     """The spec SPEC.toml; a path that does not exist but names a bundled spec says how to run
-    that one (a spec path copied from the docs, run outside the repository)."""
+    that one (a spec path copied from the docs, run outside the repository), and a lens
+    prescription (e.g. a bundled spec's start lens) given as SPEC says it is no spec."""
     from raytrace.files.library import bundled_file
     from raytrace.optimize import SpecError, read_spec
+    from raytrace.optimize.spec import resolve_spec_path
 
     try:
         return read_spec(text)
     except SpecError as e:
-        p = Path(text)
+        p = resolve_spec_path(text)
+        if p.is_file() and _is_lens(_toml_table(p)):
+            raise SpecError(_not_a_spec(text, p)) from None
         b = None if p.exists() or p.suffix.lower() != ".toml" else bundled_file("specs", p.stem)
         if b is None:
             raise
+        if _is_lens(_toml_table(b)):
+            raise SpecError(f"{e}; {_not_a_spec(f'the bundled {b.stem}', b)}") from None
         raise SpecError(
             f"{e}; the bundled spec of that name is `orthoscope optimize {b.stem}`"
         ) from None

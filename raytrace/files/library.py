@@ -59,6 +59,17 @@ def bundled_file(folder: str, name: str | Path, suffix: str = ".toml") -> Path |
     return p if p.is_file() else None
 
 
+def bundled_or_given(path: str | Path, folder: str, suffix: str = ".toml") -> Path:
+    """The file a command reads for a file argument: ``path`` itself when it exists, has a folder
+    (a path with one is never a name) or a suffix other than ``suffix``; else, for a bare NAME or
+    NAME.SUFFIX, the bundled ``lenses/FOLDER/NAME.SUFFIX`` (:func:`bundled_file`) when there is
+    one; else ``path`` (its reader then says what is missing)."""
+    p = Path(path)
+    if p.exists() or p.suffix.lower() not in ("", suffix) or len(p.parts) != 1:
+        return p
+    return bundled_file(folder, p, suffix) or p
+
+
 def bundled_names() -> list[str]:
     """Names of the bundled lenses (file stems), sorted."""
     return sorted(p.stem for p in library_dir().glob("*.toml"))

@@ -644,6 +644,16 @@ def _search_settings(d: dict, at: str, probs: _Problems) -> SearchSettings:
     return SearchSettings(**kw)
 
 
+def resolve_spec_path(path: str | Path) -> Path:
+    """The file :func:`read_spec` reads for ``path``: ``path`` itself when it exists, has a
+    folder or a suffix other than ``.toml``; else (a bare NAME or NAME.toml) the bundled
+    ``lenses/specs/NAME.toml`` when there is one (:func:`raytrace.files.library.bundled_or_given`);
+    else ``path``."""
+    from ..files.library import bundled_or_given
+
+    return bundled_or_given(path, "specs")
+
+
 def read_spec(path: str | Path) -> DesignSpec:
     """Read a TOML design spec (the language: ``docs/spec.md``; examples: ``lenses/specs/``)::
 
@@ -671,8 +681,8 @@ def read_spec(path: str | Path) -> DesignSpec:
     Parameters
     ----------
     path : str or Path
-        The spec file (UTF-8 TOML), or the name (no suffix) of a bundled spec in
-        ``lenses/specs/``.
+        The spec file (UTF-8 TOML), or the name (with or without ``.toml``, no folder) of a
+        bundled spec in ``lenses/specs/`` when no file of that name is here.
 
     Returns
     -------
@@ -684,11 +694,7 @@ def read_spec(path: str | Path) -> DesignSpec:
         Listing every problem (unknown keys with the nearest valid one, wrong types, missing
         keys), one line each; also a missing file, a folder, text that is not UTF-8 or not TOML.
     """
-    p = Path(path)
-    if not p.exists() and not p.suffix and len(p.parts) == 1:  # a bundled spec by its name
-        from ..files.library import bundled_file
-
-        p = bundled_file("specs", p) or p
+    p = resolve_spec_path(path)
     try:
         raw = p.read_bytes()
         d = tomllib.loads(raw.decode("utf-8-sig"))  # a byte-order mark is no error

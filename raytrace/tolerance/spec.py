@@ -475,14 +475,12 @@ def bundled_spec_dir() -> Path:
 
 
 def resolve_spec_path(path: str | Path) -> Path:
-    """``path`` as given when it exists or has a suffix; else the bundled example of that name
-    (``lenses/tolerances/NAME.toml``) when there is one; else ``path`` unchanged."""
-    p = Path(path)
-    if p.exists() or p.suffix or len(p.parts) != 1:  # a path with a folder is never a name
-        return p
-    from ..files.library import bundled_file
+    """``path`` as given when it exists, has a folder or a suffix other than ``.toml``; else (a
+    bare NAME or NAME.toml) the bundled example of that name (``lenses/tolerances/NAME.toml``)
+    when there is one (:func:`raytrace.files.library.bundled_or_given`); else ``path``."""
+    from ..files.library import bundled_or_given
 
-    return bundled_file("tolerances", p) or p
+    return bundled_or_given(path, "tolerances")
 
 
 def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
@@ -507,8 +505,8 @@ def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
 
     A ``.zmx`` path reads the file's TOL lines instead
     (:func:`raytrace.tolerance.zemax_tol.read_zmx_tolerances`). A bare name that is not a file
-    (no suffix) is a bundled example, one per bundled lens and named like it
-    (``read_tolerance_spec("topogon-like-pestrecov")``).
+    (no folder; with or without ``.toml``) is a bundled example, one per bundled lens and named
+    like it (``read_tolerance_spec("topogon-like-pestrecov")``).
 
     Parameters
     ----------
