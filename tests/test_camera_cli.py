@@ -90,11 +90,12 @@ def test_calibration_file_written_is_what_cv2_reads(tmp_path, monkeypatch, cooke
     a = project(written, ideal, pixels="opencv").points
     b = project(api.camera, ideal, pixels="opencv").points
     assert np.abs(a - b).max() < 1e-6
-    # an existing file needs --force; a model the format cannot hold is refused with the fix
+    # an existing file needs --force; a file of another model family than --model's is refused
+    # with the fix (test_the_output_file_is_of_the_model_family_asked_for)
     rc, _, err = run([*BASE, "-o", "cam.yml"], tmp_path, monkeypatch)
     assert rc == 2 and "--force" in err and len(err.strip().splitlines()) == 1
     rc, _, err = run([*BASE, "--model", "fisheye", "-o", "m.xml"], tmp_path, monkeypatch)
-    assert rc == 2 and "convert" in err and not (tmp_path / "m.xml").exists()
+    assert rc == 2 and "give --model metashape" in err and not (tmp_path / "m.xml").exists()
 
 
 def test_camera_spec_toml_and_flags(tmp_path, monkeypatch, cooke):
@@ -528,3 +529,98 @@ def test_form_flags_are_the_help_pages_and_cover_the_parser():
         assert page - {"-h", "--help"} == form_flags(form), form
     assert {"--picture", "--grid", "--model", "--format"} <= form_flags("lens")
     assert not {"--calibrated-at", "--camera-id", "--method"} & form_flags("lens")
+
+
+# ------------------------------------------------- flags that were accepted and silently ignored
+def test_principal_point_replaces_the_specs_offset_in_compare(tmp_path):
+    # with --camera and no --sensor / --pitch, compare took the spec's sensor whole and dropped
+    # --principal-point (camera LENS --camera ... --principal-point replaced the offset)
+    spec = tmp_path / "cam.toml"
+    spec.write_text(
+        '[sensor]\nsize = "24x16"\npixels = "3000x2000"\nprincipal_point_offset_mm = [1.0, 1.0]\n',
+        encoding="utf-8",
+    )
+    argv = ["camera", "compare", "cooke-triplet-f4", _CAL, "--camera", str(spec), "--grid",
+            "9x7", "--json"]  # fmt: skip
+    outs = {}
+    for pp in (None, "1,1", "0,0"):
+        rc, out, err = run([*argv, *(["--principal-point", pp] if pp else [])])
+        assert rc == 0, err
+        outs[pp] = json.loads(out)["comparison"]
+    assert outs[None] == outs["1,1"]  # the spec's offset, given again: the same
+    assert outs["0,0"] != outs[None]
+    # the offset 0,0 is the one of the same sensor without the spec
+    rc, out, err = run(["camera", "compare", "cooke-triplet-f4", _CAL, "--sensor", "24x16",
+                        "--grid", "9x7", "--json"])  # fmt: skip
+    assert rc == 0, err
+    assert json.loads(out)["comparison"] == outs["0,0"]
+
+
+def test_gaussian_replaces_the_specs_focus(tmp_path):
+    # --gaussian was ignored with a spec that sets [focus] (focused at 2m), while --defocus
+    # replaced it
+    spec = tmp_path / "cam.toml"
+    spec.write_text(
+        '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[focus]\ndistance = "2m"\n'
+        '[object]\ndistance = "5m"\n[trace]\ngrid = [9, 7]\n',
+        encoding="utf-8",
+    )
+    rc, out, err = run(["camera", "cooke-triplet-f4", "--camera", str(spec), "--gaussian",
+                        "--json"])  # fmt: skip
+    assert rc == 0, err
+    g = json.loads(out)["geometry"]
+    assert g["focus_object_distance_mm"] == 5000.0 and g["object_distance_mm"] == 5000.0
+    rc, out, err = run(["camera", "cooke-triplet-f4", "--camera", str(spec), "--json"])
+    assert rc == 0 and json.loads(out)["geometry"]["focus_object_distance_mm"] == 2000.0
+
+
+@pytest.mark.parametrize(
+    "argv,words",
+    [
+        ([*BASE, "--pattern", "grid"],
+         "--pattern sets the pattern of --picture: give --picture, or drop --pattern"),
+        ([*BASE, "--maps-direction", "undistort"],
+         "--maps-direction sets the direction of --maps: give --maps, or drop --maps-direction"),
+        ([*BASE, "--format", "colmap"],
+         "--format sets the file format of -o: give -o, or drop --format"),
+        (["camera", "convert", _CAL, "--model", "metashape", "--format", "metashape"],
+         "--format sets the file format of -o: give -o, or drop --format"),
+        (["camera", "convert", _CAL, "--model", "metashape", "--camera-id", "1"],
+         "--camera-id chooses a camera of a COLMAP cameras.txt, and "),
+        (["camera", "compare", "cooke-triplet-f4", _CAL, "--sensor", "24x16", "--grid", "9x7",
+          "--camera-id", "1"], "drop --camera-id"),
+        (["camera", "variation", str(DATA / "cooke-measured-1m.yml"),
+          str(DATA / "cooke-measured-5m.yml"), "--calibrated-at", "1m,5m", "--focal-length", "50",
+          "--focus", "2m", "--object-distances", "1m,2m", "--sensor", "24x16", "--camera-id",
+          "1"], "drop --camera-id"),
+    ],
+)  # fmt: skip
+def test_a_flag_that_would_do_nothing_is_refused(argv, words, tmp_path, monkeypatch):
+    # each was accepted and did nothing (exit 0); given at its default value it is given too
+    rc, _, err = run(argv, tmp_path, monkeypatch)
+    assert rc == 2, err
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert len(lines) == 1 and words in lines[0], err
+    assert not list(tmp_path.iterdir())
+
+
+def test_the_output_file_is_of_the_model_family_asked_for(tmp_path, monkeypatch):
+    # convert --model metashape -o cameras.txt said "opencv -> metashape: exact" and wrote a
+    # COLMAP FULL_OPENCV camera; the file's format and --model must name one family
+    rc, _, err = run(["camera", "convert", _CAL, "--model", "metashape", "-o", "cameras.txt"],
+                     tmp_path, monkeypatch)  # fmt: skip
+    (line,) = err.strip().splitlines()
+    assert rc == 2 and line.endswith(
+        "-o cameras.txt writes the colmap family but --model metashape converts to metashape: "
+        "give --model colmap, or -o a file of the metashape family (.xml)"
+    ), err
+    rc, _, err = run(["camera", "convert", _CAL, "--model", "colmap", "-o", "m.txt", "--format",
+                      "australis"], tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 2 and "-o m.txt --format australis writes the australis family" in err, err
+    rc, _, err = run([*BASE, "--model", "metashape", "-o", "cameras.txt"], tmp_path, monkeypatch)
+    assert rc == 2 and "--model metashape fits metashape: give --model colmap" in err, err
+    assert not list(tmp_path.iterdir())
+    rc, _, err = run(["camera", "convert", _CAL, "--model", "colmap", "-o", "cameras.txt"],
+                     tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    assert read_calibration(tmp_path / "cameras.txt").model.startswith("colmap:")

@@ -460,7 +460,8 @@ def _read_australis(text: str, path: Path) -> CameraModel:
 
 
 # ---- writing ------------------------------------------------------------------------------------
-_FAMILY = {
+#: the model family each calibration file format holds (what ``write`` needs of a camera)
+FORMAT_FAMILY = {
     "opencv-yaml": "opencv",
     "opencv-json": "opencv",
     "colmap": "colmap",
@@ -479,7 +480,7 @@ _SUGGEST = {
 
 
 def _for_format(camera: CameraModel, fmt: str) -> CameraModel:
-    family = _FAMILY[fmt]
+    family = FORMAT_FAMILY[fmt]
     try:
         return smallest_exact(camera, family)
     except NotRepresentable as e:

@@ -98,19 +98,15 @@ def _grid(text: str | None):
         raise CliError(f"--grid {text}: {e}; write it as columns x rows, e.g. 25x17") from None
 
 
+#: the focus keywords of CameraSetup (the focused object, or the sensor plane), each a flag
+FOCUS_KEYS = ("focus", "focus_s", "focus_scale", "s_prime", "from_last_vertex", "defocus")
+
+
 def _setup_keywords(args) -> dict:
     """The object / focus / trace keywords of CameraSetup from the flags (strings are parsed by
     CameraSetup, one path for the API and the command line)."""
-    plane = {
-        k: getattr(args, k)
-        for k in ("s_prime", "from_last_vertex", "defocus")
-        if getattr(args, k, None) is not None
-    }
-    focus = {
-        k: getattr(args, k)
-        for k in ("focus", "focus_s", "focus_scale")
-        if getattr(args, k, None) is not None
-    }
+    plane = {k: getattr(args, k) for k in FOCUS_KEYS[3:] if getattr(args, k, None) is not None}
+    focus = {k: getattr(args, k) for k in FOCUS_KEYS[:3] if getattr(args, k, None) is not None}
     if len(plane) + len(focus) > 1:
         flags = ", ".join("--" + k.replace("_", "-") for k in (*focus, *plane))
         raise CliError(f"give the focus one way, not {flags}")
@@ -148,7 +144,10 @@ def _sensor(args, calibration=None):
                     f"{calibration.width}x{calibration.height} px"
                 )
         if args.sensor is None and args.pitch is None and base is not None:
-            return sensor_for_calibration(calibration, base)
+            s = sensor_for_calibration(calibration, base)
+            if off is not None:  # --principal-point replaces the spec's offset
+                return Sensor(s.width_mm, s.height_mm, s.width_px, s.height_px, off)
+            return s
         return sensor_for_calibration(
             calibration,
             size=args.sensor,
@@ -183,7 +182,10 @@ def _setup(args, sensor):
 
     kw = _setup_keywords(args)
     if args.camera:
-        return read_camera_setup(args.camera).replace(sensor=sensor, **kw)
+        spec = read_camera_setup(args.camera)
+        if getattr(args, "gaussian", False):  # replaces the spec's focus, as --defocus does
+            spec = spec.replace(**dict.fromkeys(FOCUS_KEYS))
+        return spec.replace(sensor=sensor, **kw)
     return CameraSetup(sensor, **kw)
 
 
@@ -219,6 +221,73 @@ def _table_kind(path, what: str) -> str:
     if suffix not in ("csv", "json"):
         raise CliError(f"-o {path}: {what} is written as .csv or .json")
     return suffix
+
+
+#: the flags that set something of another flag's output: the flag each needs, the attribute
+#: of its value and what it sets (without that flag it would do nothing)
+NEEDS = {
+    "--pattern": ("--picture", "picture", "the pattern of --picture"),
+    "--maps-direction": ("--maps", "maps", "the direction of --maps"),
+    "--format": ("-o", "output", "the file format of -o"),
+}
+
+
+def _refuse_idle_flags(args) -> None:
+    """CliError for a flag given (:func:`_note_given`, so also at its default value) without
+    the flag whose output it sets (:data:`NEEDS`)."""
+    given = getattr(args, GIVEN, ())
+    for flag, (needs, dest, what) in NEEDS.items():
+        if flag in given and not getattr(args, dest, None):
+            raise CliError(f"{flag} sets {what}: give {needs}, or drop {flag}")
+
+
+def _read_calibrations(args, *paths):
+    """The calibrations at ``paths`` (--camera-id choosing a camera of a COLMAP cameras.txt);
+    a CliError for --camera-id given where none of them is a COLMAP file (it would do
+    nothing)."""
+    from pathlib import Path
+
+    from distortion.camera import read_calibration
+    from distortion.camera.files import detect_format
+
+    cals = [read_calibration(p, camera_id=args.camera_id) for p in paths]
+    if "--camera-id" in getattr(args, GIVEN, ()):
+        fmts = [detect_format(p, Path(p).read_text(encoding="utf-8-sig")) for p in paths]
+        if "colmap" not in fmts:
+            what = " and ".join(f"{p} is {f}" for p, f in zip(paths, fmts, strict=True))
+            raise CliError(
+                f"--camera-id chooses a camera of a COLMAP cameras.txt, and {what}: drop "
+                "--camera-id"
+            )
+    return cals
+
+
+#: the file names of each model family's calibration files (for the messages)
+FAMILY_FILES = {
+    "opencv": ".yml, .yaml or .json",
+    "colmap": "cameras.txt",
+    "metashape": ".xml",
+    "australis": ".aus",
+}
+
+
+def _calibration_out_format(args, camera, verb: str) -> str:
+    """The format of the calibration file ``-o`` (its name, or --format); a CliError where the
+    format is of another model family than ``camera`` (the file would hold another model than
+    the one --model asked for and the output states)."""
+    from distortion.camera.files import FORMAT_FAMILY  # format -> model family, as files.py writes
+
+    fmt = _calibration_format(args.output, args.format)
+    have, want = FORMAT_FAMILY[fmt], camera.spec.target
+    if have != want:
+        how = f" --format {args.format}" if args.format else ""
+        default = "" if "--model" in getattr(args, GIVEN, ()) else " (the default)"
+        raise CliError(
+            f"-o {args.output}{how} writes the {have} family but --model {args.model}{default} "
+            f"{verb} {camera.model}: give --model {have}, or -o a file of the {want} family "
+            f"({FAMILY_FILES[want]})"
+        )
+    return fmt
 
 
 #: the flags of ``camera LENS`` that only its one-distance run reads (not the table of models of
@@ -285,6 +354,7 @@ def _cmd_lens(args, lens_name: str) -> int:
         table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
         _model_table_out(args, table, setup.resolve(lens).projection_centre)
         return 0
+    _refuse_idle_flags(args)
     tc = camera_model(lens, setup, args.model, n_coefficients=n)
     if tc.points.n_failed:
         import numpy as np
@@ -304,7 +374,7 @@ def _cmd_lens(args, lens_name: str) -> int:
             "it (and its maps and picture) is not the lens's; --strict refuses such a run"
         )
     if args.output:
-        fmt = _calibration_format(args.output, args.format)
+        fmt = _calibration_out_format(args, tc.camera, "fits")
         _write(args.output, tc.calibration_text(fmt), args)
     _emit(args, format_traced_camera(tc), traced_camera_to_dict(tc), points_csv(tc),
           tc.geometry.projection_centre)  # fmt: skip
@@ -359,7 +429,7 @@ def _npz(maps) -> bytes:
 
 
 def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
-    from distortion.camera import compare_calibration, read_calibration
+    from distortion.camera import compare_calibration
 
     from ..report.camera import comparison_csv, comparison_to_dict, format_comparison
 
@@ -370,7 +440,7 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     check_output_path(args.output, args)
     if args.output:
         _table_kind(args.output, "a comparison")  # before the trace
-    cal = read_calibration(cal_path, camera_id=args.camera_id)
+    (cal,) = _read_calibrations(args, cal_path)
     sensor = _sensor(args, cal)
     setup = _setup(args, sensor)
     cmp = compare_calibration(lens, cal, setup, label=f"measured ({cal_word})")
@@ -394,7 +464,7 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
 
 
 def _cmd_convert(args, cal_word: str) -> int:
-    from distortion.camera import convert_camera_model, read_calibration, smallest_exact
+    from distortion.camera import convert_camera_model, smallest_exact
     from distortion.camera.models import CameraModel
     from distortion.errors import DataError
 
@@ -403,7 +473,8 @@ def _cmd_convert(args, cal_word: str) -> int:
     cal_path = calibration_path(cal_word)
     args._inputs = [p for p in (cal_path, args.camera) if p]
     check_output_path(args.output, args)
-    cal = read_calibration(cal_path, camera_id=args.camera_id)
+    _refuse_idle_flags(args)
+    (cal,) = _read_calibrations(args, cal_path)
     target = {"fisheye": "opencv_fisheye", "colmap": "colmap:FULL_OPENCV",
               "colmap-fisheye": "colmap:OPENCV_FISHEYE"}.get(args.model, args.model)  # fmt: skip
     ps = cal.pixel_size_mm
@@ -424,7 +495,7 @@ def _cmd_convert(args, cal_word: str) -> int:
             target = exact
     conv = convert_camera_model(cal, target, free=args.coefficients)
     if args.output:
-        fmt = _calibration_format(args.output, args.format)
+        fmt = _calibration_out_format(args, conv.camera, "converts to")
         from distortion.camera import format_calibration
 
         _write(args.output, format_calibration(conv.camera, fmt), args)
@@ -433,7 +504,7 @@ def _cmd_convert(args, cal_word: str) -> int:
 
 
 def _cmd_variation(args, word1: str, word2: str) -> int:
-    from distortion.camera import calibrated_models_by_distance, read_calibration
+    from distortion.camera import calibrated_models_by_distance
 
     cal1, cal2 = calibration_path(word1), calibration_path(word2)
     args._inputs = [cal1, cal2]
@@ -446,8 +517,7 @@ def _cmd_variation(args, word1: str, word2: str) -> int:
     if args.object_distances is None:
         raise CliError("give --object-distances D1,D2,... (distances from the lens)")
     objs = _distances(args.object_distances)
-    c1 = read_calibration(cal1, camera_id=args.camera_id)
-    c2 = read_calibration(cal2, camera_id=args.camera_id)
+    c1, c2 = _read_calibrations(args, cal1, cal2)
     ps = c1.pixel_size_mm or c2.pixel_size_mm
     if args.sensor is not None or args.pitch is not None or args.camera:
         ps = _sensor(args, c1).pixel_size_mm
