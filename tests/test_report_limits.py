@@ -334,3 +334,19 @@ def test_the_api_refuses_a_date_that_is_not_one(bad):
     with pytest.raises(DataError, match="is not a date; write it as YYYY-MM-DD"):
         calibration_certificate(lens, date=bad)
     assert calibration_certificate(lens, date="2026-01-31").date == "2026-01-31"
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["camera", "convert", "cooke-triplet-f4-synthetic-2m", "--model", "opencv", "-o", "-"],
+        ["report", "cooke-triplet-f4", "-o", "-"],
+        ["distortion", "cooke-triplet-f4", "--plot", "-"],
+    ],
+)
+def test_a_dash_is_standard_output_and_no_file_is_written(tmp_path, monkeypatch, argv):
+    # `-o -` wrote a file literally named "-" ("wrote -")
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = run_cli(argv)
+    assert rc == 2 and err.count("\n") == 1 and "names standard output" in err, err
+    assert list(tmp_path.iterdir()) == []

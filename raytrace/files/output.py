@@ -36,14 +36,19 @@ def check_output(
 ) -> Path:
     """Refuse an output that cannot or must not be written, before any work is done.
 
-    Raises :class:`~raytrace.errors.OutputError` when ``path`` ends in a path separator (it
-    names a folder), is the same file as one of ``inputs``, exists and ``overwrite`` is false
-    (``flag`` names how to allow it: ``--force`` on the command line), is a directory, or its
-    folder does not exist or cannot take a new file (tried by creating and removing an empty
-    one: permission bits do not tell — root passes them, yet cannot write in /proc or on a
-    read-only mount).
+    Raises :class:`~raytrace.errors.OutputError` when ``path`` is ``-`` (standard output, which
+    is no file), ends in a path separator (it names a folder), is the same file as one of
+    ``inputs``, exists and ``overwrite`` is false (``flag`` names how to allow it: ``--force``
+    on the command line), is a directory, or its folder does not exist or cannot take a new
+    file (tried by creating and removing an empty one: permission bits do not tell — root passes
+    them, yet cannot write in /proc or on a read-only mount).
     """
     text = os.fspath(path)
+    if text in ("-", b"-"):  # the Unix sign for standard output, which a writer here never is
+        raise OutputError(
+            "-: names standard output, which this writes no file to; give a file name (the "
+            "text, JSON or CSV output goes to standard output without -o)"
+        )
     if isinstance(text, str) and text.endswith(tuple(c for c in (os.sep, os.altsep) if c)):
         raise OutputError(f"{text}: ends in {text[-1]!r}, so it names a folder; give a file name")
     p = Path(path)
