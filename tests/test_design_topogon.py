@@ -218,7 +218,7 @@ def test_spherical_spec_operands_match_an_independent_trace(spherical, spherical
 
 
 def test_spherical_design_is_reproducible_from_its_spec(spherical):
-    """The design run itself (about 3 s on one core, 922 evaluations): the spec's minimax from its
+    """The design run itself (about 3 s on one core, 773 evaluations): the spec's minimax from its
     start lens (the 2026-11-23 design, rounded) converges to the shipped lens, to 0.01 µm in its
     max error and 1e-6 (relative) in every curvature and thickness."""
     from raytrace.optimize.solver import get_value

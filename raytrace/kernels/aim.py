@@ -62,42 +62,54 @@ def _bracket(ua, ra, ub, rb):
 
 
 @kernel(error_model="numpy")
-def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0, tol, hscale):
+def _solve_field(
+    kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0, g0, tol, hscale
+):  # fmt: skip
     """Safeguarded secant solve of y_stop(u) = 0 from the guess u0.
 
-    Returns (converged, u, residual, evaluations). A sign change between two traceable points
-    keeps a bracket; secant steps outside it are replaced by bisection; an untraceable trial
-    point is pulled halfway back toward the last good point (up to 20 times)."""
+    ``g0``: the slope dy_stop/du to start from, when known (finite and non-zero: the last slope
+    of the previous field's solve, which the continuation passes on); otherwise (NaN) the first
+    slope is a forward difference (a backward one where that point cannot be traced), one more
+    trace.
+
+    Returns (converged, u, residual, evaluations, slope): ``slope`` the last secant slope (NaN
+    when none was formed). A sign change between two traceable points keeps a bracket; secant
+    steps outside it are replaced by bisection; an untraceable trial point is pulled halfway
+    back toward the last good point (up to 20 times)."""
     nev = 1
     st, r0 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0)
     if st != STATUS_OK or not math.isfinite(r0):
-        return False, u0, np.nan, nev
+        return False, u0, np.nan, nev, np.nan
     if abs(r0) <= tol:
-        return True, u0, r0, nev
+        return True, u0, r0, nev, g0
     h = 1e-7 * max(abs(u0), hscale)
-    u1 = u0 + h
-    st, r1 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u1)
-    nev += 1
-    if st != STATUS_OK:
-        u1 = u0 - h
-        st, r1 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u1)
-        nev += 1
-        if st != STATUS_OK:
-            return False, u0, r0, nev
-    if abs(r1) <= tol:
-        return True, u1, r1, nev
     # best point (ub, rb) and bracket [lo, hi] (valid when have_br)
-    g = (r1 - r0) / (u1 - u0)
     ub, rb = u0, r0
-    if abs(r1) < abs(r0):
-        ub, rb = u1, r1
     have_br = False
     lo = 0.0
     hi = 0.0
     rlo = 0.0
-    if r0 * r1 < 0.0:
-        have_br = True
-        lo, hi, rlo = _bracket(u0, r0, u1, r1)
+    g = g0
+    if not (g0 != 0.0 and math.isfinite(g0)):
+        u1 = u0 + h
+        st, r1 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u1)
+        nev += 1
+        if st != STATUS_OK:
+            u1 = u0 - h
+            st, r1 = _stop_residual(
+                kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u1
+            )
+            nev += 1
+            if st != STATUS_OK:
+                return False, u0, r0, nev, np.nan
+        g = (r1 - r0) / (u1 - u0)
+        if abs(r1) <= tol:
+            return True, u1, r1, nev, g
+        if abs(r1) < abs(r0):
+            ub, rb = u1, r1
+        if r0 * r1 < 0.0:
+            have_br = True
+            lo, hi, rlo = _bracket(u0, r0, u1, r1)
     for _ in range(AIM_MAXIT):
         if g != 0.0 and math.isfinite(g):
             un = ub - rb / g
@@ -117,9 +129,9 @@ def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f,
                 break
             un = ub + 0.5 * (un - ub)
         if not ok:
-            return False, ub, rb, nev
+            return False, ub, rb, nev, g
         if abs(rn) <= tol:
-            return True, un, rn, nev
+            return True, un, rn, nev, g
         if un != ub:
             g = (rn - rb) / (un - ub)
         # update bracket
@@ -134,13 +146,13 @@ def _solve_field(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f,
         if abs(rn) < abs(rb) or have_br:
             ub, rb = un, rn
         if have_br and hi - lo <= 4e-16 * max(abs(lo), abs(hi)):
-            return False, ub, rb, nev
-    return False, ub, rb, nev
+            return False, ub, rb, nev, g
+    return False, ub, rb, nev, g
 
 
 @kernel(error_model="numpy")
-def aim_chief(lens, stop, finite, z_obj, fields, slope0, tol, hscale, clip, start, last, status,
-              surface, evals, residual):  # fmt: skip
+def aim_chief(lens, stop, finite, z_obj, fields, order, slope0, tol, hscale, clip, start, last,
+              status, surface, evals, residual):  # fmt: skip
     """Aim the meridional chief ray (through the stop vertex) for every wavelength × field; one
     call.
 
@@ -148,7 +160,9 @@ def aim_chief(lens, stop, finite, z_obj, fields, slope0, tol, hscale, clip, star
     n_in_w, n_out_w, sd, with the indices as (n_wavelengths, n_surfaces) arrays (row i =
     wavelength i). fields: field values (α in rad for ``finite == 0``; object height in mm for
     ``finite == 1``), the same for every wavelength, any order and sign (negative fields are
-    mirror images of positive ones). Per wavelength (arrays of n_wavelengths): slope0, the
+    mirror images of positive ones); order: the indices that sort them by |field| (int64; the
+    caller sorts, so that no sort is compiled into the kernel). Per wavelength (arrays of
+    n_wavelengths): slope0, the
     paraxial du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object); tol,
     the absolute stop-height tolerance (mm); hscale, the scale of u for finite-difference steps.
 
@@ -160,24 +174,28 @@ def aim_chief(lens, stop, finite, z_obj, fields, slope0, tol, hscale, clip, star
     kind, c, k, asph, geo, n_in_w, n_out_w, sd = lens
     for iw in range(n_in_w.shape[0]):
         _aim_fields(kind, c, k, asph, geo, n_in_w[iw], n_out_w[iw], sd, stop, finite, z_obj, fields,
-                    slope0[iw], tol[iw], hscale[iw], clip, start[iw], last[iw], status[iw],
+                    order, slope0[iw], tol[iw], hscale[iw], clip, start[iw], last[iw], status[iw],
                     surface[iw], evals[iw], residual[iw])  # fmt: skip
 
 
 @kernel(error_model="numpy")
-def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fields, slope0, tol,
-                hscale, clip, start, last, status, surface, evals, residual):  # fmt: skip
+def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fields, order,
+                slope0, tol, hscale, clip, start, last, status, surface, evals,
+                residual):  # fmt: skip
     """Aim the meridional chief ray (through the stop vertex) for every field at one wavelength
     (indices ``n_in``, ``n_out``).
 
     fields: field values (α in rad for ``finite == 0``; object height in mm for ``finite == 1``),
-    any order and sign (negative fields are mirror images of positive ones). slope0: paraxial
+    any order and sign (negative fields are mirror images of positive ones); order: the indices
+    that sort them by |f|. slope0: paraxial
     du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object). tol: absolute
     stop-height tolerance (mm). hscale: scale of u for finite-difference steps.
 
-    Fields are solved in order of |f| by continuation: each starts from the extrapolation of the
-    last two solutions; a failed solve halves the field step (intermediate fields) until it
-    succeeds or AIM_MAX_HALVINGS / AIM_MAX_EVALS is exhausted (→ AIM_FAILED).
+    Fields are solved in order of |f| by continuation: each starts from the quadratic
+    extrapolation of the last three solutions (linear from the paraxial slope at f = 0 while
+    there are fewer) and from the last solve's slope dy_stop/du; a failed solve halves the
+    field step (intermediate fields) until it succeeds or AIM_MAX_HALVINGS / AIM_MAX_EVALS is
+    exhausted (→ AIM_FAILED).
 
     Outputs (filled in place, one column / entry per field): ``start`` (4, n) float64 rows y, z,
     M, N of the object-space ray (a point and direction cosines, meridional plane x = 0);
@@ -189,22 +207,34 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
     n = fields.shape[0]
     ns = c.shape[0]
     symmetric = (int(geo[0, G_LENS]) & L_SYMMETRIC) != 0
-    order = np.argsort(np.abs(fields))
     # continuation state per side (0: f >= 0, 1: f < 0; a symmetric lens uses side 0 for |f|):
-    # last solved field fb, its solution ub and the secant slope du/df there
+    # last solved field fb, its solution ub, the divided difference du/df over [fs, fb] of the
+    # last two solutions (at the start the paraxial slope, which off the axis of a lens that is
+    # not symmetric can be far off) and the second divided difference curv over the last three
+    # (0 until there are three): the guess is the quadratic through them
     fb = np.zeros(2)
     ub = np.zeros(2)
+    fs = np.zeros(2)
     slope = np.array([slope0, slope0])
+    curv = np.zeros(2)
+    secant = np.zeros(2, dtype=np.bool_)  # slope is a divided difference of two solutions
+    # and the last slope dy_stop/du of its solve, the next solve's first slope (NaN: none yet,
+    # or the last solve failed; the solve then forms one by a forward difference)
+    gb = np.full(2, np.nan)
     ok0 = True
     u0 = 0.0
     r0 = 0.0
     ne0 = 0
     if not symmetric:  # the zero field is not on the axis: solve it first
-        ok0, u0, r0, ne0 = _solve_field(
-            kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, 0.0, 0.0, tol, hscale
-        )
+        ok0, u0, r0, ne0, g0 = _solve_field(
+            kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, 0.0, 0.0, np.nan, tol,
+            hscale,
+        )  # fmt: skip
         ub[0] = u0
         ub[1] = u0
+        if ok0:
+            gb[0] = g0
+            gb[1] = g0
     for ii in range(n):
         i = order[ii]
         if symmetric:
@@ -235,15 +265,21 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
                 ftry = fcur + step
                 if step == ftarget - fcur:
                     ftry = ftarget
-                guess = ucur + slope[side] * (ftry - fcur)
-                ok, usol, rsol, ne = _solve_field(
-                    kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, ftry, guess, tol,
-                    hscale,
+                guess = ucur + (ftry - fcur) * (slope[side] + curv[side] * (ftry - fs[side]))
+                ok, usol, rsol, ne, gsol = _solve_field(
+                    kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, ftry, guess,
+                    gb[side], tol, hscale,
                 )  # fmt: skip
                 nev += ne
+                gb[side] = gsol if ok else np.nan
                 if ok:
                     if ftry != fcur:
-                        slope[side] = (usol - ucur) / (ftry - fcur)
+                        snew = (usol - ucur) / (ftry - fcur)
+                        if secant[side]:
+                            curv[side] = (snew - slope[side]) / (ftry - fs[side])
+                        slope[side] = snew
+                        fs[side] = fcur
+                        secant[side] = True
                     fcur, ucur = ftry, usol
                     fb[side], ub[side] = fcur, ucur
                     if ftry == ftarget:

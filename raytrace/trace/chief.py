@@ -502,19 +502,20 @@ def aim(
     n = f.size
     kf = np.ascontiguousarray(kf, dtype=np.float64)
     outs = start, last, status, surface, evals, residual = aim_outputs(nw, n, 1)
+    # the fields in order of |field|: the kernel's continuation order
+    order = np.argsort(np.abs(kf), kind="stable")
     if n <= AIM_CHUNK:
         kernel.aim_chief(su.packed.lens_arrays, su.packed.stop, 1 if finite else 0, z_obj, kf,
-                  su.slope0, su.tol, su.hscale, bool(clip), *outs)  # fmt: skip
+                  order, su.slope0, su.tol, su.hscale, bool(clip), *outs)  # fmt: skip
     else:
-        # chunks of fields in order of |field| (the kernel's own continuation order), so that
-        # Ctrl-C stops a long aim within a fraction of a second
-        order = np.argsort(np.abs(kf), kind="stable")
+        # chunks of fields in that order, so that Ctrl-C stops a long aim within a fraction of
+        # a second
         for i0 in range(0, n, AIM_CHUNK):
             idx = order[i0 : i0 + AIM_CHUNK]
             part = tuple(np.empty(a.shape[:-1] + (idx.size,), dtype=a.dtype) for a in outs)
             kernel.aim_chief(su.packed.lens_arrays, su.packed.stop, 1 if finite else 0, z_obj,
-                      np.ascontiguousarray(kf[idx]), su.slope0, su.tol, su.hscale, bool(clip),
-                      *part)  # fmt: skip
+                      np.ascontiguousarray(kf[idx]), np.arange(idx.size), su.slope0, su.tol,
+                      su.hscale, bool(clip), *part)  # fmt: skip
             for a, b in zip(outs, part, strict=True):
                 a[..., idx] = b
     rays = []
