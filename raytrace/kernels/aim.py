@@ -162,9 +162,9 @@ def aim_chief(lens, stop, finite, z_obj, fields, order, slope0, tol, hscale, cli
     ``finite == 1``), the same for every wavelength, any order and sign (negative fields are
     mirror images of positive ones); order: the indices that sort them by |field| (int64; the
     caller sorts, so that no sort is compiled into the kernel). Per wavelength (arrays of
-    n_wavelengths): slope0, the
-    paraxial du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object); tol,
-    the absolute stop-height tolerance (mm); hscale, the scale of u for finite-difference steps.
+    n_wavelengths): slope0, the paraxial du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj)
+    for a finite object); tol, the absolute stop-height tolerance (mm); hscale, the scale of u
+    for finite-difference steps.
 
     Outputs (filled in place): ``start`` and ``last`` (n_wavelengths, 4, n) float64 — rows y, z,
     M, N of the object-space ray and of the final segment (see :func:`_aim_fields`);
@@ -187,9 +187,9 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
 
     fields: field values (α in rad for ``finite == 0``; object height in mm for ``finite == 1``),
     any order and sign (negative fields are mirror images of positive ones); order: the indices
-    that sort them by |f|. slope0: paraxial
-    du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj) for a finite object). tol: absolute
-    stop-height tolerance (mm). hscale: scale of u for finite-difference steps.
+    that sort them by |f|. slope0: paraxial du/df at f = 0 (−z_E0 for infinity; −1/(z_E0 − z_obj)
+    for a finite object). tol: absolute stop-height tolerance (mm). hscale: scale of u for
+    finite-difference steps.
 
     Fields are solved in order of |f| by continuation: each starts from the quadratic
     extrapolation of the last three solutions (linear from the paraxial slope at f = 0 while
