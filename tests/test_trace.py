@@ -419,9 +419,10 @@ def test_chief_ray_continuation_takes_few_traces_per_field():
     continuation of raytrace.kernels.aim starts each field from the quadratic through the last
     three solutions and from the last solve's slope, so a 50-field Topogon curve to 45° takes at
     most 4 traces to the stop per field, 3.5 on average (the forward-difference start of before
-    took 3.8 on the Cooke triplet). An off-axis three-mirror system (CODE V file of ray-optics),
-    whose paraxial slope is far from its real one, keeps within 4 per signed field: a curvature
-    formed from that paraxial slope once took 1280 traces for one field there."""
+    took 4.5 on this Topogon, 3.9 on the Cooke triplet). An off-axis three-mirror system (CODE V
+    file of ray-optics), whose paraxial slope is far from its real one, keeps within 4 per signed
+    field: a curvature formed from that paraxial slope once took 1280 traces for one field
+    there."""
     topogon = chief_rays(load_lens(TOPOGON), np.linspace(0.0, 45.0, 50))
     assert topogon.ok.all()
     assert topogon.iterations.max() <= 4 and topogon.iterations[1:].mean() <= 3.5
@@ -432,6 +433,24 @@ def test_chief_ray_continuation_takes_few_traces_per_field():
     cr = chief_rays(mirrors, np.linspace(-v, v, 41))
     assert cr.ok.all()
     assert cr.iterations.max() <= 4
+
+
+def test_chief_ray_continuation_stays_cheap_past_the_edge_and_on_close_fields():
+    """Regression pins (this project's aim against its own earlier version, found by a review):
+    a quadratic prediction formed over steps that halved toward the edge of the traceable
+    fields, or over fields 1e-10° apart, was noise, and sent guesses far off. Fields beyond
+    the lens's reach then cost up to the trace cap each (31 fields to 67.5° on the
+    topogon-like-pestrecov: 8114 traces, against 513 before the quadratic and 497 now; the
+    Cooke triplet to ±60°: 70,581 against 2503 and 2394), and a field after three close ones
+    31–83 traces (now 7). The same fields fail as before."""
+    lens = load_lens("topogon-like-pestrecov")
+    cr = chief_rays(lens, np.linspace(0.0, 67.5, 31))
+    assert (~cr.ok).sum() == 9 and cr.ok[:22].all()  # 49.5° and beyond fail, as before
+    assert cr.iterations.sum() <= 600
+    cooke = chief_rays(load_lens("cooke-triplet-f4"), np.linspace(-60.0, 60.0, 101))
+    assert cooke.iterations.sum() <= 3000
+    close = chief_rays(lens, [20.0, 20.0 + 1e-10, 20.0 + 2e-10, 45.0])
+    assert close.ok.all() and close.iterations[-1] <= 10
 
 
 def test_a_stop_smaller_than_the_aperture_says_so():

@@ -72,10 +72,11 @@ def _solve_field(
     slope is a forward difference (a backward one where that point cannot be traced), one more
     trace.
 
-    Returns (converged, u, residual, evaluations, slope): ``slope`` the last secant slope (NaN
-    when none was formed). A sign change between two traceable points keeps a bracket; secant
-    steps outside it are replaced by bisection; an untraceable trial point is pulled halfway
-    back toward the last good point (up to 20 times)."""
+    Returns (converged, u, residual, evaluations, slope): ``slope`` the last secant slope (``g0``
+    when the guess needed no step; NaN when none was formed). A sign change between two
+    traceable points keeps a bracket; secant steps outside it are replaced by bisection; an
+    untraceable trial point is pulled halfway back toward the last good point (up to 20
+    times)."""
     nev = 1
     st, r0 = _stop_residual(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, f, u0)
     if st != STATUS_OK or not math.isfinite(r0):
@@ -192,10 +193,11 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
     finite-difference steps.
 
     Fields are solved in order of |f| by continuation: each starts from the quadratic
-    extrapolation of the last three solutions (linear from the paraxial slope at f = 0 while
-    there are fewer) and from the last solve's slope dy_stop/du; a failed solve halves the
-    field step (intermediate fields) until it succeeds or AIM_MAX_HALVINGS / AIM_MAX_EVALS is
-    exhausted (→ AIM_FAILED).
+    extrapolation of the last three solutions (linear through the last two, or from the
+    paraxial slope at f = 0, while there are fewer; the quadratic term is dropped where it is
+    not a small correction, and a failed solve forgets it) and from the last solve's slope
+    dy_stop/du; a failed solve halves the field step (intermediate fields) until it succeeds or
+    AIM_MAX_HALVINGS / AIM_MAX_EVALS is exhausted (→ AIM_FAILED).
 
     Outputs (filled in place, one column / entry per field): ``start`` (4, n) float64 rows y, z,
     M, N of the object-space ray (a point and direction cosines, meridional plane x = 0);
@@ -265,7 +267,13 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
                 ftry = fcur + step
                 if step == ftarget - fcur:
                     ftry = ftarget
-                guess = ucur + (ftry - fcur) * (slope[side] + curv[side] * (ftry - fs[side]))
+                # the quadratic term only while it is a correction: a curvature formed over
+                # steps that halved toward the edge of the traceable fields, or over fields a
+                # rounding error apart, is noise and sent guesses metres off
+                dq = curv[side] * (ftry - fs[side])
+                if not (abs(dq) <= 0.5 * abs(slope[side])):
+                    dq = 0.0
+                guess = ucur + (ftry - fcur) * (slope[side] + dq)
                 ok, usol, rsol, ne, gsol = _solve_field(
                     kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, ftry, guess,
                     gb[side], tol, hscale,
@@ -291,6 +299,9 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
                     if abs(step) > abs(ftarget - fcur):
                         step = ftarget - fcur
                 else:
+                    # a failed solve: the curvature starts again from the next three solutions
+                    curv[side] = 0.0
+                    secant[side] = False
                     halvings += 1
                     if halvings > AIM_MAX_HALVINGS or nev > AIM_MAX_EVALS:
                         u = usol
