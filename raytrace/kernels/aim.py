@@ -269,7 +269,7 @@ def _aim_fields(kind, c, k, asph, geo, n_in, n_out, sd, stop, finite, z_obj, fie
                     ftry = ftarget
                 # the quadratic term only while it is a correction: a curvature formed over
                 # steps that halved toward the edge of the traceable fields, or over fields a
-                # rounding error apart, is noise and sent guesses metres off
+                # rounding error apart, is noise (one guess was 3e9 mm off)
                 dq = curv[side] * (ftry - fs[side])
                 if not (abs(dq) <= 0.5 * abs(slope[side])):
                     dq = 0.0
