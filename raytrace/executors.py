@@ -70,6 +70,102 @@ def ignore_worker_warnings() -> None:
         warnings.simplefilter("ignore", getattr(importlib.import_module(module), name))
 
 
+#: on a remote Dask worker: the names of the :class:`QuietWarningsPlugin` instances set up
+#: there, and the warning filters they added (removed when the last one is torn down)
+_QUIET_PLUGINS: set[str] = set()
+_QUIET_FILTERS: list[tuple] = []
+
+
+def _quiet_worker_warnings(name: str) -> None:
+    """:func:`ignore_worker_warnings` for the plugin ``name`` (a remote worker; the filters
+    already there are left as they are, and none is added twice)."""
+    import importlib
+    import warnings
+
+    if not _QUIET_PLUGINS:
+        for module, cname in WORKER_QUIET_WARNINGS:
+            entry = ("ignore", None, getattr(importlib.import_module(module), cname), None, 0)
+            if entry not in warnings.filters:
+                warnings.simplefilter("ignore", entry[2])
+                _QUIET_FILTERS.append(entry)
+    _QUIET_PLUGINS.add(name)
+
+
+def _unquiet_worker_warnings(name: str) -> None:
+    """Undo :func:`_quiet_worker_warnings` of the plugin ``name``: once the last such plugin
+    is gone, the filters it added are removed (the worker warns as it did before)."""
+    import warnings
+
+    _QUIET_PLUGINS.discard(name)
+    if _QUIET_PLUGINS:
+        return
+    while _QUIET_FILTERS:
+        entry = _QUIET_FILTERS.pop()
+        if entry in warnings.filters:
+            warnings.filters.remove(entry)
+    getattr(warnings, "_filters_mutated", lambda: None)()  # no cached verdict outlives them
+
+
+def _quiet_warnings_plugin_class():
+    """The class :data:`QuietWarningsPlugin`, made on first use (it subclasses
+    ``distributed.WorkerPlugin``, and this module imports Dask only when a cluster is asked
+    for)."""
+    from distributed import WorkerPlugin
+
+    class QuietWarningsPlugin(WorkerPlugin):
+        """On every worker of a remote cluster (one that :func:`dask_client` did not start, so
+        no preload): the warnings of :data:`WORKER_QUIET_WARNINGS` are ignored while this
+        client is connected, as the workers of a LocalCluster and of the process pool ignore
+        them; its teardown (the client's close) puts the worker's warnings back. SIGINT and
+        the worker's logging are left alone: the worker belongs to whoever started it."""
+
+        def __init__(self, name: str) -> None:
+            self.name = name
+
+        def setup(self, worker) -> None:
+            _quiet_worker_warnings(self.name)
+
+        def teardown(self, worker) -> None:
+            _unquiet_worker_warnings(self.name)
+
+    QuietWarningsPlugin.__module__ = __name__
+    QuietWarningsPlugin.__qualname__ = "QuietWarningsPlugin"
+    return QuietWarningsPlugin
+
+
+def __getattr__(name: str):
+    # QuietWarningsPlugin: made when first asked for (by dask_client, or by pickle on a worker
+    # unpickling the plugin), then a plain module attribute
+    if name == "QuietWarningsPlugin":
+        cls = globals()[name] = _quiet_warnings_plugin_class()
+        return cls
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def quiet_remote_workers(client) -> Callable[[], None]:
+    """Register a :class:`QuietWarningsPlugin` on the cluster of ``client`` (its workers now
+    and those that join later); returns the function that unregisters it. Best effort: a
+    cluster that refuses the plugin (its workers cannot import raytrace: the tasks would fail
+    there anyway, with their own error) runs without it."""
+    import uuid
+
+    name = f"orthoscope-quiet-warnings-{uuid.uuid4().hex}"
+    try:
+        client.register_plugin(__getattr__("QuietWarningsPlugin")(name), name=name)
+    except Exception:  # the warnings are noise, not a reason to fail
+        return lambda: None
+
+    def undo() -> None:
+        if client.status != "running":  # scheduler lost: it would wait for it to come back
+            return
+        try:
+            client.unregister_worker_plugin(name)
+        except Exception:  # a cluster already gone has no plugin left to remove
+            pass
+
+    return undo
+
+
 def dask_setup(worker) -> None:
     """Dask preload hook, run in each worker process that :func:`dask_client` starts: Ctrl-C in
     the terminal reaches the whole process group, and the workers leave it to this process
@@ -107,8 +203,9 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
         ``"local"`` or ``"local:N"``: a Dask ``LocalCluster`` on this machine (N >= 1 worker
         processes, one thread each; ``"local"``: one per CPU), whose workers ignore Ctrl-C
         and leave the warnings of :data:`WORKER_QUIET_WARNINGS` to this process
-        (:func:`dask_setup`); ``"tcp://HOST:PORT"``: a running scheduler; a
-        ``distributed.Client``: used as it is.
+        (:func:`dask_setup`); ``"tcp://HOST:PORT"``: a running scheduler, whose workers ignore
+        those warnings while this client is connected (:func:`quiet_remote_workers`; their
+        SIGINT and logging are theirs); a ``distributed.Client``: used as it is.
 
     Returns
     -------
@@ -151,4 +248,10 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
         client = distributed.Client(executor, timeout="20s")
     except OSError as e:
         raise OrthoscopeError(f"cannot reach the Dask scheduler {executor}: {e}") from None
-    return client, client.close
+    unquiet = quiet_remote_workers(client)  # no preload there: the warnings, as a plugin
+
+    def close_remote():
+        unquiet()
+        client.close()
+
+    return client, close_remote

@@ -446,6 +446,55 @@ def test_ctrl_c_held_by_a_long_compile_ends_the_run_within_the_hold(tmp_path):
     assert took < SIGINT_HOLD_S + 3.0  # the 20 s "compile" did not run to its end
 
 
+def test_ctrl_c_held_by_a_long_compile_removes_the_temporary_matplotlib_folder(tmp_path):
+    # The Ctrl-C held back past SIGINT_HOLD_S ends the run through os._exit, which runs no
+    # atexit handler: the temporary MPLCONFIGDIR folder of a read-only home
+    # (_matplotlib_folder) stayed behind in TMPDIR. It is removed before that exit.
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from support import default_sigint
+
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("HOME", "XDG_CONFIG_HOME", "XDG_CACHE_HOME", "MPLCONFIGDIR")
+    }
+    env.update(HOME="/proc/no-home", TMPDIR=str(tmp_path))
+    code = (
+        "import os, sys, time\n"
+        "from orthoscope.cli import _matplotlib_folder, _sigint_outside_llvm\n"
+        "_matplotlib_folder()\n"
+        "print(os.environ['MPLCONFIGDIR'], flush=True)\n"
+        "_sigint_outside_llvm()\n"
+        "ns = {'__name__': 'numba.core.compiler'}\n"
+        "exec('def compile_for_a_while():\\n    import time\\n    t = time.monotonic()\\n'\n"
+        "     '    while time.monotonic() - t < 20:\\n        sum(range(1000))', ns)\n"
+        "print('compiling', file=sys.stderr, flush=True)\n"
+        "ns['compile_for_a_while']()\n"
+    )
+    p = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        preexec_fn=default_sigint,
+    )
+    folder = Path(p.stdout.readline().strip())
+    assert p.stderr.readline().strip() == "compiling"
+    assert folder.parent == tmp_path and folder.is_dir()  # made, and used by matplotlib
+    time.sleep(0.3)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=15)
+    assert p.returncode == 130 and err.strip() == "orthoscope: interrupted"
+    assert not folder.exists()
+    assert not list(tmp_path.glob("*matplotlib*"))
+
+
 def test_a_plot_with_a_read_only_home_prints_no_matplotlib_lines(tmp_path):
     # matplotlib printed "mkdir -p failed for path ..." and "Matplotlib created a temporary cache
     # directory ..." on every plot when HOME cannot be written; the command gives it a

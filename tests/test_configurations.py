@@ -34,6 +34,7 @@ from raytrace.files.configurations import (
     parse_seq_configurations,
     parse_toml_configurations,
     parse_zmx_configurations,
+    read_configurations,
     read_configured,
     write_lens_with_configurations,
 )
@@ -231,6 +232,31 @@ def test_scale_to_efl_scales_the_configurations_with_the_lens(tmp_path: Path) ->
     assert "scale_to_efl" not in tomllib.loads(out.read_text(encoding="utf-8"))
     lens2, confs2 = read_configured(out)
     assert lens2 == lens and confs2.configurations == confs.configurations
+
+
+def test_read_configured_builds_a_scaled_lens_once(tmp_path: Path, monkeypatch) -> None:
+    # with scale_to_efl, read_configured built the lens twice: once to read it, once more for
+    # the factor its configurations are scaled by; once is enough, for the same result (the
+    # result itself: test_scale_to_efl_scales_the_configurations_with_the_lens)
+    import raytrace.files.native as native
+
+    text = (ROOT / "lenses" / f"{INNER}.toml").read_text(encoding="utf-8")
+    p = tmp_path / "tessar50.toml"
+    p.write_text(text.replace('units      = "mm"\n', 'units      = "mm"\nscale_to_efl = 50.0\n'))
+    real, builds = native._build, []
+
+    def build(*a, **k):
+        builds.append(1)
+        return real(*a, **k)
+
+    monkeypatch.setattr(native, "_build", build)
+    lens, confs = read_configured(p)
+    assert len(builds) == 1
+    assert paraxial(lens).efl == pytest.approx(50.0, rel=1e-14)
+    # the same lens and configurations as read apart (each builds it once)
+    assert lens == native.read_lens(p)
+    assert confs.configurations == read_configurations(p).configurations
+    assert len(builds) == 3
 
 
 def test_toml_bad_configuration_is_refused() -> None:

@@ -109,3 +109,69 @@ def test_local_cluster_workers_leave_the_warnings_to_the_parent(tmp_path):
     assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
     assert "control (in a worker)" in r.stderr, r.stderr
     assert "OutOfRangeWarning" not in r.stderr and "KernelCacheWarning" not in r.stderr, r.stderr
+
+
+REMOTE = """
+import warnings
+import distributed
+from raytrace.executors import dask_client
+from raytrace.kernels.jit import KernelCacheWarning
+from raytrace.materials import model_glass
+
+
+def glass():
+    return float(model_glass(1.6, 40.0).index(1550.0))
+
+
+def warn_on(client, text, category, worker=None):
+    kw = {} if worker is None else {"workers": [worker]}
+    client.submit(warnings.warn, text, category, pure=False, **kw).result()
+
+
+if __name__ == "__main__":
+    # a cluster that dask_client does not start (no preload): a remote one, as tcp://HOST:PORT
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    raw = distributed.Client(cluster)
+    try:
+        warn_on(raw, "no cache (before)", KernelCacheWarning)
+        client, close = dask_client(cluster.scheduler_address)
+        try:
+            client.submit(glass, pure=False).result()
+            warn_on(client, "no cache (connected)", KernelCacheWarning)
+            warn_on(client, "control (connected)", UserWarning)
+            # a worker that joins while the client is connected is quiet too
+            first = set(client.scheduler_info()["workers"])
+            cluster.scale(2)
+            client.wait_for_workers(2)
+            (late,) = set(client.scheduler_info()["workers"]) - first
+            warn_on(client, "no cache (late worker)", KernelCacheWarning, late)
+            warn_on(client, "control (late worker)", UserWarning, late)
+        finally:
+            close()
+        # the client gone, its plugin is torn down: the workers warn as before
+        warn_on(raw, "no cache (after)", KernelCacheWarning)
+    finally:
+        raw.close()
+        cluster.close()
+    print("ok")
+"""
+
+
+def test_remote_cluster_workers_leave_the_warnings_to_the_parent_while_connected(tmp_path):
+    # a remote scheduler's workers got no preload: the warnings the local workers leave to the
+    # parent repeated at every evaluation on each of them. dask_client("tcp://...") registers a
+    # worker plugin (raytrace.executors.quiet_remote_workers) that ignores them on every worker,
+    # also one that joins later, and that its close() removes again (about 5 s)
+    pytest.importorskip("distributed")
+    script = tmp_path / "remote.py"
+    script.write_text(REMOTE)
+    r = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=180, check=False
+    )
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+    err = r.stderr
+    assert "no cache (before)" in err and "no cache (after)" in err, err  # the plugin's edges
+    assert "control (connected)" in err and "control (late worker)" in err, err
+    assert "no cache (connected)" not in err and "no cache (late worker)" not in err, err
+    assert "OutOfRangeWarning" not in err, err

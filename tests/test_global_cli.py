@@ -239,9 +239,9 @@ def test_interrupted_global_counts_the_starts_cut_short(
     cap = capsys.readouterr()
     d = json.loads(cap.out)
     assert d["stopped"] == "interrupted" and d["starts_done"] == 2 and d["starts_stopped"] == 1
-    assert "1/3 starts finished and 1 cut short" in d["message"]
+    assert d["message"].startswith("stopped (interrupted) with 1 of 3 starts finished, 1 cut short")
     notes = read_lens(out).notes
-    assert "best of 1/3 starts finished and 1 cut short (start " in notes
+    assert "; 1 of 3 starts finished, 1 cut short), " in notes
     assert "Search stopped early (interrupted)" in notes
     hit.clear()
     out.unlink()
@@ -249,7 +249,57 @@ def test_interrupted_global_counts_the_starts_cut_short(
     err = capsys.readouterr().err.splitlines()
     assert "start 0 done (1/3)" in err[0]
     assert err[1].startswith("start 1 cut short (interrupted; 2/3 ended): merit ")
-    assert err[-1] == "orthoscope optimize: interrupted; the best design found was kept"
+    assert err[-1] == (
+        "orthoscope optimize: interrupted with 1 of 3 starts finished, 1 cut short; the best "
+        "design found was kept"
+    )
+
+
+def test_interrupted_global_says_how_far_it_got_not_not_converged(
+    refocus: Path, tmp_path: Path, monkeypatch, capsys
+):
+    # Ctrl-C in start 0's first local run, the spec's merit goal out of reach: the run said
+    # "best merit ... from start 0 of 0/2 starts finished and 1 cut short" and its notes "NOT
+    # CONVERGED" beside "stopped early". It was stopped, not failed: it says how many starts
+    # finished of how many, that it was stopped, and keeps the best design found.
+    spec = tmp_path / "goal.toml"
+    spec.write_text(
+        REFOCUS.replace("max_evaluations = 60", "max_evaluations = 60\nmerit_goal = 1e-12")
+    )
+    out = tmp_path / "out.toml"
+    real, hit = GlobalProgress.__call__, []
+
+    def call(self, ev):
+        real(self, ev)
+        if ev.event == "local" and ev.start == 0 and not hit:
+            hit.append(ev)
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(GlobalProgress, "__call__", call)
+    argv = ["optimize", str(spec), "-o", str(out), "--global", "--seed", "9"]
+    assert main(argv) == 130
+    cap = capsys.readouterr()
+    first = cap.out.splitlines()[0]
+    assert first.startswith(
+        "cooke-refocus: stopped (interrupted) with 0 of 2 starts finished, 1 cut short; best merit "
+    ), first
+    assert "from start 0, cut short (seed 9); above the merit goal 1e-12" in first, first
+    assert "0/2" not in cap.out + cap.err and "of 0 of" not in cap.out
+    assert cap.err.splitlines()[-1] == (
+        "orthoscope optimize: interrupted with 0 of 2 starts finished, 1 cut short; the best "
+        "design found was kept"
+    )
+    assert f"wrote {out}" in cap.out
+    notes = read_lens(out).notes
+    assert "NOT CONVERGED" not in notes
+    assert (
+        "the best design found (start 0, cut short; 0 of 2 starts finished, 1 cut short)" in notes
+    )
+    assert "Search stopped early (interrupted): the best design found by then." in notes
+    assert "It does not meet the spec's goal: merit " in notes and "merit goal 1e-12." in notes
+    # the design kept is the one the run reports
+    merit = float(first.split("best merit ")[1].split()[0])
+    assert f"merit {merit:.6g} is above" in notes
 
 
 def test_help_says_method_works_with_global(capsys):

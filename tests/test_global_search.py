@@ -339,7 +339,8 @@ def test_starts_cut_short_are_counted_apart():
     res = global_optimize(singlet(), SINGLET_SPEC, seed=11, progress=progress)
     assert res.stopped == "interrupted"
     assert res.starts_done == 2 and res.starts_stopped == 1 and res.starts_finished == 1
-    assert "from start " in res.message and "of 1/4 starts finished and 1 cut short" in res.message
+    assert res.message.startswith("stopped (interrupted) with 1 of 4 starts finished, 1 cut short;")
+    assert "best merit " in res.message and "from start " in res.message
     ends = [(ev.start, ev.stopped) for ev in seen if ev.event == "start"]
     assert ends == [(0, ""), (1, "interrupted")]
     # a run that is not stopped counts its starts as before

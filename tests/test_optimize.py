@@ -169,3 +169,22 @@ def test_gaussian_image_solve_is_kept(tmp_path: Path):
     assert lens.image_solve == "gaussian"
     assert lens.surfaces[-1].thickness == pytest.approx(paraxial(lens).bfl, abs=1e-9)
     assert 't = "gaussian"' in out.read_text().replace("  ", " ")
+
+
+@pytest.mark.parametrize("method", ["least_squares", "minimax"])
+def test_cli_evaluation_limit_is_said_in_our_words(tmp_path: Path, capsys, method):
+    # --max-evaluations reached with the merit above the spec's goal: damped least squares
+    # printed scipy's own sentence ("The maximum number of function evaluations is exceeded.")
+    # as the reason; both methods now name the limit and how to raise it
+    spec = tmp_path / "s.toml"
+    spec.write_text(SPEC.format(target=48.0))
+    out = tmp_path / "out.toml"
+    argv = ["optimize", str(spec), "-o", str(out), "--quiet", "--max-evaluations", "2"]
+    assert main([*argv, "--method", method]) == 1
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "maximum number of function evaluations" not in first
+    assert "evaluation limit (2" in first, first
+    assert "raise it: max_evaluations in the spec, or --max-evaluations" in first, first
+    if method == "least_squares":
+        assert "is above the goal 1e-12" in first, first
+    assert not out.exists()

@@ -276,8 +276,8 @@ def _sigint_handler(signum, frame) -> None:
     what it has finished); compiling kernels on a new machine keeps numba on the stack for about
     a minute, so a Ctrl-C held back for more than :data:`SIGINT_HOLD_S` ends the process at once
     (one line, status 130), with nothing finished to keep. That exit (``os._exit``) runs no
-    atexit handlers; every file a command writes is written atomically, so none is left half
-    written."""
+    atexit handlers: the temporary matplotlib folder (:func:`_matplotlib_folder`) is removed
+    first; every file a command writes is written atomically, so none is left half written."""
     import signal
     import threading
     import time
@@ -291,6 +291,7 @@ def _sigint_handler(signum, frame) -> None:
             elif now - _HELD["since"] > SIGINT_HOLD_S:
                 sys.stdout.flush()
                 print(f"{_HELD['command']}: interrupted", file=sys.stderr, flush=True)
+                _remove_temporary_folders()  # os._exit runs no atexit handler
                 os._exit(EXIT_INTERRUPTED)
             t = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT))
             t.daemon = True
@@ -595,7 +596,25 @@ def _matplotlib_folder() -> None:
 
     tmp = tempfile.mkdtemp(prefix="orthoscope-matplotlib-")
     atexit.register(shutil.rmtree, tmp, ignore_errors=True)
+    _TEMPORARY_FOLDERS.append(tmp)
     os.environ["MPLCONFIGDIR"] = tmp
+
+
+#: temporary folders this process made (:func:`_matplotlib_folder`), removed at exit by atexit,
+#: or by :func:`_remove_temporary_folders` before an exit that skips atexit
+_TEMPORARY_FOLDERS: list[str] = []
+
+
+def _remove_temporary_folders() -> None:
+    """Remove :data:`_TEMPORARY_FOLDERS`, best effort, never raising: before ``os._exit``
+    (:func:`_sigint_handler`), which runs no atexit handler."""
+    try:
+        import shutil
+
+        for tmp in _TEMPORARY_FOLDERS:
+            shutil.rmtree(tmp, ignore_errors=True)
+    except BaseException:  # a second Ctrl-C, anything: the exit goes on
+        pass
 
 
 def _set_threads(n: int) -> None:

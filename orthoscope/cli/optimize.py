@@ -131,7 +131,11 @@ OUTPUTS = [("-o", ".toml")]
 #: how the CLI names the merit of each method (OptimizationResult.merit)
 MERIT_NAMES = {"least_squares": "merit", "minimax": "max weighted residual"}
 #: why a run or a start was cut short (``stopped``), in words
-STOP_WORDS = {"interrupted": "interrupted", "time": "time budget spent"}
+STOP_WORDS = {
+    "interrupted": "interrupted",
+    "time": "time budget spent",
+    "cluster": "the Dask cluster was lost",
+}
 
 
 def provenance_notes(lens, spec, res, start_name: str) -> str:
@@ -155,22 +159,33 @@ def provenance_notes(lens, spec, res, start_name: str) -> str:
 
 def global_provenance_notes(spec, res, start_name: str, dask: str | None = None) -> str:
     """Notes of a lens designed by the global search: provenance line first, then how to
-    reproduce it (seed, starts) and what it found (``dask``: the --dask cluster it ran on); the
-    starts cut short by a stop are counted apart from those that finished."""
+    reproduce it (seed, starts) and what it found (``dask``: the --dask cluster it ran on). A
+    search cut short by a stop says how many starts finished of how many (those cut short
+    counted apart) and that it was stopped; a stopped design that misses the spec's goal says
+    so in words, not as NOT CONVERGED (it was stopped, not failed)."""
     from raytrace.optimize.global_search import starts_count
 
     date = _dt.date.today().isoformat()
     glasses = "; ".join(f"S{g.surface} {g.name} ({g.catalog})" for g in res.glasses)
+    count = starts_count(res.starts_finished, res.starts_stopped, res.starts, bool(res.stopped))
+    origin = (
+        f"start {res.best_start}" + (", cut short" if res.best_start_cut_short else "")
+        if res.best_start >= 0
+        else "the start lens, kept"
+    )
+    found = (
+        f"the best design found ({origin}; {count})"
+        if res.stopped
+        else f"best of {count} ({origin})"
+    )
     text = (
         "provenance: derived\n"
         f"Designed with 'orthoscope optimize {Path(spec.path).name} --global --seed {res.seed} "
         f"--starts {res.starts}{' --method minimax' if res.method == 'minimax' else ''}' "
         f"({spec.search.hops} hops per start, local method "
         f"{res.method}) from the start lens {start_name}; {res.merit_is} "
-        f"{res.merit:.9g} (start {res.merit_start:.9g}), best of "
-        f"{starts_count(res.starts_finished, res.starts_stopped, res.starts)} ("
-        + (f"start {res.best_start}" if res.best_start >= 0 else "the start lens, kept")
-        + f"), {res.evaluations} evaluations, {res.seconds:.0f} s with {res.workers} worker(s)"
+        f"{res.merit:.9g} (start {res.merit_start:.9g}), {found}, {res.evaluations} "
+        f"evaluations, {res.seconds:.0f} s with {res.workers} worker(s)"
         + (f" on Dask ({dask})" if dask else "")
         + f"; {date}."
     )
@@ -178,7 +193,18 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
         text += f" Glasses: {glasses}."
     if res.stopped:
         text += f" Search stopped early ({res.stopped}): the best design found by then."
+        if not res.converged:
+            text += f" It does not meet the spec's goal: {_goal_missed(spec, res)}."
     return text
+
+
+def _goal_missed(spec, res) -> str:
+    """How a global search's design misses the spec's goal (``res.converged`` false)."""
+    from raytrace.optimize.minimax import bounds_met
+
+    if res.method == "minimax" and not bounds_met(res.violation, res.merit):
+        return f"a bound is not met (largest weighted violation {res.violation:.3g})"
+    return f"{res.merit_is} {res.merit:.6g} is above the merit goal {spec.merit_goal:.6g}"
 
 
 def _aim(op) -> str:
@@ -454,9 +480,9 @@ def _write_design(
 ) -> bool:
     """Write the optimized lens ``res.lens`` to ``out`` when it converged, or was interrupted
     (``stopped``: the best design found is kept), or with ``--write-anyway``; one that did not
-    converge has its notes marked NOT CONVERGED unless they say so already (``said``: a local
-    run cut short). ``notes()`` gives its provenance notes and ``source`` its origin. Returns
-    whether it was written."""
+    converge has its notes marked NOT CONVERGED unless they say so already (``said``: a run
+    cut short by a stop, which was stopped, not failed, and whose notes say so). ``notes()``
+    gives its provenance notes and ``source`` its origin. Returns whether it was written."""
     from raytrace.files.native import write_lens
 
     written = res.converged or args.write_anyway or stopped == "interrupted"
@@ -558,7 +584,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         args, res, spec, out, inputs,
         lambda: global_provenance_notes(spec, res, spec.start, args.dask),
         f"derived by orthoscope optimize --global from {spec.start} with {Path(spec.path).name}",
-        stopped=res.stopped,
+        stopped=res.stopped, said=bool(res.stopped),
     )  # fmt: skip
     if args.glass_map is not None:
         from raytrace.optimize import glass_pool
@@ -630,16 +656,27 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
         _print_table(table)
         if written:
             print(f"wrote {out}")
+        elif res.stopped:  # stopped (time budget, cluster lost) short of the goal: not a failure
+            print(
+                f"no lens written: the search stopped ({STOP_WORDS.get(res.stopped, res.stopped)}) "
+                "short of the spec's goal (--write-anyway writes it)"
+            )
         else:
             print("NOT CONVERGED: no lens written (--write-anyway writes it, marked as such)")
         if args.glass_map is not None:
             print(f"wrote {args.glass_map}")
     if res.stopped == "interrupted":
-        print("orthoscope optimize: interrupted; the best design found was kept", file=sys.stderr)
+        from raytrace.optimize.global_search import starts_count
+
+        count = starts_count(res.starts_finished, res.starts_stopped, res.starts, True)
+        print(
+            f"orthoscope optimize: interrupted with {count}; the best design found was kept",
+            file=sys.stderr,
+        )
         return EXIT_INTERRUPTED
     if res.stopped == "cluster":
-        kept = "; the best design of the finished starts was kept" if written else ""
-        print(f"orthoscope optimize: {res.message.split('stopped: ')[-1]}{kept}", file=sys.stderr)
+        kept = "; the best design found was kept" if written else ""
+        print(f"orthoscope optimize: {res.message}{kept}", file=sys.stderr)
         return 1
     return 0 if res.converged else EXIT_NOT_CONVERGED
 

@@ -647,7 +647,40 @@ def read_configured(path: str | Path) -> tuple[Lens, Configurations]:
     from .library import resolve_lens_path
 
     p = resolve_lens_path(path)
+    both = _scaled_toml_configured(p)
+    if both is not None:
+        return both
     lens = read_lens_file(p)
     configs = read_configurations(p)
+    check_surfaces(lens, configs)
+    return lens, configs
+
+
+def _scaled_toml_configured(p: Path) -> tuple[Lens, Configurations] | None:
+    """:func:`read_configured` of a native TOML file with ``scale_to_efl`` and
+    ``[[configurations]]``, the lens built once: the build gives the factor the configurations
+    are scaled by (reading the lens and the configurations apart builds it twice). None for
+    any other file, or one that cannot be read or parsed (the ordinary path says why)."""
+    from . import READ_SUFFIXES
+    from .native import WHAT, build_lens
+
+    if p.suffix.lower() in READ_SUFFIXES[1:] or p.suffix.lower() == ".zar":
+        return None  # read by another reader (read_lens_file, by suffix)
+    spath = str(p)
+    try:
+        text = decode_text(read_bytes(p), spath, WHAT, latin1=False)
+        data = tomllib.loads(text)
+    except (PrescriptionError, tomllib.TOMLDecodeError, RecursionError):
+        return None
+    if not ("scale_to_efl" in data and data.get("configurations")):
+        return None
+    try:
+        lens, factor = build_lens(data, text=text, path=spath)  # checks the configurations too
+    except PrescriptionError:
+        from . import read_lens_file
+
+        read_lens_file(p)  # the error it gives (with its hint for a file of another format)
+        raise
+    configs = configurations_from_toml(data, path=spath, scale=factor)
     check_surfaces(lens, configs)
     return lens, configs

@@ -658,6 +658,15 @@ def loads(text: str | bytes, *, path: str | Path | None = None) -> Lens:
     return _build(src, data)[0]
 
 
+def build_lens(
+    data: dict[str, Any], *, text: str = "", path: str | Path | None = None
+) -> tuple[Lens, float]:
+    """The validated :class:`Lens` of parsed TOML ``data`` and the factor ``scale_to_efl``
+    multiplied its lengths by (1.0 without the key); ``text`` (the file's text) and ``path``
+    place the errors, as :func:`loads` does."""
+    return _build(_Source(text, None if path is None else str(path)), data)
+
+
 def efl_scale(data: dict[str, Any], *, text: str = "", path: str | Path | None = None) -> float:
     """The factor ``scale_to_efl`` multiplies every length of the lens in parsed TOML ``data``
     by (1.0 without the key): what :mod:`.configurations` scales the ``[[configurations]]``
@@ -665,7 +674,7 @@ def efl_scale(data: dict[str, Any], *, text: str = "", path: str | Path | None =
     factor); ``text`` (the file's text) and ``path`` place the errors, as :func:`loads` does."""
     if "scale_to_efl" not in data:
         return 1.0
-    return _build(_Source(text, None if path is None else str(path)), data)[1]
+    return build_lens(data, text=text, path=path)[1]
 
 
 def _build(src: _Source, data: dict[str, Any]) -> tuple[Lens, float]:

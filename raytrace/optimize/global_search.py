@@ -153,7 +153,8 @@ class GlobalResult:
     did not run); starts_stopped: how many of those starts were cut short by the stop (their
     merit is that of their best design by then; :attr:`starts_finished` ran to their end);
     best_start: the start the design came from (-1: the start lens, when no finished start is
-    better); seed: the root seed; glasses: the glass of each glass variable;
+    better); best_start_cut_short: that start was cut short by the stop; seed: the root seed;
+    glasses: the glass of each glass variable;
     operands: every operand on the best design; evaluations: merit evaluations in all starts and
     the polish; seconds: wall time; workers: processes used (on Dask: the cluster's workers);
     stopped: ``""``, ``"time"`` (budget spent), ``"interrupted"`` or ``"cluster"`` (the Dask
@@ -179,6 +180,7 @@ class GlobalResult:
     method: str = "least_squares"
     violation: float = 0.0
     starts_stopped: int = 0
+    best_start_cut_short: bool = False
 
     @property
     def merit_is(self) -> str:
@@ -200,20 +202,34 @@ class GlobalResult:
         return self.starts_done - self.starts_stopped
 
     def __repr__(self) -> str:
+        count = starts_count(
+            self.starts_finished, self.starts_stopped, self.starts, bool(self.stopped)
+        )
         return (
-            f"GlobalResult(merit {self.merit:.6g} from start {self.best_start}, "
-            f"{starts_count(self.starts_finished, self.starts_stopped, self.starts)}, "
+            f"GlobalResult(merit {self.merit:.6g} from start {self.best_start}, {count}, "
             f"seed {self.seed}, "
             f"{self.seconds:.1f} s{', stopped: ' + self.stopped if self.stopped else ''})"
         )
 
 
-def starts_count(finished: int, stopped: int, starts: int) -> str:
-    """How many starts gave a design: "3/8 starts", or with starts cut short by a stop "3/8
-    starts finished and 1 cut short"."""
-    if not stopped:
+def starts_count(finished: int, stopped: int, starts: int, search_stopped: bool = False) -> str:
+    """How many starts gave a design: "3/8 starts"; in a search that was stopped
+    (``search_stopped``) or had starts cut short (``stopped`` of them) "3 of 8 starts finished"
+    and ", 1 cut short"."""
+    if not (stopped or search_stopped):
         return f"{finished}/{starts} starts"
-    return f"{finished}/{starts} starts finished and {stopped} cut short"
+    return f"{finished} of {starts} starts finished" + (f", {stopped} cut short" if stopped else "")
+
+
+#: why the search was stopped (:attr:`GlobalResult.stopped`), in words; "cluster" adds the cause
+STOP_WORDS = {"time": "time budget spent", "interrupted": "interrupted"}
+
+
+def stop_words(stopped: str, lost: str = "") -> str:
+    """Why the search was stopped, in words (``lost``: what ended the Dask cluster)."""
+    if stopped == "cluster":
+        return "the Dask cluster was lost" + (f" ({lost})" if lost else "")
+    return STOP_WORDS.get(stopped, stopped)
 
 
 # ----------------------------------------------------------------------------- the design
@@ -673,20 +689,28 @@ def global_optimize(
     feasible = spec.method != "minimax" or bounds_met(viol, m)
     converged = feasible and (spec.merit_goal is None or m <= spec.merit_goal)
     n_cut = sum(1 for o in done if o.stopped)  # cut short by the stop, with a design
-    count = starts_count(len(done) - n_cut, n_cut, s.starts)
-    if best_k < 0:
+    best_cut = best_k >= 0 and bool(outcomes[best_k].stopped)
+    name = MERIT_NAMES[spec.method]
+    if stopped:  # first what stopped it and how far it got, then what it kept
+        msg = (
+            f"stopped ({stop_words(stopped, lost)}) with "
+            f"{starts_count(len(done) - n_cut, n_cut, s.starts, True)}; "
+            + (
+                f"{name} {m:.6g}: the start lens, kept (no start better)"
+                if best_k < 0
+                else f"best {name} {m:.6g} from start {best_k}"
+                + (", cut short" if best_cut else "")
+            )
+            + f" (seed {s.seed})"
+        )
+    elif best_k < 0:
+        count = starts_count(len(done) - n_cut, n_cut, s.starts)
         if not n_cut:
             count = count.replace(" starts", " starts finished")
-        msg = (
-            f"{MERIT_NAMES[spec.method]} {m:.6g}: the start lens, kept ({count}, none better; "
-            f"seed {s.seed})"
-        )
+        msg = f"{name} {m:.6g}: the start lens, kept ({count}, none better; seed {s.seed})"
     else:
-        name = MERIT_NAMES[spec.method]
+        count = starts_count(len(done) - n_cut, n_cut, s.starts)
         msg = f"best {name} {m:.6g} from start {best_k} of {count} (seed {s.seed})"
-    if stopped:
-        why = {"time": "time budget spent", "interrupted": "interrupted"}
-        msg += f"; stopped: {why.get(stopped, f'the Dask cluster was lost ({lost})')}"
     if not feasible:
         msg += f"; a bound is not met (largest weighted violation {viol:.3g})"
     elif not converged:
@@ -709,6 +733,7 @@ def global_optimize(
         method=spec.method,
         violation=viol,
         starts_stopped=n_cut,
+        best_start_cut_short=best_cut,
     )
 
 

@@ -60,6 +60,7 @@ from .solver import (
     check_spec,
     checked_evaluate,
     continuous,
+    limit_message,
     max_violation,
     start_values,
     variable_scales,
@@ -298,7 +299,7 @@ def minimax(
         f = phi(e, g)
         while True:
             if log.n + 2 * n + 1 > limit:
-                status, message = "limit", f"stopped at the evaluation limit ({limit})"
+                status, message = "limit", limit_message(str(limit))
                 break
             J = np.zeros((len(e), n))
             G = np.zeros((len(g), n))
@@ -334,7 +335,7 @@ def minimax(
                     message = "converged: the linearised problem predicts no further decrease"
                     break
                 if log.n + 1 > limit:
-                    status, message = "limit", f"stopped at the evaluation limit ({limit})"
+                    status, message = "limit", limit_message(str(limit))
                     break
                 xn = np.clip(x + z * sc, lo, hi)
                 step = float(np.max(np.abs(z))) if n else 0.0

@@ -284,6 +284,15 @@ class EvaluationLog:
         )
 
 
+def limit_message(count: str) -> str:
+    """Why a local run ended at its evaluation limit, and how to raise the limit; ``count``:
+    the limit as the method counts it ("400", "400 merit evaluations of ...")."""
+    return (
+        f"stopped at the evaluation limit ({count}) before converging; raise it: "
+        "max_evaluations in the spec, or --max-evaluations N on the command line"
+    )
+
+
 def checked_evaluate(
     lens: Lens,
     spec: DesignSpec,
@@ -454,15 +463,17 @@ def optimize(
     m = merit(vals)
     converged = status > 0
     msg = message
+    if status == 0:  # scipy's max_nfev, said in our words (not scipy's sentence)
+        msg = limit_message(
+            f"{limit} merit evaluations of the solver's steps; {log.n} with its "
+            "finite-difference Jacobians"
+        )
     if stopped:
         converged = False
     elif spec.merit_goal is not None and m > spec.merit_goal:
         converged = False
-        msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g} ({message})"
-    elif status == 0:
-        msg = (
-            f"stopped at the evaluation limit ({limit} merit evaluations of the solver's steps; "
-            f"{log.n} with its finite-difference Jacobians) before converging"
+        msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g}" + (
+            f": {msg}" if status == 0 else f" ({message})"
         )
     msg += log.note()
     return OptimizationResult(
