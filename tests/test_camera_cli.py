@@ -479,8 +479,10 @@ _FORM_ARGV = {
         ("convert", ["--grid", "9x7"],
          "--grid is not read by `camera convert` (it is a flag of `camera LENS` and `camera "
          "compare`); drop it"),
-        # an abbreviation with '=' is named by the flag's full name
-        ("convert", ["--gri=9x7"], "--grid is not read by `camera convert`"),
+        # an abbreviation (with '=') of another form's flag: named as typed, and what it would be
+        ("convert", ["--gri=9x7"],
+         "--gri is not a flag of `camera convert` (it would be --grid, a flag of `camera LENS` "
+         "and `camera compare`); drop it"),
         ("convert", ["--csv"], "--csv is not read by `camera convert`"),
         ("variation", ["--pattern", "grid"],
          "--pattern is not read by `camera variation` (it is a flag of `camera LENS`); drop it"),
@@ -624,3 +626,262 @@ def test_the_output_file_is_of_the_model_family_asked_for(tmp_path, monkeypatch)
                      tmp_path, monkeypatch)  # fmt: skip
     assert rc == 0, err
     assert read_calibration(tmp_path / "cameras.txt").model.startswith("colmap:")
+
+
+# ------------------------------------------- abbreviations, help, --s, the words of the refusals
+def _one_line(err: str) -> str:
+    lines = [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+def test_an_abbreviation_resolves_among_the_flags_of_the_form(tmp_path):
+    """Abbreviated long flags stay allowed, as in every orthoscope command (`orthoscope
+    distortion --obj` is argparse's), but only the form's own flags count: `variation
+    --object-d` was ambiguous with `camera LENS`'s --object-distance, `compare --pi` listed
+    --picture, and an abbreviation of another form's flag was named by that flag only."""
+    argv = [a.format(tmp=tmp_path) for a in _FORM_ARGV["variation"][:-2]]
+    rc, full, err = run(argv)
+    assert rc == 0, err
+    short = ["--object-d" if a == "--object-distances" else a for a in argv]
+    short = ["--calib" if a == "--calibrated-at" else a for a in short]
+    rc, out, err = run(short)
+    assert rc == 0 and out == full, err
+    rc, _, err = run(["camera", "compare", "cooke-triplet-f4", _CAL, "--pi", "24x16"])
+    line = _one_line(err)
+    assert rc == 2 and "--pi could match --pixels, --pitch" in line and "--picture" not in line
+    rc, _, err = run([*BASE, "--calib", "1m,5m"])
+    assert rc == 2 and _one_line(err).endswith(
+        "error: --calib is not a flag of `camera LENS` (it would be --calibrated-at, a flag of "
+        "`camera variation`); drop it"
+    )
+    rc, _, err = run(["camera", "convert", _CAL, "--mo", "metashape", "--ma", "x.npz"])
+    assert rc == 2 and "--ma is not a flag of `camera convert` (it would be --maps, a flag of " in (
+        _one_line(err)
+    )
+    assert not list(tmp_path.iterdir())
+    rc, page, _ = run(["camera", "convert", _CAL, "--he"])  # the help, abbreviated
+    assert rc == 0 and page.startswith("usage: orthoscope camera convert ")
+
+
+@pytest.mark.parametrize("form", ["compare", "convert", "variation"])
+def test_help_before_the_form_prints_the_form_page(form):
+    # `orthoscope camera --help compare` printed the general page
+    rc, page, err = run(["camera", form, "--help"])
+    assert rc == 0 and page.startswith(f"usage: orthoscope camera {form} "), err
+    for argv in (["camera", "--help", form], ["camera", "-h", form, "x"],
+                 ["camera", "--sensor", "24x16", "--help", form]):  # fmt: skip
+        rc, out, err = run(argv)
+        assert rc == 0 and out == page, (argv, err)
+    rc, general, _ = run(["camera", "--help", "cooke-triplet-f4"])
+    assert rc == 0 and general.count("orthoscope camera") >= 4 and general != page
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        [*BASE, "--s", "-1000", "--object-s", "-2000"],
+        [*BASE, "--object-s", "-2000", "--s", "-1000"],
+        ["camera", "compare", "cooke-triplet-f4", _CAL, "--sensor", "24x16", "--s", "-2m",
+         "--object-s", "-2m"],
+    ],
+)  # fmt: skip
+def test_s_with_object_s_is_a_conflict(argv, tmp_path):
+    # --s is the deprecated --object-s: both were taken, the last one winning, with a
+    # deprecation line
+    rc, _, err = run([*argv, "-o", str(tmp_path / "out.json")])
+    assert rc == 2, err
+    assert _one_line(err).endswith(
+        "error: --s and --object-s both give the object's s (--s is the deprecated spelling of "
+        "--object-s): give --object-s alone"
+    )
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    "argv,words",
+    [
+        (["camera", "convert", _CAL, "--model", "metashape", "--s", "-1000"],
+         "--s is not read by `camera convert`"),
+        ([*_FORM_ARGV["variation"][:-2], "--s", "-1000"], "--s is not read by `camera variation`"),
+        ([*BASE, "--s", "-1000", "--object-distance", "1m"],
+         "give the object one way, not --s and --object-distance"),
+        ([*BASE, "--object-distances", "1m,2m", "--s", "-1000"],
+         "--object-distances are the table's rows: leave out --s"),
+        ([*BASE, "--s", "abc"], "--s: 'abc' is not a number"),
+    ],
+)  # fmt: skip
+def test_a_refused_s_gets_no_deprecation_line(argv, words):
+    # the deprecation line came first, then the refusal
+    rc, _, err = run(argv)
+    assert rc == 2 and words in _one_line(err), err
+    assert "deprecated" not in err
+
+
+def test_an_accepted_s_still_says_it_is_deprecated():
+    rc, out, err = run([*BASE, "--s", "-1000", "--json"])
+    assert rc == 0, err
+    assert err.count("--s is deprecated and will be removed; use --object-s") == 1
+    rc, same, _ = run([*BASE, "--object-s", "-1000", "--json"])
+    assert rc == 0
+    a, b = json.loads(out), json.loads(same)
+    assert a["geometry"] == b["geometry"] and a["geometry"]["s_mm"] == -1000.0
+    for k, v in b["camera"]["parameters"].items():
+        assert a["camera"]["parameters"][k] == pytest.approx(v, rel=1e-9, abs=1e-12)
+
+
+_VAR = _FORM_ARGV["variation"][:-2]  # without -o
+
+
+@pytest.mark.parametrize(
+    "argv,words",
+    [
+        # the object and focus flags, named as given (API keywords before: object_distance_s,
+        # object_s, "focus" for --object-distances, CameraSetup's keywords)
+        ([*BASE, "--object-s", "abc"], "--object-s: 'abc' is not a number"),
+        ([*BASE, "--object-s", "100"], "--object-s 100: Pestrecov's s is negative for a real"),
+        ([*BASE, "--object-distance", "-5"],
+         "--object-distance -5: a positive distance in mm from the object plane to the first "
+         "vertex (or 2m, inf, 12x); for Pestrecov's signed s use --object-s"),
+        ([*BASE, "--object-scale", "abc"], "--object-scale: 'abc' is not a number"),
+        ([*BASE, "--object-distance", "1m", "--object-s", "-1000"],
+         "give the object one way, not --object-distance and --object-s"),
+        ([*BASE, "--object-distances", "1m,abc"], "--object-distances: 'abc' is not a number"),
+        ([*BASE, "--object-distances", "abc"], "--object-distances: 'abc' is not a number"),
+        ([*BASE, "--object-distances", "1m,2m", "--object-s", "-1000"],
+         "--object-distances are the table's rows: leave out --object-s"),
+        ([*BASE, "--object-distances", "10,2m"],
+         "focused at 10 (the first of --object-distances, as no focus is given): the "
+         "sensor plane would lie"),
+        ([*BASE, "--focus-s", "100"], "--focus-s 100: Pestrecov's s is negative"),
+        ([*BASE, "--s-prime", "-5"], "sensor at --s-prime -5 mm: the sensor plane would lie"),
+        ([*BASE, "--grid", "0x0"], "--grid 0x0: write it as columns x rows, each 2..401, e.g."),
+        ([*BASE, "--grid", "abc"], "--grid abc: write it as columns x rows, each 2..401, e.g."),
+        # the sensor flags
+        (["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pixels", "0x800"],
+         "--pixels 0x800: columns and rows are whole numbers of pixels, 1..1000000"),
+        (["camera", "cooke-triplet-f4", "--sensor", "24x16", "--pitch", "abc"],
+         "--pitch abc: not a number; give the pixel pitch in µm, e.g. 4.35"),
+        (["camera", "cooke-triplet-f4", "--sensor", "5000x16", "--pixels", "1200x800"],
+         "--sensor 5000x16: the width 5000 mm is outside"),
+        (["camera", "compare", "cooke-triplet-f4", _CAL],
+         "holds pixels only: give --sensor WxH (mm) or --pitch UM (or --camera SPEC.toml)"),
+        (["camera", "compare", "cooke-triplet-f4", _CAL, "--sensor", "24x16", "--pitch", "20"],
+         "give --sensor or --pitch (the pixel count is the calibration's 3000x2000 px)"),
+        # the model, before the trace
+        ([*BASE, "--model", "foo"], "--model foo: not a camera model (a family: opencv, fisheye"),
+        ([*BASE, "--model", "fisheye", "--coefficients", "7"],
+         "--coefficients 7 does not apply to --model fisheye: give 4, 5, 8, 12 or 14 with "
+         "--model opencv, or 1 to 4 with --model fisheye"),
+        ([*BASE, "--coefficients", "x"], "'x' is not a whole number; give 4, 5, 8, 12 or 14"),
+        (["camera", "convert", _CAL, "--model", "opencv", "--coefficients", "6"],
+         "--coefficients 6 does not apply to --model opencv: it fixes the number of "
+         "coefficients of --model opencv, 4, 5, 8, 12 or 14"),
+        (["camera", "convert", _CAL, "--model", "foo"], "--model foo: not a camera model"),
+        # file names: no --format for an input; -o named
+        (["camera", "convert", _CAL, "--model", "metashape", "-o", "x.foo"],
+         "-o x.foo: the name does not tell the calibration format; end it in .yml"),
+        ([*BASE, "-o", "x.foo"], "-o x.foo: the name does not tell the calibration format"),
+        # variation (API keywords before: s1, focal_length_mm, method=, g)
+        ([*_VAR[:4], "--calibrated-at", "abc,5m", *_VAR[6:]],
+         "--calibrated-at: 'abc' is not a number"),
+        ([*_VAR[:4], "--calibrated-at", "2m,2m", *_VAR[6:]],
+         "--calibrated-at 2m,2m: the two calibrations are focused at the same distance"),
+        ([*_VAR[:6], "--focal-length", "-50", *_VAR[8:]],
+         "--focal-length: expected a positive length, got '-50'"),
+        ([*_VAR, "--method", "fraser-shortis"],
+         "--method fraser-shortis needs --g G (g_ss' of Fraser & Shortis' Eq. 6, e.g. 0.45)"),
+        ([*_VAR, "--g", "0.5"],
+         "--g is g_ss' of --method fraser-shortis (Eq. 6); Brown's Eq. 1 has none: give "
+         "--method fraser-shortis, or drop --g"),
+        ([*_VAR, "--g", "abc"], "'abc' is not a number; give g_ss' of Fraser & Shortis' Eq. 6"),
+        # the words of a form
+        (["camera", "convert"], "`camera convert` takes CALIBRATION; got none (usage: "),
+        (["camera", "variation", _CAL],
+         f"`camera variation` takes CAL1 CAL2; got 1: {_CAL} (usage: "),
+    ],
+)  # fmt: skip
+def test_each_refusal_names_the_flag_in_the_command_line_words(argv, words, tmp_path, monkeypatch):
+    """One line naming the flag and the fix, exit 2, no API keyword (a review found messages
+    such as 'object_distance_s: ...', 'free=6: ...', 's1: ...', 'CameraSetup: grid=(0, 0)')."""
+    rc, _, err = run(argv, tmp_path, monkeypatch)
+    line = _one_line(err)
+    assert rc == 2 and words in line, err
+    keys = "object_distance|object_s|focus_s|s_prime|focal_length_mm|width_px|s1|free|g"
+    assert (
+        not re.search(rf"(?<![\w-])({keys})(=|:| =)", line)
+        and "CameraSetup" not in line
+        and "Traceback" not in err
+    )
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_setup_the_lens_cannot_image_is_named_where_it_was_given(tmp_path, monkeypatch):
+    # the lens decides these (after the flags' own checks): the API said "sensor at s_prime =
+    # -5 mm"; a value of the --camera spec is named by its key there, not by a flag not given
+    (tmp_path / "cam.toml").write_text(
+        '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[focus]\ns_prime = "-5"\n'
+        "[trace]\ngrid = [9, 7]\n",
+        encoding="utf-8",
+    )
+    spec = ["camera", "cooke-triplet-f4", "--camera", "cam.toml"]
+    for argv, said in (
+        (spec, "sensor at cam.toml [focus] s_prime = -5 mm: the sensor plane would lie"),
+        ([*spec, "--s-prime", "-6"], "sensor at --s-prime -6 mm: the sensor plane would lie"),
+    ):
+        rc, _, err = run(argv, tmp_path, monkeypatch)
+        assert rc == 2 and said in _one_line(err), err
+
+
+def test_a_calibration_named_without_a_format_is_refused_with_the_names(tmp_path, monkeypatch):
+    # the fix said "give --format", a flag compare does not read (and convert's --format is
+    # the format of -o)
+    (tmp_path / "cal.dat").write_bytes((DATA / "cooke-measured-2m.yml").read_bytes())
+    for argv in (["camera", "compare", "cooke-triplet-f4", "cal.dat", "--sensor", "24x16"],
+                 ["camera", "convert", "cal.dat", "--model", "metashape"]):  # fmt: skip
+        rc, _, err = run(argv, tmp_path, monkeypatch)
+        assert rc == 2 and _one_line(err).endswith(
+            "error: cal.dat: the name does not tell the calibration format; a calibration file "
+            "ends in .yml, .yaml or .json (OpenCV), .txt (COLMAP cameras.txt), .xml (Metashape) "
+            "or .aus (Australis)"
+        ), err
+
+
+def test_camera_id_reaches_the_colmap_file_of_two(tmp_path, monkeypatch):
+    """read_calibration refuses camera_id for a file that is not COLMAP: the command gives it
+    to the COLMAP file only (variation of a cameras.txt and a .yml)."""
+    rc, _, err = run(["camera", "convert", str(DATA / "cooke-measured-5m.yml"), "--model",
+                      "colmap", "-o", "cameras.txt"], tmp_path, monkeypatch)  # fmt: skip
+    assert rc == 0, err
+    argv = ["camera", "variation", str(DATA / "cooke-measured-1m.yml"), "cameras.txt",
+            *_VAR[4:]]  # fmt: skip
+    rc, out, err = run([*argv, "--camera-id", "1"], tmp_path, monkeypatch)
+    assert rc == 0, err
+    rc, same, err = run(argv, tmp_path, monkeypatch)
+    assert rc == 0 and same == out, err
+
+
+def test_the_table_kind_is_found_once_and_before_the_work(tmp_path, monkeypatch):
+    """The suffix of -o of a table (lens --object-distances, compare, variation) is read once
+    per run, before any work (variation read it after the calibrations)."""
+    import orthoscope.cli.camera as camera
+
+    calls = []
+
+    def counted(path, what):
+        calls.append(path)
+        return kind(path, what)
+
+    kind = camera._table_kind
+    monkeypatch.setattr(camera, "_table_kind", counted)
+    for argv in (
+        [*BASE, "--object-distances", "1m,inf", "-o", str(tmp_path / "t.csv")],
+        [*_FORM_ARGV["compare"], "-o", str(tmp_path / "c.json")],
+        [*_VAR, "-o", str(tmp_path / "v.csv")],
+    ):
+        calls.clear()
+        rc, _, err = run(argv)
+        assert rc == 0 and len(calls) == 1, (argv, err, calls)
+    rc, _, err = run(["camera", "variation", "no-such-1.yml", "no-such-2.yml", *_VAR[4:], "-o",
+                      str(tmp_path / "v.txt")])  # fmt: skip
+    assert rc == 2 and "-o " in _one_line(err) and "written as .csv or .json" in err, err

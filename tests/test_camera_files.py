@@ -118,6 +118,25 @@ def test_colmap_cameras_txt(tmp_path):
         read_calibration(tmp_path / "bad2.txt", format="colmap")
 
 
+def test_camera_id_is_refused_for_a_file_that_is_not_colmap(tmp_path):
+    """camera_id chooses a camera of a COLMAP cameras.txt; any other file holds one camera and
+    the id was silently ignored (the command line refused it; now both do)."""
+    write_calibration(_opencv(5), tmp_path / "cam.yml")
+    write_calibration(australis_camera(), tmp_path / "cam.txt", format="australis")
+    write_calibration(_opencv(5), tmp_path / "cameras.txt", format="colmap", camera_id=3)
+    for name, fmt in (("cam.yml", "opencv-yaml"), ("cam.txt", "australis")):
+        with pytest.raises(DataError) as e:
+            read_calibration(tmp_path / name, camera_id=1)
+        assert str(e.value) == (
+            f"{tmp_path / name}: camera_id=1 chooses a camera of a COLMAP cameras.txt, and this "
+            f"file is {fmt}: leave out camera_id"
+        )
+        assert read_calibration(tmp_path / name).model in ("opencv", "australis")
+    with pytest.raises(DataError, match="this file is opencv-yaml"):
+        read_calibration(tmp_path / "cam.yml", format="opencv-yaml", camera_id=1)
+    assert read_calibration(tmp_path / "cameras.txt", camera_id=3).model.startswith("colmap:")
+
+
 def test_colmap_line_is_the_smallest_exact_model():
     cam = _opencv(5).replace(k3=0.0)
     assert colmap_line(cam).split()[1] == "OPENCV"

@@ -101,7 +101,8 @@ def read_calibration(
     """Read a calibration file into a :class:`~distortion.camera.models.CameraModel`.
 
     ``camera_id`` chooses a camera of a COLMAP ``cameras.txt`` with several (default: the only
-    one). Errors name the file and line and say what to fix (:class:`DataError`).
+    one); it is refused for a file of another format (which holds one camera: the id would do
+    nothing). Errors name the file and line and say what to fix (:class:`DataError`).
 
     Parameters
     ----------
@@ -113,7 +114,7 @@ def read_calibration(
         ``.yaml``, ``.json``, ``.xml`` (Metashape, or legacy PhotoScan by its content), ``.txt``
         (COLMAP, or this package's Australis text by its first line), ``.aus``/``.australis``.
     camera_id : int, optional
-        The COLMAP camera id to read.
+        The COLMAP camera id to read (a COLMAP file only).
 
     Returns
     -------
@@ -124,7 +125,8 @@ def read_calibration(
     ------
     DataError
         An unreadable file, an unknown format or one the name does not tell, a malformed file, a
-        COLMAP file with several cameras and no ``camera_id``, or an id it does not hold.
+        COLMAP file with several cameras and no ``camera_id``, an id it does not hold, or a
+        ``camera_id`` for a file that is not COLMAP.
     """
     p = Path(path)
     try:
@@ -132,6 +134,11 @@ def read_calibration(
     except OSError as e:
         raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
     fmt = _check_format(format) if format else detect_format(p, text)
+    if camera_id is not None and fmt != "colmap":
+        raise DataError(
+            f"{p}: camera_id={camera_id!r} chooses a camera of a COLMAP cameras.txt, and this file "
+            f"is {fmt}: leave out camera_id"
+        )
     if fmt == "opencv-yaml":
         return _opencv_from_nodes(_parse_opencv_yaml(text, p), p)
     if fmt == "opencv-json":

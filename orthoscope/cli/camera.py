@@ -21,8 +21,10 @@ import argparse
 import functools
 import math
 
+from . import EXIT_USAGE, Parser
 from .common import (
     CliError,
+    DeprecatedAlias,
     add_force_arg,
     add_object_args,
     add_output_args,
@@ -72,6 +74,33 @@ BUNDLED_CALIBRATIONS = (
 
 
 # ---------------------------------------------------------------------------------- helpers
+def _whole(text: str, how: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number; {how}") from None
+
+
+def coefficient_count(text: str) -> int:
+    """argparse type of --coefficients: a whole number (the counts are checked with --model)."""
+    return _whole(text, "give 4, 5, 8, 12 or 14 (--model opencv) or 1 to 4 (--model fisheye)")
+
+
+def camera_id(text: str) -> int:
+    """argparse type of --camera-id: a whole number, a CAMERA_ID of the cameras.txt."""
+    return _whole(text, "give the CAMERA_ID of a camera of the cameras.txt (its first column)")
+
+
+def g_factor(text: str) -> float:
+    """argparse type of --g: a number, g_ss' of Fraser & Shortis' Eq. 6."""
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a number; give g_ss' of Fraser & Shortis' Eq. 6, e.g. 0.45"
+        ) from None
+
+
 def calibration_path(word: str) -> str:
     """A CALIBRATION as given, or the bundled calibration of that name
     (``lenses/calibrations/NAME.yml``; :func:`~orthoscope.cli.common.bundled_or_path`)."""
@@ -91,15 +120,154 @@ def _grid(text: str | None):
     if text is None:
         return None
     from distortion.camera.sensor import parse_pixels
+    from distortion.camera.setup import MAX_GRID
 
+    how = f"write it as columns x rows, each 2..{MAX_GRID}, e.g. 25x17"
     try:
-        return parse_pixels(text)
-    except Exception as e:  # noqa: BLE001 - DataError with its own words
-        raise CliError(f"--grid {text}: {e}; write it as columns x rows, e.g. 25x17") from None
+        grid = parse_pixels(text)
+    except Exception:  # noqa: BLE001 - DataError in the words of --pixels
+        raise CliError(f"--grid {text}: {how}") from None
+    if not all(2 <= n <= MAX_GRID for n in grid):
+        raise CliError(f"--grid {text}: {how}")
+    return grid
 
 
 #: the focus keywords of CameraSetup (the focused object, or the sensor plane), each a flag
 FOCUS_KEYS = ("focus", "focus_s", "focus_scale", "s_prime", "from_last_vertex", "defocus")
+
+
+#: the object flags of ``camera LENS`` / ``compare`` (``--s``: the deprecated ``--object-s``)
+OBJECT_FLAGS = ("--object-distance", "--object-s", "--object-scale", "--s")
+
+
+def _given(args) -> list[str]:
+    """The flags given (:func:`_note_given`), in the order given, each once."""
+    return list(dict.fromkeys(getattr(args, GIVEN, ())))
+
+
+def _check_object_flags(args) -> None:
+    """The object and focus flags of ``camera LENS`` / ``compare`` before any work: given one
+    way, each value readable, named as given (``--s`` where that was typed). Object distances
+    are positive and Pestrecov's s negative (a real object); the lens decides the rest."""
+    given = _given(args)
+    obj = [f for f in given if f in OBJECT_FLAGS]
+    if "--s" in obj and "--object-s" in obj:
+        raise CliError(
+            "--s and --object-s both give the object's s (--s is the deprecated spelling of "
+            "--object-s): give --object-s alone"
+        )
+    if len(obj) > 1:
+        raise CliError(f"give the object one way, not {' and '.join(obj)}")
+    if getattr(args, "object_distances", None) is not None and obj:
+        raise CliError(f"--object-distances are the table's rows: leave out {obj[0]}")
+    focus = [k for k in FOCUS_KEYS if getattr(args, k, None) is not None]
+    if len(focus) > 1:
+        flags = ", ".join("--" + k.replace("_", "-") for k in focus)
+        raise CliError(f"give the focus one way, not {flags}")
+    if args.gaussian and focus:
+        raise CliError("--gaussian (focused on the object) goes alone, without another focus flag")
+    s_flag = "--s" if "--s" in obj else "--object-s"
+    for flag, value, signed in (
+        ("--object-distance", args.object_distance, s_flag),
+        ("--focus", args.focus, "--focus-s"),
+    ):
+        if value is not None:
+            _object_distance(value, flag, signed)
+    for flag, value in ((s_flag, args.object_s), ("--focus-s", args.focus_s)):
+        if value is not None and not length(value, flag) < 0:
+            raise CliError(
+                f"{flag} {value}: Pestrecov's s is negative for a real object (mm from H, left "
+                "of it), e.g. -2000 or -2m"
+            )
+    for flag, value in (("--object-scale", args.object_scale), ("--focus-scale", args.focus_scale)):
+        if value is not None:
+            _scale(value, flag)
+    for flag in ("--s-prime", "--from-last-vertex", "--defocus"):
+        value = getattr(args, flag[2:].replace("-", "_"))
+        if value is not None:
+            length(value, flag)
+
+
+def _scale(value: str, flag: str) -> float:
+    from raytrace.units import UnitError, image_scale
+
+    try:
+        return image_scale(str(value).strip(), flag)
+    except UnitError as e:
+        raise CliError(str(e)) from None
+
+
+def _object_distance(value: str, flag: str, signed: str | None = None) -> None:
+    """An object distance as ``camera LENS`` reads it (mm from the first vertex, with a unit,
+    ``inf`` or an image scale ``12x``): a CliError naming ``flag`` for anything else; ``signed``
+    the flag of Pestrecov's signed s, the fix for a negative one."""
+    t = str(value).strip().lower()
+    if t in ("inf", "infinity"):
+        return
+    if t.endswith(("x", "\u00d7")):
+        _scale(t, flag)
+        return
+    if not length(t, flag, allow_inf=True) > 0:
+        fix = f"; for Pestrecov's signed s use {signed}" if signed else ""
+        raise CliError(
+            f"{flag} {value}: a positive distance in mm from the object plane to the first "
+            f"vertex (or 2m, inf, 12x){fix}"
+        )
+
+
+#: the API's keywords of CameraSetup and the flags that give them (its messages in the
+#: command line's words, :func:`_api_words`)
+SETUP_FLAGS = {
+    "object_distance": "--object-distance",
+    "object_s": "--object-s",
+    "object_scale": "--object-scale",
+    "focus": "--focus",
+    "focus_s": "--focus-s",
+    "focus_scale": "--focus-scale",
+    "s_prime": "--s-prime",
+    "from_last_vertex": "--from-last-vertex",
+    "defocus": "--defocus",
+}
+
+
+#: the same keywords as the TOML camera spec names them (distortion/camera/setup.py)
+SPEC_KEYS = {
+    "object_distance": "[object] distance",
+    "object_s": "[object] s",
+    "object_scale": "[object] scale",
+    "focus": "[focus] distance",
+    "focus_s": "[focus] s",
+    "focus_scale": "[focus] scale",
+    "s_prime": "[focus] s_prime",
+    "from_last_vertex": "[focus] from_last_vertex",
+    "defocus": "[focus] defocus",
+}
+
+
+def _api_words(message: str, args) -> str:
+    """A message of the camera API (a setup the lens cannot image) in the command line's words:
+    ``sensor at s_prime = -5 mm`` -> ``sensor at --s-prime -5 mm``, ``focus_s must be`` ->
+    ``--focus-s must be`` (a keyword that the --camera spec gave: its key there, ``cam.toml
+    [focus] s``), without the ``CameraSetup:`` prefix."""
+    import re
+
+    given = _given(args)
+
+    def flag(key: str, value: str = "") -> str:
+        f = SETUP_FLAGS[key]
+        if f == "--object-s" and "--s" in given:
+            f = "--s"
+        if f not in given and getattr(args, "camera", None):
+            return f"{args.camera} {SPEC_KEYS[key]}" + (f" = {value}" if value else "")
+        return f"{f} {value}" if value else f
+
+    keys = "|".join(sorted(SETUP_FLAGS, key=len, reverse=True))
+    underscored = "|".join(k for k in SETUP_FLAGS if "_" in k)
+    return re.sub(  # "key = value" or a bare keyword with an underscore, in one pass
+        rf"(?<![\w-])(?:({keys}) = (\S+)|({underscored})\b(?!=))",
+        lambda m: flag(m.group(1), m.group(2)) if m.group(1) else flag(m.group(3)),
+        message.replace("CameraSetup: ", ""),
+    )
 
 
 def _setup_keywords(args) -> dict:
@@ -107,11 +275,6 @@ def _setup_keywords(args) -> dict:
     CameraSetup, one path for the API and the command line)."""
     plane = {k: getattr(args, k) for k in FOCUS_KEYS[3:] if getattr(args, k, None) is not None}
     focus = {k: getattr(args, k) for k in FOCUS_KEYS[:3] if getattr(args, k, None) is not None}
-    if len(plane) + len(focus) > 1:
-        flags = ", ".join("--" + k.replace("_", "-") for k in (*focus, *plane))
-        raise CliError(f"give the focus one way, not {flags}")
-    if getattr(args, "gaussian", False) and (plane or focus):
-        raise CliError("--gaussian (focused on the object) goes alone, without another focus flag")
     kw = {
         "object_distance": args.object_distance,
         "object_s": args.object_s,
@@ -126,9 +289,80 @@ def _setup_keywords(args) -> dict:
     return {k: v for k, v in kw.items() if v is not None}
 
 
+#: the sensor flags as the messages of distortion.camera.sensor name them: (head of the
+#: message, flag, attribute)
+SENSOR_WORDS = (
+    ("principal-point offset", "--principal-point", "principal_point"),
+    ("sensor size", "--sensor", "sensor"),
+    ("Sensor width_mm", "--sensor", "sensor"),
+    ("Sensor height_mm", "--sensor", "sensor"),
+    ("sensor", "--sensor", "sensor"),
+    ("pixel count", "--pixels", "pixels"),
+    ("Sensor width_px", "--pixels", "pixels"),
+    ("Sensor height_px", "--pixels", "pixels"),
+    ("pixel pitch", "--pitch", "pitch"),
+)
+
+
+#: how each sensor flag is written, for a refusal that does not say it
+SENSOR_HOW = {
+    "--sensor": "give width x height in mm, e.g. 36x24",
+    "--pixels": "give columns x rows, e.g. 6000x4000",
+    "--pitch": "give the pixel pitch in µm, e.g. 4.35 (or 0.00435mm)",
+    "--principal-point": "give dx,dy in mm from the sensor centre (x right, y up), e.g. 0.1,-0.05",
+}
+
+
+def _sensor_words(message: str, args, calibration) -> str:
+    """A refusal of the sensor (:mod:`distortion.camera.sensor`) in the flags' words: ``pixel
+    count 'abc': give ...`` -> ``--pixels abc: give ...``; the fixes that name the API's
+    keywords name the flags."""
+    import re
+
+    for head, flag, dest in SENSOR_WORDS:
+        value = getattr(args, dest, None)
+        if value is None or not message.startswith(head):
+            continue
+        m = re.match(rf"{re.escape(head)}(=\S+|\s+'[^']*'|\s+\S+):\s+(.*)$", message)
+        if m:  # "pixel count 'abc': give ..." -> "--pixels abc: give ..."
+            why = m.group(2).replace("a whole number of pixels", "columns and rows are whole "
+                                     "numbers of pixels")  # fmt: skip
+            if not any(w in why for w in ("e.g.", "give", "write", "pixels, 1..")):
+                why += f"; {SENSOR_HOW[flag]}"
+            return f"{flag} {value}: {why}"
+        if head != "sensor":  # "pixel pitch 0.006 µm looks like ...", "Sensor width_mm=5000 mm"
+            what = re.sub(r"^Sensor (width|height)_mm=", r"the \1 ", message)
+            return f"{flag} {value}: {what}"
+    if calibration is not None:
+        pixels = f"{calibration.width}x{calibration.height} px"
+        message = message.replace(
+            "give two of size, pixels and pitch, or consistent values",
+            f"give --sensor or --pitch (the pixel count is the calibration's {pixels})",
+        )
+        message = message.replace(
+            "give the sensor size (e.g. '36x24' mm) or the pixel pitch (um)",
+            "give --sensor WxH (mm) or --pitch UM (or --camera SPEC.toml)",
+        )
+    message = message.replace(
+        "give two of size, pixels and pitch", "give two of --sensor, --pixels and --pitch"
+    )
+    return message.replace(
+        "check the size (mm) and the pixel count", "check --sensor (mm) and --pixels"
+    )
+
+
 def _sensor(args, calibration=None):
     """The Sensor from --camera / --sensor / --pixels / --pitch / --principal-point (a
-    calibration's pixel count when one is given)."""
+    calibration's pixel count when one is given); its refusals in the flags' words."""
+    from distortion.errors import DataError
+
+    try:
+        return _sensor_of(args, calibration)
+    except DataError as e:
+        raise CliError(_sensor_words(str(e), args, calibration)) from e
+
+
+def _sensor_of(args, calibration=None):
     from distortion.camera import Sensor, read_camera_setup
     from distortion.camera.traced import sensor_for_calibration
 
@@ -189,14 +423,28 @@ def _setup(args, sensor):
     return CameraSetup(sensor, **kw)
 
 
+#: the names that tell a calibration file's format (distortion.camera.files.detect_format)
+CALIBRATION_NAMES = (
+    ".yml, .yaml or .json (OpenCV), .txt (COLMAP cameras.txt), .xml (Metashape) or .aus (Australis)"
+)
+
+
 def _calibration_format(path: str, fmt: str | None) -> str:
+    """The format of the calibration file ``-o PATH``: --format, or the name's."""
     from distortion.camera.files import FORMATS, detect_format
+    from distortion.errors import DataError
 
     if fmt is not None:
         if fmt not in FORMATS:
             raise CliError(f"--format {fmt}: use one of {', '.join(FORMATS)}")
         return fmt
-    return detect_format(path)
+    try:
+        return detect_format(path)
+    except DataError:
+        raise CliError(
+            f"-o {path}: the name does not tell the calibration format; end it in "
+            f"{CALIBRATION_NAMES}, or give --format ({', '.join(FORMATS)})"
+        ) from None
 
 
 def _emit(args, text: str, data: dict, csv: str | None = None, note: str | None = None) -> None:
@@ -245,21 +493,46 @@ def _read_calibrations(args, *paths):
     """The calibrations at ``paths`` (--camera-id choosing a camera of a COLMAP cameras.txt);
     a CliError for --camera-id given where none of them is a COLMAP file (it would do
     nothing)."""
+    from distortion.camera import read_calibration
+
+    fmts = [_input_format(p) for p in paths]
+    for p, f in zip(paths, fmts, strict=True):
+        if f is None:  # read_calibration says why it cannot be read
+            read_calibration(p)
+    if "--camera-id" in getattr(args, GIVEN, ()) and "colmap" not in fmts:
+        what = " and ".join(f"{p} is {f}" for p, f in zip(paths, fmts, strict=True))
+        raise CliError(
+            f"--camera-id chooses a camera of a COLMAP cameras.txt, and {what}: drop --camera-id"
+        )
+    return [
+        read_calibration(p, camera_id=args.camera_id if f == "colmap" else None)
+        for p, f in zip(paths, fmts, strict=True)
+    ]
+
+
+def _input_format(path: str) -> str | None:
+    """The format of the calibration file ``path`` as read_calibration tells it (its name,
+    and the text of a .txt / .xml); a CliError for a name that tells none (no flag gives the
+    format of an input); None for a file that cannot be read as text."""
     from pathlib import Path
 
-    from distortion.camera import read_calibration
     from distortion.camera.files import detect_format
+    from distortion.errors import DataError
 
-    cals = [read_calibration(p, camera_id=args.camera_id) for p in paths]
-    if "--camera-id" in getattr(args, GIVEN, ()):
-        fmts = [detect_format(p, Path(p).read_text(encoding="utf-8-sig")) for p in paths]
-        if "colmap" not in fmts:
-            what = " and ".join(f"{p} is {f}" for p, f in zip(paths, fmts, strict=True))
-            raise CliError(
-                f"--camera-id chooses a camera of a COLMAP cameras.txt, and {what}: drop "
-                "--camera-id"
-            )
-    return cals
+    try:
+        detect_format(path)
+    except DataError:
+        raise CliError(
+            f"{path}: the name does not tell the calibration format; a calibration file ends "
+            f"in {CALIBRATION_NAMES}"
+        ) from None
+    try:
+        text = Path(path).read_text(encoding="utf-8-sig")
+    except OSError:
+        return None
+    except UnicodeError:
+        raise CliError(f"{path}: not a text file; a calibration file is text") from None
+    return detect_format(path, text)
 
 
 #: the file names of each model family's calibration files (for the messages)
@@ -271,13 +544,12 @@ FAMILY_FILES = {
 }
 
 
-def _calibration_out_format(args, camera, verb: str) -> str:
-    """The format of the calibration file ``-o`` (its name, or --format); a CliError where the
-    format is of another model family than ``camera`` (the file would hold another model than
-    the one --model asked for and the output states)."""
+def _calibration_out_format(args, camera, verb: str, fmt: str) -> str:
+    """``fmt``, the format of the calibration file ``-o`` (:func:`_calibration_format`, found
+    before the run); a CliError where it is of another model family than ``camera`` (the file
+    would hold another model than the one --model asked for and the output states)."""
     from distortion.camera.files import FORMAT_FAMILY  # format -> model family, as files.py writes
 
-    fmt = _calibration_format(args.output, args.format)
     have, want = FORMAT_FAMILY[fmt], camera.spec.target
     if have != want:
         how = f" --format {args.format}" if args.format else ""
@@ -296,17 +568,17 @@ ONE_DISTANCE_ONLY = ("--plot", "--picture", "--maps", "--maps-direction", "--pat
                      "--strict")  # fmt: skip
 
 
-def _model_table_out(args, table, note: str | None = None) -> None:
-    """A table of camera models per object distance: written to ``-o`` (.csv or .json) when
-    given, and shown as text, JSON or CSV (:func:`_emit`, ``note`` as there)."""
+def _model_table_out(args, table, kind: str | None, note: str | None = None) -> None:
+    """A table of camera models per object distance: written to ``-o`` as ``kind`` (.csv or
+    .json, :func:`_table_kind` before the run) when given, and shown as text, JSON or CSV
+    (:func:`_emit`, ``note`` as there)."""
     from ..report.camera import format_model_table, model_table_csv, model_table_to_dict
 
     data = {"models_by_distance": model_table_to_dict(table)}
     if args.output:
         from ..report.jsonout import dumps
 
-        suffix = _table_kind(args.output, "a table of models")
-        text = model_table_csv(table) if suffix == "csv" else dumps(data) + "\n"
+        text = model_table_csv(table) if kind == "csv" else dumps(data) + "\n"
         _write(args.output, text, args)
     _emit(args, format_model_table(table), data, model_table_csv(table), note)
 
@@ -319,6 +591,7 @@ def _cmd_lens(args, lens_name: str) -> int:
         remap_maps,
         traced_models_by_distance,
     )
+    from distortion.errors import DataError
 
     from ..report.camera import (
         format_traced_camera,
@@ -339,8 +612,6 @@ def _cmd_lens(args, lens_name: str) -> int:
     setup = _setup(args, sensor)
     n = args.coefficients
     if args.object_distances is not None:
-        if any(k is not None for k in (args.object_distance, args.object_s, args.object_scale)):
-            raise CliError("--object-distances are the table's rows: leave out --object-distance")
         unread = [f for f in dict.fromkeys(getattr(args, GIVEN, ())) if f in ONE_DISTANCE_ONLY]
         if unread:
             raise CliError(
@@ -348,13 +619,28 @@ def _cmd_lens(args, lens_name: str) -> int:
                 f"only: {', '.join(unread)} {'is' if len(unread) == 1 else 'are'} read for one "
                 f"object distance (--object-distance); drop {'it' if len(unread) == 1 else 'them'}"
             )
-        if args.output:
-            _table_kind(args.output, "a table of models")  # before the trace
+        kind = _table_kind(args.output, "a table of models") if args.output else None
         objs = _distances(args.object_distances)
-        table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
-        _model_table_out(args, table, setup.resolve(lens).projection_centre)
+        for d in objs:
+            _object_distance(d, "--object-distances")
+        try:
+            table = traced_models_by_distance(lens, setup, objs, args.model, n_coefficients=n)
+        except DataError as e:
+            if any(getattr(setup, k) is not None for k in FOCUS_KEYS):
+                raise
+            import re  # no focus (flag or spec): the table is focused at its first distance
+
+            raise CliError(
+                re.sub(
+                    r"focused at focus = (\S+):",
+                    r"focused at \1 (the first of --object-distances, as no focus is given):",
+                    str(e),
+                )
+            ) from e
+        _model_table_out(args, table, kind, setup.resolve(lens).projection_centre)
         return 0
     _refuse_idle_flags(args)
+    fmt = _calibration_format(args.output, args.format) if args.output else None
     tc = camera_model(lens, setup, args.model, n_coefficients=n)
     if tc.points.n_failed:
         import numpy as np
@@ -374,7 +660,7 @@ def _cmd_lens(args, lens_name: str) -> int:
             "it (and its maps and picture) is not the lens's; --strict refuses such a run"
         )
     if args.output:
-        fmt = _calibration_out_format(args, tc.camera, "fits")
+        fmt = _calibration_out_format(args, tc.camera, "fits", fmt)
         _write(args.output, tc.calibration_text(fmt), args)
     _emit(args, format_traced_camera(tc), traced_camera_to_dict(tc), points_csv(tc),
           tc.geometry.projection_centre)  # fmt: skip
@@ -438,8 +724,7 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
     check_plot_path(args.plot, "--plot", args)
     check_output_path(args.output, args)
-    if args.output:
-        _table_kind(args.output, "a comparison")  # before the trace
+    kind = _table_kind(args.output, "a comparison") if args.output else None  # before the trace
     (cal,) = _read_calibrations(args, cal_path)
     sensor = _sensor(args, cal)
     setup = _setup(args, sensor)
@@ -447,11 +732,8 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     if args.output:
         from ..report.jsonout import dumps
 
-        suffix = _table_kind(args.output, "a comparison")
         data = (
-            comparison_csv(cmp)
-            if suffix == "csv"
-            else dumps({"comparison": comparison_to_dict(cmp)})
+            comparison_csv(cmp) if kind == "csv" else dumps({"comparison": comparison_to_dict(cmp)})
         )
         _write(args.output, data, args)
     _emit(args, format_comparison(cmp), {"comparison": comparison_to_dict(cmp)},
@@ -474,16 +756,14 @@ def _cmd_convert(args, cal_word: str) -> int:
     args._inputs = [p for p in (cal_path, args.camera) if p]
     check_output_path(args.output, args)
     _refuse_idle_flags(args)
+    fmt = _calibration_format(args.output, args.format) if args.output else None
     (cal,) = _read_calibrations(args, cal_path)
-    target = {"fisheye": "opencv_fisheye", "colmap": "colmap:FULL_OPENCV",
-              "colmap-fisheye": "colmap:OPENCV_FISHEYE"}.get(args.model, args.model)  # fmt: skip
+    target = CONVERT_TARGETS.get(args.model, args.model)
     ps = cal.pixel_size_mm
     if ps is None and (args.sensor is not None or args.pitch is not None or args.camera):
         ps = _sensor(args, cal).pixel_size_mm
     if ps is not None and cal.pixel_size_mm is None:
         cal = CameraModel(cal.model, cal.params, cal.width, cal.height, ps)
-    if args.coefficients is not None and target != "opencv":
-        raise CliError("--coefficients applies to --model opencv")
     if args.model in ("colmap", "opencv", "metashape", "australis") and args.coefficients is None:
         try:  # the smallest model of the family that holds the calibration exactly
             exact = smallest_exact(cal, args.model).model
@@ -495,7 +775,7 @@ def _cmd_convert(args, cal_word: str) -> int:
             target = exact
     conv = convert_camera_model(cal, target, free=args.coefficients)
     if args.output:
-        fmt = _calibration_out_format(args, conv.camera, "converts to")
+        fmt = _calibration_out_format(args, conv.camera, "converts to", fmt)
         from distortion.camera import format_calibration
 
         _write(args.output, format_calibration(conv.camera, fmt), args)
@@ -509,14 +789,8 @@ def _cmd_variation(args, word1: str, word2: str) -> int:
     cal1, cal2 = calibration_path(word1), calibration_path(word2)
     args._inputs = [cal1, cal2]
     check_output_path(args.output, args)
-    if args.calibrated_at is None or args.focal_length is None or args.focus is None:
-        raise CliError("variation needs --calibrated-at S1,S2, --focal-length F and --focus S")
-    at = [s.strip() for s in str(args.calibrated_at).split(",") if s.strip()]
-    if len(at) != 2:
-        raise CliError("--calibrated-at: give the two focus distances S1,S2 of the calibrations")
-    if args.object_distances is None:
-        raise CliError("give --object-distances D1,D2,... (distances from the lens)")
-    objs = _distances(args.object_distances)
+    kind = _table_kind(args.output, "a table of models") if args.output else None
+    at, objs = _variation_distances(args)
     c1, c2 = _read_calibrations(args, cal1, cal2)
     ps = c1.pixel_size_mm or c2.pixel_size_mm
     if args.sensor is not None or args.pitch is not None or args.camera:
@@ -536,35 +810,138 @@ def _cmd_variation(args, word1: str, word2: str) -> int:
         pixel_size_mm=ps,
         name=f"{word1} and {word2}",
     )
-    _model_table_out(args, table)
+    _model_table_out(args, table, kind)
     return 0
 
 
-def cmd_camera(args) -> int:
-    words = list(args.words)
-    head = words[0]
-    if head == "compare":
-        if len(words) != 3:
-            raise CliError(f"usage: {USAGE['compare']}")
-        _refuse_foreign_flags(args, "compare")
-        return _cmd_compare(args, words[1], words[2])
-    if head == "convert":
-        if len(words) != 2:
-            raise CliError(f"usage: {USAGE['convert']}")
-        _refuse_foreign_flags(args, "convert")
-        return _cmd_convert(args, words[1])
-    if head == "variation":
-        if len(words) != 3:
-            raise CliError(f"usage: {USAGE['variation']}")
-        _refuse_foreign_flags(args, "variation")
-        return _cmd_variation(args, words[1], words[2])
-    if len(words) != 1:
+def _variation_distances(args) -> tuple[list[str], list[str]]:
+    """The distances of ``camera variation`` (--calibrated-at S1,S2 and --object-distances,
+    from the lens) and its other flags, checked before any file is read: each named by its
+    flag."""
+    if args.calibrated_at is None or args.focal_length is None or args.focus is None:
+        raise CliError("variation needs --calibrated-at S1,S2, --focal-length F and --focus S")
+    at = [s.strip() for s in str(args.calibrated_at).split(",") if s.strip()]
+    if len(at) != 2:
+        raise CliError("--calibrated-at: give the two focus distances S1,S2 of the calibrations")
+    s1, s2 = (length(s, "--calibrated-at", allow_inf=True, positive=True) for s in at)
+    if s1 == s2:
+        raise CliError(
+            f"--calibrated-at {args.calibrated_at}: the two calibrations are focused at the same "
+            "distance; give two different ones (Brown's Eq. 4 interpolates between them)"
+        )
+    length(args.focal_length, "--focal-length", positive=True)
+    length(args.focus, "--focus", allow_inf=True, positive=True)
+    if args.object_distances is None:
+        raise CliError("give --object-distances D1,D2,... (distances from the lens)")
+    objs = _distances(args.object_distances)
+    for d in objs:
+        length(d, "--object-distances", allow_inf=True, positive=True)
+    if args.method == "fraser-shortis" and args.g is None:
+        raise CliError(
+            "--method fraser-shortis needs --g G (g_ss' of Fraser & Shortis' Eq. 6, e.g. 0.45)"
+        )
+    if args.method == "brown" and args.g is not None:
+        raise CliError(
+            "--g is g_ss' of --method fraser-shortis (Eq. 6); Brown's Eq. 1 has none: give "
+            "--method fraser-shortis, or drop --g"
+        )
+    return at, objs
+
+
+#: the number of words of each form (the form's word and its inputs)
+N_WORDS = {"lens": 1, "compare": 3, "convert": 2, "variation": 3}
+
+
+def _check_words(form: str, words: list[str]) -> None:
+    """The words of ``form``: its inputs, as many as its usage line names."""
+    if len(words) == N_WORDS[form]:
+        return
+    if form == "lens":
         raise CliError(
             f"orthoscope camera takes one LENS (or: {', '.join(ACTIONS)} ...); got "
             + " ".join(words)
         )
-    _refuse_foreign_flags(args, "lens")
-    return _cmd_lens(args, head)
+    takes = USAGE[form].split(f"camera {form} ", 1)[1].split(" --", 1)[0]
+    got = words[1:]
+    said = f"got {len(got)}: {' '.join(got)}" if got else "got none"
+    raise CliError(f"`camera {form}` takes {takes}; {said} (usage: {USAGE[form]})")
+
+
+#: the --model words of ``camera convert`` that name a family's model to convert to
+CONVERT_TARGETS = {"fisheye": "opencv_fisheye", "colmap": "colmap:FULL_OPENCV",
+                   "colmap-fisheye": "colmap:OPENCV_FISHEYE"}  # fmt: skip
+
+
+def _check_model(args, form: str) -> None:
+    """--model and --coefficients of ``camera LENS`` / ``convert`` before any work: a model
+    family or one model name, and a coefficient count that family takes (the words of
+    distortion.camera: FAMILY_WORDS, COEFFICIENT_COUNTS, model_name)."""
+    import difflib
+
+    from distortion.camera.models import MODEL_NAMES, model_name
+    from distortion.camera.traced import COEFFICIENT_COUNTS, FAMILY_WORDS
+    from distortion.errors import DataError
+
+    model = str(args.model).strip()
+    family = FAMILY_WORDS.get(model.lower()) if form == "lens" else None
+    if family is None and model not in CONVERT_TARGETS:
+        try:
+            model_name(model)
+        except DataError:
+            words = list(dict.fromkeys([*MODEL_WORDS, *MODEL_NAMES]))
+            near = difflib.get_close_matches(model, words, n=3)
+            hint = f"; did you mean {', '.join(near)}?" if near else ""
+            raise CliError(
+                f"--model {model}: not a camera model{hint} (a family: {', '.join(MODEL_WORDS)}; "
+                f"or one model: {', '.join(MODEL_NAMES)})"
+            ) from None
+    n = args.coefficients
+    if n is None:
+        return
+    *most, last = COEFFICIENT_COUNTS["opencv"]
+    opencv = f"{', '.join(map(str, most))} or {last}"
+    if form == "convert":
+        if CONVERT_TARGETS.get(model, model) != "opencv" or n not in COEFFICIENT_COUNTS["opencv"]:
+            raise CliError(
+                f"--coefficients {n} does not apply to --model {model}: it fixes the number of "
+                f"coefficients of --model opencv, {opencv}"
+            )
+        return
+    if n not in COEFFICIENT_COUNTS.get(family, ()):
+        fisheye = COEFFICIENT_COUNTS["opencv_fisheye"]
+        raise CliError(
+            f"--coefficients {n} does not apply to --model {model}: give {opencv} with --model "
+            f"opencv, or {fisheye[0]} to {fisheye[-1]} with --model fisheye"
+        )
+
+
+def cmd_camera(args) -> int:
+    """``orthoscope camera``: the form its first word names, its flags checked before any work
+    (the flags of another form, conflicts, values; then the deprecation line of a deprecated
+    spelling that passed); a refusal of the API in the flags' words (:func:`_api_words`)."""
+    from raytrace.errors import OrthoscopeError
+
+    words = list(args.words)
+    form = _form_of_word(words[0])
+    _check_words(form, words)
+    _refuse_foreign_flags(args, form)
+    if form in ("lens", "compare"):
+        _check_object_flags(args)
+    if form in ("lens", "convert"):
+        _check_model(args, form)
+    _warn_deprecated(args)
+    try:
+        if form == "compare":
+            return _cmd_compare(args, words[1], words[2])
+        if form == "convert":
+            return _cmd_convert(args, words[1])
+        if form == "variation":
+            return _cmd_variation(args, words[1], words[2])
+        return _cmd_lens(args, words[0])
+    except CliError:
+        raise
+    except OrthoscopeError as e:
+        raise CliError(_api_words(str(e), args)) from e
 
 
 # ------------------------------------------------------------------- the flags each form reads
@@ -584,6 +961,13 @@ def form_flags(form: str) -> frozenset[str]:
     return frozenset(o for a in q._actions for o in a.option_strings)
 
 
+def _owners(flag: str) -> str:
+    """The forms that read ``flag``, as the messages name them (`camera LENS` and `camera
+    compare`)."""
+    names = [FORM_WORDS[f] for f in FORMS if flag in form_flags(f)]
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
 def _refuse_foreign_flags(args, form: str) -> None:
     """CliError naming each flag given (:func:`_note_given`) that ``form`` does not read, the
     form, and the forms it belongs to: the one parser of the command accepts every form's
@@ -592,22 +976,32 @@ def _refuse_foreign_flags(args, form: str) -> None:
     foreign = [flag for flag in given if flag not in form_flags(form)]
     if not foreign:
         return
-
-    def owners(flag: str) -> str:
-        names = [FORM_WORDS[f] for f in FORMS if flag in form_flags(f)]
-        return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
-
     where = FORM_WORDS[form]
     if len(foreign) == 1:
         flag = foreign[0]
-        raise CliError(f"{flag} is not read by {where} (it is a flag of {owners(flag)}); drop it")
-    each = ", ".join(f"{flag} (a flag of {owners(flag)})" for flag in foreign)
+        raise CliError(f"{flag} is not read by {where} (it is a flag of {_owners(flag)}); drop it")
+    each = ", ".join(f"{flag} (a flag of {_owners(flag)})" for flag in foreign)
     raise CliError(f"{where} does not read {each}; drop them")
+
+
+def _foreign_abbreviation(typed: str, flags, form: str) -> str:
+    """The refusal of an abbreviation ``typed`` that starts only ``flags`` of other forms than
+    ``form`` (:class:`_CameraParser`): what was typed, the flags it would be and their forms."""
+    each = " or ".join(f"{f}, a flag of {_owners(f)}" for f in dict.fromkeys(flags))
+    return f"{typed} is not a flag of {FORM_WORDS[form]} (it would be {each}); drop it"
 
 
 #: the namespace attribute in which the options of the command's parser note the option
 #: strings they were given by (:func:`_note_given`)
 GIVEN = "_given_flags"
+
+
+def _note(namespace, option_string: str) -> None:
+    noted = getattr(namespace, GIVEN, None)
+    if noted is None:
+        noted = []
+        setattr(namespace, GIVEN, noted)
+    noted.append(option_string)
 
 
 class _Noted:
@@ -616,27 +1010,124 @@ class _Noted:
     apart from absent even when the value given is the default (``--model opencv``)."""
 
     def __call__(self, parser, namespace, values, option_string=None):
-        noted = getattr(namespace, GIVEN, None)
-        if noted is None:
-            noted = []
-            setattr(namespace, GIVEN, noted)
-        noted.append(option_string or self.option_strings[0])
+        _note(namespace, option_string or self.option_strings[0])
         super().__call__(parser, namespace, values, option_string)
 
+
+class _NotedAlias(_Noted, DeprecatedAlias):
+    """A deprecated spelling (``--s`` of ``--object-s``) in the command's parser: noted and
+    stored like the flag it spells, its deprecation line said by :func:`_warn_deprecated` once
+    the run has accepted it (a flag refused anyway, of another form or in conflict, gets the
+    refusal alone)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        _note(namespace, option_string or self.option_strings[0])
+        setattr(namespace, self.dest, values)  # one value, as DeprecatedAlias stores it
+
+
+def _warn_deprecated(args) -> None:
+    """The deprecation line of each deprecated spelling given (as :class:`DeprecatedAlias` says
+    it), after the checks that refuse flags."""
+    given = dict.fromkeys(getattr(args, GIVEN, ()))
+    for flag in given:
+        new = DEPRECATED.get(flag)
+        if new is not None:
+            warn(f"{flag} is deprecated and will be removed; use {new}")
+
+
+#: the deprecated spellings of the command's parser and the flag each spells (filled by
+#: :func:`_note_given`)
+DEPRECATED: dict[str, str] = {}
 
 _NOTED: dict[type, type] = {}
 
 
 def _note_given(q: argparse.ArgumentParser) -> None:
     """Make every option of ``q`` but the help a :class:`_Noted` one (the same action, of a
-    subclass that notes it was given)."""
+    subclass that notes it was given; a deprecated spelling a :class:`_NotedAlias`)."""
     for a in q._actions:
         if not a.option_strings or isinstance(a, (_CameraHelp, argparse._HelpAction)):
+            continue
+        if isinstance(a, DeprecatedAlias):
+            if a.nargs is not None:  # pragma: no cover - every alias here stores one value
+                raise TypeError(f"{a.option_strings}: a deprecated alias of one value")
+            DEPRECATED.update(dict.fromkeys(a.option_strings, a.new))
+            a.__class__ = _NotedAlias
             continue
         cls = type(a)
         if cls not in _NOTED:
             _NOTED[cls] = type(f"Noted{cls.__name__}", (_Noted, cls), {})
         a.__class__ = _NOTED[cls]
+
+
+def _form_of_word(word: str) -> str:
+    return word if word in ACTIONS else "lens"
+
+
+class _CameraParser(Parser):
+    """The command's one parser, aware of the form it parses: an abbreviated long flag
+    (``--calib``) resolves among the flags of that form only (argparse would match every
+    form's), and one that starts only flags of other forms is refused, naming what was typed
+    and where those flags belong. The form is the first word, found before parsing
+    (:meth:`_form_of`); ``-h``/``--help`` (:class:`_CameraHelp`) uses it too."""
+
+    #: the form of the argv being parsed (None: not known, every form's flags)
+    _form: str | None = None
+
+    def parse_known_args(self, args=None, namespace=None):
+        import sys
+
+        tokens = list(sys.argv[1:] if args is None else args)
+        self._form = self._form_of(tokens)
+        try:
+            return super().parse_known_args(tokens, namespace)
+        finally:
+            self._form = None
+
+    def _form_of(self, tokens) -> str | None:
+        """The form of ``tokens`` (the arguments after ``camera``): its first word, skipping
+        the options and their values (an abbreviation counted by what it can stand for);
+        None where that is not plain (an unknown option before the first word, or none)."""
+        i = 0
+        while i < len(tokens):
+            tok = tokens[i]
+            if tok == "--":
+                return _form_of_word(tokens[i + 1]) if i + 1 < len(tokens) else None
+            if not tok.startswith("-") or tok == "-" or self._negative_number_matcher.match(tok):
+                return _form_of_word(tok)
+            if tok.startswith("--"):
+                if "=" in tok:  # --flag=value
+                    i += 1
+                    continue
+                acts = [a for o, a in self._option_string_actions.items() if o.startswith(tok)]
+                if tok in self._option_string_actions:
+                    acts = [self._option_string_actions[tok]]
+            else:  # -o FILE, -oFILE, -h
+                a = self._option_string_actions.get(tok[:2])
+                if a is None:
+                    return None
+                acts = [a] if len(tok) == 2 or a.nargs == 0 else []
+                if not acts:  # the value attached
+                    i += 1
+                    continue
+            values = {0 if a.nargs == 0 else 1 for a in acts}
+            if len(values) != 1:
+                return None
+            i += 1 + values.pop()
+        return None
+
+    def _get_option_tuples(self, option_string):
+        found = super()._get_option_tuples(option_string)
+        form = self._form
+        if form is None or not found:
+            return found
+        own = form_flags(form) | {"-h", "--help"}
+        mine = [t for t in found if t[1] in own]
+        if mine:
+            return mine
+        typed = option_string.split("=", 1)[0]
+        message = _foreign_abbreviation(typed, [t[1] for t in found], form)
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
 # ---------------------------------------------------------------------------------- the parser
@@ -724,8 +1215,9 @@ def _epilog(forms) -> str:
 
 
 class _CameraHelp(argparse.Action):
-    """``-h``/``--help``: the help page of the form the words before it name (``orthoscope camera
-    compare --help`` prints compare's), otherwise the command's general page."""
+    """``-h``/``--help``: the help page of the form the command's first word names (``orthoscope
+    camera compare --help`` and ``orthoscope camera --help compare`` print compare's), otherwise
+    the command's general page."""
 
     def __init__(
         self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None
@@ -734,8 +1226,9 @@ class _CameraHelp(argparse.Action):
 
     def __call__(self, parser, namespace, values, option_string=None):
         words = getattr(namespace, "words", None) or []
-        if words and words[0] in ACTIONS:
-            parser = action_parser(words[0])
+        form = words[0] if words else getattr(parser, "_form", None)  # --help before the words
+        if form in ACTIONS:
+            parser = action_parser(form)
         parser.print_help()
         parser.exit()
 
@@ -744,8 +1237,6 @@ def action_parser(action: str) -> argparse.ArgumentParser:
     """The help page of ``orthoscope camera ACTION`` (compare, convert, variation): its usage,
     what it does, the flags it reads and its examples. Only for the help: the command's one
     parser (:func:`register`) parses every form."""
-    from . import Parser
-
     q = Parser(
         prog=f"orthoscope camera {action}",
         usage=USAGE[action],
@@ -838,7 +1329,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
         )
         m.add_argument(
             "--coefficients",
-            type=int,
+            type=coefficient_count,
             metavar="N",
             help=say(
                 "Fix the number of coefficients: OpenCV 4, 5, 8, 12 or 14; fisheye 1-4.",
@@ -918,7 +1409,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
             default="brown",
             help="Brown's Eq. 1, or Fraser & Shortis' Eq. 6 with --g.",
         )
-        v.add_argument("--g", type=float, metavar="G", help="g_ss' of Fraser & Shortis' Eq. 6.")
+        v.add_argument("--g", type=g_factor, metavar="G", help="g_ss' of Fraser & Shortis' Eq. 6.")
     o = q.add_argument_group("outputs")
     o.add_argument(
         "-o",
@@ -937,7 +1428,7 @@ def _add_arguments(q: argparse.ArgumentParser, action: str | None) -> None:
         which = "the camera of a COLMAP cameras.txt that holds several (its CAMERA_ID)."
         o.add_argument(
             "--camera-id",
-            type=int,
+            type=camera_id,
             metavar="N",
             help=say(
                 f"compare / convert / variation: {which}",
@@ -1018,11 +1509,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         + "\n\nRun 'orthoscope camera compare --help' (convert, variation) for the flags of each.",
         add_help=False,
     )
+    q.__class__ = _CameraParser  # the parser of the subcommand, aware of the form it parses
     q.add_argument(
         "-h",
         "--help",
         action=_CameraHelp,
-        help="Show this help and exit (after compare, convert or variation: that form's help).",
+        help="Show this help and exit (with compare, convert or variation: that form's help).",
     )
     _add_arguments(q, None)
     _note_given(q)
