@@ -20,6 +20,8 @@ Measured per revision:
   this row by 10-40 % between processes of the same code. Differences of a few per cent are
   resolved only in one process: ``benchmarks/kernel_ab.py``;
 * the 50-field chief-ray curve (Cooke, 0–20°): median of 300 calls, ms;
+* the 2-D chief-ray grid (``chief_rays_2d``, ``topogon-us2031792-fig1``, 21 × 21 field angles
+  of ±30° on each axis): median of 50 calls, ms, and its mean traces to the stop per field;
 * CLI wall time and CPU time (user + system of the child, ``os.wait4``: a busy machine inflates
   it far less than the wall time), warm: ``distortion topogon-like-pestrecov``, ``paraxial
   cooke-triplet-f4`` and ``paraxial`` of a .zmx with catalog glasses
@@ -92,6 +94,19 @@ ts = []
 for _ in range(300):
     t0 = time.perf_counter(); cr(lens, f); ts.append(time.perf_counter() - t0)
 out["chief50_ms"] = float(np.median(ts) * 1e3)
+try:
+    from raytrace.trace.chief2d import chief_rays_2d
+except ImportError:  # a revision before the 2-D aim
+    chief_rays_2d = None
+if chief_rays_2d is not None:
+    tl = load_lens("topogon-us2031792-fig1")
+    X, Y = np.meshgrid(np.linspace(-30.0, 30.0, 21), np.linspace(-30.0, 30.0, 21))
+    c2 = chief_rays_2d(tl, X, Y)
+    ts = []
+    for _ in range(50):
+        t0 = time.perf_counter(); chief_rays_2d(tl, X, Y); ts.append(time.perf_counter() - t0)
+    out["grid21_ms"] = float(np.median(ts) * 1e3)
+    out["grid21_traces"] = float(np.mean(c2.iterations))
 print("RESULT", json.dumps(out))
 """
 

@@ -8,6 +8,7 @@ angle-field definition, tan(field_x), tan(field_y) — optiland/fields/field_typ
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -16,6 +17,7 @@ from support import benchmark_module
 
 from raytrace.errors import TraceError
 from raytrace.files.library import load_lens
+from raytrace.frames import Placement
 from raytrace.paraxial import paraxial
 from raytrace.trace import STATUS_AIM_FAILED, STATUS_OK, chief_rays, chief_rays_2d
 
@@ -129,6 +131,54 @@ def test_rays_the_lens_cannot_pass_get_a_status_and_nan():
     assert np.all(np.isfinite(cr.positions_at(60.0)[:2]))
     assert set(cr.status_names[2:]) <= {"aim_failed", "missed", "tir", "clipped"}
     assert STATUS_AIM_FAILED in cr.status or np.all(cr.surface[2:] > 0)
+
+
+@pytest.mark.parametrize(
+    "name,od,half",
+    [("topogon-us2031792-fig1", math.inf, 30.0), ("cooke-triplet-f4", 500.0, 14.0)],
+)
+def test_grid_fields_start_from_their_neighbours_jacobian_and_agree_with_lone_aims(name, od, half):
+    # The grid aim carries each solved field's Jacobian and slope du/df to its neighbours
+    # (raytrace.kernels.aim2d): the Topogon's 21 x 21 grid to 39 deg took 10.5 traces to the
+    # stop per field with a difference Jacobian in every Newton step, 5.9 now (regression pins,
+    # benchmarks/ab.py's grid21_traces, 2026-11-28); the bound here fails on the old aim.
+    lens = load_lens(name)
+    X, Y = np.meshgrid(np.linspace(-half, half, 21), np.linspace(-half, half, 21))
+    cr = chief_rays_2d(lens, X, Y, object_distance=od)
+    assert np.all(cr.status == STATUS_OK)
+    assert cr.iterations.mean() <= 7.0 and cr.iterations.max() <= 12
+    # the polish (with the carried, Broyden-updated Jacobian) takes every field far below the
+    # tolerance (here <= 0.007 of it; 0.0006 with a fresh difference Jacobian: regression pins),
+    # so a field aimed alone (from the origin field's solution and Jacobian) lands on the same
+    # image point
+    i = [0, 17, 220, 303, 440]
+    lone = [chief_rays_2d(lens, [X.flat[k]], [Y.flat[k]], object_distance=od) for k in i]
+    z = paraxial(lens, od).z_gauss
+    for k, one in zip(i, lone, strict=True):
+        assert one.iterations[0] > 0
+        np.testing.assert_allclose(
+            one.positions_at(z)[0], cr.positions_at(z).reshape(-1, 2)[k], rtol=0, atol=1e-12
+        )
+    for r in (cr.stop_residual_x, cr.stop_residual_y):
+        assert np.max(np.abs(r)) <= 0.05 * cr.tolerance
+
+
+def test_fields_a_round_off_apart_leave_the_carried_slope_finite():
+    # a review's reproducer: fields k x 2.3e-162 (tangents) on a triplet whose stop surface is
+    # decentred and tilted; the slope du/df carried from field to field once divided by a
+    # denormal |df|^2 and became inf/NaN, and 19 of the 20 fields failed (0 before carrying)
+    cooke = load_lens("cooke-triplet-f4")
+    s = list(cooke.surfaces)
+    s[3] = dataclasses.replace(
+        s[3], placement=Placement((-0.4, 0.7, 0.0), (-3.0, 4.0, 0.0)), after="return"
+    )
+    lens = dataclasses.replace(cooke, surfaces=tuple(s))
+    f = np.degrees(np.arctan(np.arange(1, 21) * 2.3e-162))
+    cr = chief_rays_2d(lens, f, np.zeros(20))
+    assert np.all(cr.status == STATUS_OK)
+    ref = chief_rays_2d(lens, [0.0], [0.0])
+    np.testing.assert_allclose(cr.positions_at(60.0), np.repeat(ref.positions_at(60.0), 20, 0),
+                               rtol=0, atol=1e-12)  # fmt: skip
 
 
 def test_shapes_and_plane_stacks():

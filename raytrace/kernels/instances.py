@@ -151,8 +151,9 @@ def _newton(lens, stop, finite, z_obj, f1, f2, u1, u2, tol, hscale):
     """The full Newton solve of :mod:`.aim2d` (:func:`.aim2d.newton_2d`, without its backward
     finite-difference step), the fallback of the chord iteration. Returns (converged, u1, u2,
     r1, r2, evaluations)."""
-    return newton_2d(_stop_point, lens, stop, finite, z_obj, f1, f2, u1, u2, tol, hscale,
-                     False)  # fmt: skip
+    nan = np.nan
+    return newton_2d(_stop_point, lens, stop, finite, z_obj, f1, f2, u1, u2, tol, hscale, False,
+                     nan, nan, nan, nan)[:6]  # fmt: skip
 
 
 @kernel(error_model="numpy")
