@@ -519,11 +519,12 @@ def test_form_flags_are_the_help_pages_and_cover_the_parser():
     variation), every flag of the command's parser is some form's, and every flag notes that
     it was given (so none escapes the check)."""
     from orthoscope.cli import build_parser
-    from orthoscope.cli.camera import ACTIONS, FORMS, _Noted, action_parser, form_flags
+    from orthoscope.cli.camera import ACTIONS, FORMS, action_parser, form_flags
+    from orthoscope.cli.common import Noted
 
     sub = build_parser("camera")._subparsers._group_actions[0].choices["camera"]
     options = [a for a in sub._actions if a.option_strings and "--help" not in a.option_strings]
-    assert all(isinstance(a, _Noted) for a in options)
+    assert all(isinstance(a, Noted) for a in options)
     every = {o for a in options for o in a.option_strings}
     assert set().union(*(form_flags(f) for f in FORMS)) == every
     for form in ACTIONS:
@@ -831,6 +832,21 @@ def test_a_setup_the_lens_cannot_image_is_named_where_it_was_given(tmp_path, mon
     ):
         rc, _, err = run(argv, tmp_path, monkeypatch)
         assert rc == 2 and said in _one_line(err), err
+
+
+def test_an_object_value_of_the_spec_is_named_by_its_key(tmp_path, monkeypatch):
+    # the API named [object] s and scale object_distance_s, object_distance_scale (no such
+    # keyword): the line kept them, as no flag or key is spelt so
+    head = '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[trace]\ngrid = [5, 5]\n'
+    for table, said in (
+        ('[object]\nscale = "abc"\n', "cam.toml [object] scale: 'abc' is not a number"),
+        ('[object]\ns = "abc"\n', "cam.toml [object] s: 'abc' is not a number"),
+        ("[object]\ns = 100\n", "cam.toml [object] s must be negative"),
+    ):
+        (tmp_path / "cam.toml").write_text(head + table, encoding="utf-8")
+        rc, _, err = run(["camera", "cooke-triplet-f4", "--camera", "cam.toml"], tmp_path,
+                         monkeypatch)  # fmt: skip
+        assert rc == 2 and said in _one_line(err) and "object_" not in err, err
 
 
 def test_a_calibration_named_without_a_format_is_refused_with_the_names(tmp_path, monkeypatch):

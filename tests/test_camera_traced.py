@@ -32,6 +32,7 @@ Numbers from our own earlier runs (the stated residuals) are regression pins and
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import sys
@@ -94,6 +95,32 @@ def test_setup_refuses_two_ways_and_bad_grids():
     # replace swaps one keyword of a kind for another
     a = CameraSetup(s, focus="2m").replace(from_last_vertex=40.0)
     assert a.focus is None and a.from_last_vertex == 40.0
+
+
+@pytest.mark.parametrize(
+    "kw,key",
+    [
+        ({"object_distance": "abc"}, "object_distance"),
+        ({"object_s": "abc"}, "object_s"),
+        ({"object_scale": "abc"}, "object_scale"),
+        ({"object_scale": -3}, "object_scale"),
+        ({"object_s": 100}, "object_s"),
+        ({"focus": "abc"}, "focus"),
+        ({"focus_s": "abc"}, "focus_s"),
+        ({"focus_scale": "abc"}, "focus_scale"),
+        ({"focus_s": 100}, "focus_s"),
+    ],
+)
+def test_a_refused_object_value_names_its_keyword(kw, key, cooke):
+    # the keyword given, a field of CameraSetup (object_s, object_scale were named
+    # object_distance_s, object_distance_scale: no such keyword)
+    assert key in {f.name for f in dataclasses.fields(CameraSetup)}
+    s = Sensor.from_spec(size="24x16", pixels="1200x800")
+    with pytest.raises(DataError) as e:
+        CameraSetup(s, grid=(3, 3), **kw).resolve(cooke)
+    # the keyword-like words of the message ("a real object" is prose): the one given
+    words = re.findall(r"\b(?:object|focus)\w*", str(e.value))
+    assert [w for w in words if "_" in w or w == "focus"] == [key], str(e.value)
 
 
 def test_focus_puts_the_sensor_in_the_gaussian_plane_of_the_focused_object(cooke):

@@ -555,3 +555,68 @@ def test_a_flood_of_distinct_warnings_is_cut_short(capsys):
         "orthoscope: warning: more warnings like these (OutOfRangeWarning) are not shown"
     )
     assert lines[11] == "orthoscope: warning: another kind"
+
+
+# ------------------------------------------------------------------ deprecated spellings
+S_DEPRECATED = "orthoscope: warning: --s is deprecated and will be removed; use --object-s"
+
+
+def _err_lines(err: str) -> list[str]:
+    return [ln for ln in err.strip().splitlines() if "compiling" not in ln]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["distortion", "cooke-triplet-f4", "--s", "-1000", "--object-s", "-900"],
+        ["distortion", "cooke-triplet-f4", "--object-s", "-900", "--s", "-1000"],
+        ["distortion", "cooke-triplet-f4", "--s", "-900", "--object-s", "-900", "--json"],
+        ["paraxial", "cooke-triplet-f4", "--object-s", "-900", "--s", "-1000"],
+        ["trace", "cooke-triplet-f4", "--s", "-1000", "--object-s=-1m"],
+    ],
+)
+def test_s_with_object_s_is_refused(argv, capsys):
+    # --s is the deprecated spelling of --object-s (one place): the last one given won, with
+    # the deprecation line said at parse time
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2 and out == ""
+    assert _err_lines(err) == [
+        f"orthoscope {argv[0]}: error: --s and --object-s both give the object's s (--s is the "
+        "deprecated spelling of --object-s): give --object-s alone"
+    ]
+
+
+@pytest.mark.parametrize(
+    "argv,said",
+    [
+        (["distortion", "cooke-triplet-f4", "--s", "-1000", "--fields", "abc"],
+         "--fields: expected a number"),
+        (["distortion", "cooke-triplet-f4", "--s", "abc"], "--s: 'abc' is not a number"),
+        (["distortion", "cooke-triplet-f4", "--s", "-1000", "--image-distance", "50",
+          "--defocus", "1"], "give the image planes one way"),
+        (["distortion", "cooke-triplet-f4", "--k", "100", "--at", "5"],
+         "--at and --value need --calibrate"),
+        (["trace", "cooke-triplet-f4", "--s", "-1000", "--object-distance", "1m"],
+         "give the object one way"),
+    ],
+)  # fmt: skip
+def test_a_refused_run_with_a_deprecated_spelling_prints_the_refusal_alone(argv, said, capsys):
+    # the deprecation line was said at parse time, before the refusal
+    rc, out, err = run(capsys, *argv)
+    lines = _err_lines(err)
+    assert rc == 2 and out == "" and len(lines) == 1 and said in lines[0], err
+    assert "deprecated" not in err
+
+
+def test_an_accepted_deprecated_spelling_is_said_once(capsys):
+    new = run(capsys, "distortion", "cooke-triplet-f4", "--object-s", "-1000", "--json")
+    assert new[0] == 0 and _err_lines(new[2]) == []
+    for argv in (["--s", "-1000"], ["--s", "-1000", "--s", "-1000"]):  # twice: said once
+        rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", *argv, "--json")
+        assert rc == 0 and out == new[1]
+        assert _err_lines(err) == [S_DEPRECATED]
+    rc, out, err = run(capsys, "distortion", "cooke-triplet-f4", "--s", "-1000", "--k", "100")
+    assert rc == 0 and _err_lines(err) == [
+        S_DEPRECATED,
+        "orthoscope: warning: --k is deprecated and will be removed; use --exaggeration",
+    ]

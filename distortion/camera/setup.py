@@ -59,6 +59,7 @@ from __future__ import annotations
 import difflib
 import math
 import os
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
@@ -294,22 +295,24 @@ def _in_units(
         raise DataError(str(e)) from None
 
 
-def _resolve_object(lens, distance, s, scale, wavelength, prefix: str) -> float:
+def _resolve_object(lens, distance, s, scale, wavelength, keys: tuple[str, str, str]) -> float:
+    """The object distance of one of the setup's object keyword triples ``keys``
+    (:data:`_OBJECT_KEYS` or :data:`_FOCUS_OBJECT_KEYS`), a refusal naming the keyword given."""
     from raytrace.errors import TraceError
     from raytrace.paraxial import resolve_object_distance
 
+    key_distance, key_s, key_scale = keys
     try:
         return resolve_object_distance(
             lens,
-            object_distance=_object_value(distance, prefix),
-            object_s=_in_units(length_mm, s, f"{prefix}_s"),
-            object_scale=_in_units(image_scale, scale, f"{prefix}_scale"),
+            object_distance=_object_value(distance, key_distance),
+            object_s=_in_units(length_mm, s, key_s),
+            object_scale=_in_units(image_scale, scale, key_scale),
             wavelength=wavelength,
         )
-    except TraceError as e:
-        msg = str(e)
-        if prefix == "focus":
-            msg = msg.replace("object_distance", "focus").replace("object_s", "focus_s")
+    except TraceError as e:  # the words of resolve_object_distance: the object_* keywords
+        own = dict(zip(_OBJECT_KEYS, keys, strict=True))
+        msg = re.sub(r"\b(object_distance|object_s|object_scale)\b", lambda m: own[m[1]], str(e))
         raise DataError(f"{lens.name}: {msg}") from None
 
 
@@ -338,13 +341,13 @@ def resolve_setup(lens, setup: CameraSetup) -> CameraGeometry:
         else _in_units(wavelength_nm, setup.wavelength, "wavelength")
     )
     od = _resolve_object(
-        lens, setup.object_distance, setup.object_s, setup.object_scale, wl_ref, "object_distance"
+        lens, setup.object_distance, setup.object_s, setup.object_scale, wl_ref, _OBJECT_KEYS
     )
     par_ref = paraxial(lens, od, wl_ref)
     focus_od: float | None = None
     if any(getattr(setup, k) is not None for k in _FOCUS_OBJECT_KEYS):
         focus_od = _resolve_object(
-            lens, setup.focus, setup.focus_s, setup.focus_scale, wl_ref, "focus"
+            lens, setup.focus, setup.focus_s, setup.focus_scale, wl_ref, _FOCUS_OBJECT_KEYS
         )
         flv = paraxial(lens, focus_od, wl_ref).gaussian_image_distance
         what = f"focused at {setup.describe_focus()}"

@@ -344,7 +344,12 @@ def _run(argv: Sequence[str] | None) -> int:
                 from raytrace.materials import OutOfRangeWarning
 
                 warnings.filterwarnings("error", category=OutOfRangeWarning)
-            return int(args.func(args) or 0)
+            status = int(args.func(args) or 0)
+        if status < EXIT_USAGE:  # the flags were accepted (not refused, not interrupted)
+            from .common import warn_deprecated
+
+            warn_deprecated(args)  # the deprecated spellings given, after the command's checks
+        return status
     except KeyboardInterrupt:
         print(f"{command}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

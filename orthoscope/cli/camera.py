@@ -23,8 +23,9 @@ import math
 
 from . import EXIT_USAGE, Parser
 from .common import (
+    S_AND_OBJECT_S,
     CliError,
-    DeprecatedAlias,
+    Noted,
     add_force_arg,
     add_object_args,
     add_output_args,
@@ -34,11 +35,13 @@ from .common import (
     check_output_path,
     check_plot_path,
     first_repeat,
+    given_flags,
     length,
     load,
     print_json,
     save_plot,
     warn,
+    warn_deprecated,
 )
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -140,22 +143,14 @@ FOCUS_KEYS = ("focus", "focus_s", "focus_scale", "s_prime", "from_last_vertex", 
 OBJECT_FLAGS = ("--object-distance", "--object-s", "--object-scale", "--s")
 
 
-def _given(args) -> list[str]:
-    """The flags given (:func:`_note_given`), in the order given, each once."""
-    return list(dict.fromkeys(getattr(args, GIVEN, ())))
-
-
 def _check_object_flags(args) -> None:
     """The object and focus flags of ``camera LENS`` / ``compare`` before any work: given one
     way, each value readable, named as given (``--s`` where that was typed). Object distances
     are positive and Pestrecov's s negative (a real object); the lens decides the rest."""
-    given = _given(args)
+    given = given_flags(args)
     obj = [f for f in given if f in OBJECT_FLAGS]
     if "--s" in obj and "--object-s" in obj:
-        raise CliError(
-            "--s and --object-s both give the object's s (--s is the deprecated spelling of "
-            "--object-s): give --object-s alone"
-        )
+        raise CliError(S_AND_OBJECT_S)
     if len(obj) > 1:
         raise CliError(f"give the object one way, not {' and '.join(obj)}")
     if getattr(args, "object_distances", None) is not None and obj:
@@ -251,7 +246,7 @@ def _api_words(message: str, args) -> str:
     [focus] s``), without the ``CameraSetup:`` prefix."""
     import re
 
-    given = _given(args)
+    given = given_flags(args)
 
     def flag(key: str, value: str = "") -> str:
         f = SETUP_FLAGS[key]
@@ -481,9 +476,9 @@ NEEDS = {
 
 
 def _refuse_idle_flags(args) -> None:
-    """CliError for a flag given (:func:`_note_given`, so also at its default value) without
+    """CliError for a flag given (:func:`given_flags`, so also at its default value) without
     the flag whose output it sets (:data:`NEEDS`)."""
-    given = getattr(args, GIVEN, ())
+    given = given_flags(args)
     for flag, (needs, dest, what) in NEEDS.items():
         if flag in given and not getattr(args, dest, None):
             raise CliError(f"{flag} sets {what}: give {needs}, or drop {flag}")
@@ -499,7 +494,7 @@ def _read_calibrations(args, *paths):
     for p, f in zip(paths, fmts, strict=True):
         if f is None:  # read_calibration says why it cannot be read
             read_calibration(p)
-    if "--camera-id" in getattr(args, GIVEN, ()) and "colmap" not in fmts:
+    if "--camera-id" in given_flags(args) and "colmap" not in fmts:
         what = " and ".join(f"{p} is {f}" for p, f in zip(paths, fmts, strict=True))
         raise CliError(
             f"--camera-id chooses a camera of a COLMAP cameras.txt, and {what}: drop --camera-id"
@@ -553,7 +548,7 @@ def _calibration_out_format(args, camera, verb: str, fmt: str) -> str:
     have, want = FORMAT_FAMILY[fmt], camera.spec.target
     if have != want:
         how = f" --format {args.format}" if args.format else ""
-        default = "" if "--model" in getattr(args, GIVEN, ()) else " (the default)"
+        default = "" if "--model" in given_flags(args) else " (the default)"
         raise CliError(
             f"-o {args.output}{how} writes the {have} family but --model {args.model}{default} "
             f"{verb} {camera.model}: give --model {have}, or -o a file of the {want} family "
@@ -612,7 +607,7 @@ def _cmd_lens(args, lens_name: str) -> int:
     setup = _setup(args, sensor)
     n = args.coefficients
     if args.object_distances is not None:
-        unread = [f for f in dict.fromkeys(getattr(args, GIVEN, ())) if f in ONE_DISTANCE_ONLY]
+        unread = [f for f in given_flags(args) if f in ONE_DISTANCE_ONLY]
         if unread:
             raise CliError(
                 f"with --object-distances the command writes the table of models per distance "
@@ -929,7 +924,7 @@ def cmd_camera(args) -> int:
         _check_object_flags(args)
     if form in ("lens", "convert"):
         _check_model(args, form)
-    _warn_deprecated(args)
+    warn_deprecated(args)
     try:
         if form == "compare":
             return _cmd_compare(args, words[1], words[2])
@@ -969,10 +964,10 @@ def _owners(flag: str) -> str:
 
 
 def _refuse_foreign_flags(args, form: str) -> None:
-    """CliError naming each flag given (:func:`_note_given`) that ``form`` does not read, the
+    """CliError naming each flag given (:func:`given_flags`) that ``form`` does not read, the
     form, and the forms it belongs to: the one parser of the command accepts every form's
     flags, and a flag the form does not read would otherwise be silently ignored."""
-    given = dict.fromkeys(getattr(args, GIVEN, ()))  # in the order given, each once
+    given = given_flags(args)  # in the order given, each once
     foreign = [flag for flag in given if flag not in form_flags(form)]
     if not foreign:
         return
@@ -991,72 +986,20 @@ def _foreign_abbreviation(typed: str, flags, form: str) -> str:
     return f"{typed} is not a flag of {FORM_WORDS[form]} (it would be {each}); drop it"
 
 
-#: the namespace attribute in which the options of the command's parser note the option
-#: strings they were given by (:func:`_note_given`)
-GIVEN = "_given_flags"
-
-
-def _note(namespace, option_string: str) -> None:
-    noted = getattr(namespace, GIVEN, None)
-    if noted is None:
-        noted = []
-        setattr(namespace, GIVEN, noted)
-    noted.append(option_string)
-
-
-class _Noted:
-    """Mixin of an option of the command's parser: when given, it notes the option string it
-    was given by in the namespace (``GIVEN``), before doing what its action does. Given is told
-    apart from absent even when the value given is the default (``--model opencv``)."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        _note(namespace, option_string or self.option_strings[0])
-        super().__call__(parser, namespace, values, option_string)
-
-
-class _NotedAlias(_Noted, DeprecatedAlias):
-    """A deprecated spelling (``--s`` of ``--object-s``) in the command's parser: noted and
-    stored like the flag it spells, its deprecation line said by :func:`_warn_deprecated` once
-    the run has accepted it (a flag refused anyway, of another form or in conflict, gets the
-    refusal alone)."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        _note(namespace, option_string or self.option_strings[0])
-        setattr(namespace, self.dest, values)  # one value, as DeprecatedAlias stores it
-
-
-def _warn_deprecated(args) -> None:
-    """The deprecation line of each deprecated spelling given (as :class:`DeprecatedAlias` says
-    it), after the checks that refuse flags."""
-    given = dict.fromkeys(getattr(args, GIVEN, ()))
-    for flag in given:
-        new = DEPRECATED.get(flag)
-        if new is not None:
-            warn(f"{flag} is deprecated and will be removed; use {new}")
-
-
-#: the deprecated spellings of the command's parser and the flag each spells (filled by
-#: :func:`_note_given`)
-DEPRECATED: dict[str, str] = {}
-
 _NOTED: dict[type, type] = {}
 
 
 def _note_given(q: argparse.ArgumentParser) -> None:
-    """Make every option of ``q`` but the help a :class:`_Noted` one (the same action, of a
-    subclass that notes it was given; a deprecated spelling a :class:`_NotedAlias`)."""
+    """Make every option of ``q`` but the help a :class:`~orthoscope.cli.common.Noted` one (the
+    same action, of a subclass that notes it was given, :func:`given_flags`: given is told
+    apart from absent even when the value given is the default, ``--model opencv``). Those that
+    note themselves already (a deprecated spelling, the flag it spells) are left as they are."""
     for a in q._actions:
-        if not a.option_strings or isinstance(a, (_CameraHelp, argparse._HelpAction)):
-            continue
-        if isinstance(a, DeprecatedAlias):
-            if a.nargs is not None:  # pragma: no cover - every alias here stores one value
-                raise TypeError(f"{a.option_strings}: a deprecated alias of one value")
-            DEPRECATED.update(dict.fromkeys(a.option_strings, a.new))
-            a.__class__ = _NotedAlias
+        if not a.option_strings or isinstance(a, (_CameraHelp, argparse._HelpAction, Noted)):
             continue
         cls = type(a)
         if cls not in _NOTED:
-            _NOTED[cls] = type(f"Noted{cls.__name__}", (_Noted, cls), {})
+            _NOTED[cls] = type(f"Noted{cls.__name__}", (Noted, cls), {})
         a.__class__ = _NOTED[cls]
 
 

@@ -48,15 +48,68 @@ class CliError(OrthoscopeError):
     """A usage error detected after argparse (bad combination of flags, bad value)."""
 
 
-class DeprecatedAlias(argparse.Action):
-    """An old flag spelling that still works for one release, with a warning on stderr."""
+#: the namespace attributes of the flags given: the option strings of the noting actions
+#: (:class:`Noted`) in the order given, the deprecated spellings given (each with the flag it
+#: spells), and whether their deprecation lines were said
+GIVEN_FLAGS = "_noted_flags"
+DEPRECATED_GIVEN = "_deprecated_given"
+DEPRECATIONS_SAID = "_deprecations_said"
+
+#: the refusal of the deprecated --s with --object-s (each command that reads them)
+S_AND_OBJECT_S = (
+    "--s and --object-s both give the object's s (--s is the deprecated spelling of --object-s): "
+    "give --object-s alone"
+)
+
+
+def note_given(namespace, option_string: str) -> None:
+    """Note in ``namespace`` that the flag ``option_string`` was given (:func:`given_flags`)."""
+    noted = getattr(namespace, GIVEN_FLAGS, None)
+    if noted is None:
+        noted = []
+        setattr(namespace, GIVEN_FLAGS, noted)
+    noted.append(option_string)
+
+
+def given_flags(args) -> list[str]:
+    """The flags of noting actions (:class:`Noted`) given, in the order given, each once: a
+    deprecated spelling (:class:`DeprecatedAlias`), the flags that have one
+    (:class:`NotedStore`), and every flag of a parser that notes them all (``camera``)."""
+    return list(dict.fromkeys(getattr(args, GIVEN_FLAGS, ())))
+
+
+class Noted:
+    """Mixin of an argparse action: when given, it notes the option string it was given by
+    (:func:`given_flags`), then does what its action does."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        note_given(namespace, option_string or self.option_strings[0])
+        super().__call__(parser, namespace, values, option_string)
+
+
+class NotedStore(Noted, argparse._StoreAction):
+    """A flag stored as usual and noted as given: one that has a deprecated spelling, so that
+    both spellings given are told apart from one (the two store to one place)."""
+
+
+class DeprecatedAlias(Noted, argparse.Action):
+    """An old flag spelling that still works for one release: stored like the flag ``new`` it
+    spells, and noted (:func:`given_flags`); its warning on stderr is said once, after the
+    command's checks (:func:`warn_deprecated`), so that a refused run prints the refusal
+    alone."""
 
     def __init__(self, option_strings, dest, new: str = "", **kw) -> None:
         self.new = new
         super().__init__(option_strings, dest, **kw)
 
     def __call__(self, parser, namespace, values, option_string=None) -> None:
-        warn(f"{option_string} is deprecated and will be removed; use {self.new}")
+        flag = option_string or self.option_strings[0]
+        note_given(namespace, flag)
+        deprecated = getattr(namespace, DEPRECATED_GIVEN, None)
+        if deprecated is None:
+            deprecated = {}
+            setattr(namespace, DEPRECATED_GIVEN, deprecated)
+        deprecated[flag] = self.new
         if self.nargs == 0:
             setattr(namespace, self.dest, self.const)
         elif isinstance(getattr(namespace, self.dest, None), list) or self.default == []:
@@ -70,6 +123,17 @@ class DeprecatedAlias(argparse.Action):
 def add_alias(p, old: str, new: str, dest: str, **kw) -> None:
     """The hidden flag ``old``: a :class:`DeprecatedAlias` of ``new`` (storing to ``dest``)."""
     p.add_argument(old, dest=dest, action=DeprecatedAlias, new=new, help=argparse.SUPPRESS, **kw)
+
+
+def warn_deprecated(args) -> None:
+    """The deprecation line of each deprecated spelling given (:class:`DeprecatedAlias`), once
+    per run: after the command's checks (a handler may call it once its checks have passed;
+    :func:`orthoscope.cli.main` calls it when the handler returns)."""
+    if getattr(args, DEPRECATIONS_SAID, False):
+        return
+    setattr(args, DEPRECATIONS_SAID, True)
+    for old, new in getattr(args, DEPRECATED_GIVEN, {}).items():
+        warn(f"{old} is deprecated and will be removed; use {new}")
 
 
 def warn(message: str) -> None:
@@ -217,17 +281,25 @@ def add_object_args(p: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--object-distance", metavar="D", help="mm from the object plane to the first vertex."
     )
-    g.add_argument("--object-s", metavar="S", help="Pestrecov's s: mm from H, negative.")
+    g.add_argument(
+        "--object-s", action=NotedStore, metavar="S", help="Pestrecov's s: mm from H, negative."
+    )
     g.add_argument("--object-scale", metavar="N", help="image scale N (Nx): magnification -1/N.")
     add_alias(g, "--s", "--object-s", "object_s", metavar="S")
 
 
 def resolve_object(lens, args) -> float:
-    """The object distance (mm from the first vertex, or inf) from the object flags."""
+    """The object distance (mm from the first vertex, or inf) from the object flags
+    (:func:`add_object_args`); the deprecated ``--s`` with ``--object-s`` is refused, and a
+    value of ``--s`` is named as typed."""
     from raytrace.paraxial import resolve_object_distance
     from raytrace.units import UnitError, image_scale
 
-    s = None if args.object_s is None else length(args.object_s, "--object-s")
+    given = given_flags(args)
+    if "--s" in given and "--object-s" in given:
+        raise CliError(S_AND_OBJECT_S)
+    s_flag = "--s" if "--s" in given else "--object-s"
+    s = None if args.object_s is None else length(args.object_s, s_flag)
     scale = None
     if args.object_scale is not None:
         try:
