@@ -689,7 +689,7 @@ def test_help_before_the_form_prints_the_form_page(form):
 )  # fmt: skip
 def test_s_with_object_s_is_a_conflict(argv, tmp_path):
     # --s is the deprecated --object-s: both were taken, the last one winning, with a
-    # deprecation line
+    # deprecation line (now refused for every command when the arguments are parsed)
     rc, _, err = run([*argv, "-o", str(tmp_path / "out.json")])
     assert rc == 2, err
     assert _one_line(err).endswith(

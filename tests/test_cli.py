@@ -446,17 +446,10 @@ def test_ctrl_c_held_by_a_long_compile_ends_the_run_within_the_hold(tmp_path):
     assert took < SIGINT_HOLD_S + 3.0  # the 20 s "compile" did not run to its end
 
 
-def test_ctrl_c_held_by_a_long_compile_removes_the_temporary_matplotlib_folder(tmp_path):
-    # The Ctrl-C held back past SIGINT_HOLD_S ends the run through os._exit, which runs no
-    # atexit handler: the temporary MPLCONFIGDIR folder of a read-only home
-    # (_matplotlib_folder) stayed behind in TMPDIR. It is removed before that exit.
+def _read_only_home(tmp_path) -> dict:
+    """This environment with a home that cannot be written (no config or cache folders) and
+    ``tmp_path`` as TMPDIR."""
     import os
-    import signal
-    import subprocess
-    import sys
-    import time
-
-    from support import default_sigint
 
     env = {
         k: v
@@ -464,6 +457,21 @@ def test_ctrl_c_held_by_a_long_compile_removes_the_temporary_matplotlib_folder(t
         if k not in ("HOME", "XDG_CONFIG_HOME", "XDG_CACHE_HOME", "MPLCONFIGDIR")
     }
     env.update(HOME="/proc/no-home", TMPDIR=str(tmp_path))
+    return env
+
+
+def test_ctrl_c_held_by_a_long_compile_removes_the_temporary_matplotlib_folder(tmp_path):
+    # The Ctrl-C held back past SIGINT_HOLD_S ends the run through os._exit, which runs no
+    # atexit handler: the temporary MPLCONFIGDIR folder of a read-only home
+    # (_matplotlib_folder) stayed behind in TMPDIR. It is removed before that exit.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from support import default_sigint
+
+    env = _read_only_home(tmp_path)
     code = (
         "import os, sys, time\n"
         "from orthoscope.cli import _matplotlib_folder, _sigint_outside_llvm\n"
@@ -499,16 +507,10 @@ def test_a_plot_with_a_read_only_home_prints_no_matplotlib_lines(tmp_path):
     # matplotlib printed "mkdir -p failed for path ..." and "Matplotlib created a temporary cache
     # directory ..." on every plot when HOME cannot be written; the command gives it a
     # temporary folder first and removes it at exit
-    import os
     import subprocess
     import sys
 
-    env = {
-        k: v
-        for k, v in os.environ.items()
-        if k not in ("HOME", "XDG_CONFIG_HOME", "XDG_CACHE_HOME", "MPLCONFIGDIR")
-    }
-    env.update(HOME="/proc/no-home", TMPDIR=str(tmp_path))
+    env = _read_only_home(tmp_path)
     png = tmp_path / "d.png"
     r = subprocess.run(
         [sys.executable, "-m", "orthoscope", "distortion", "cooke-triplet-f4", "--fields",
@@ -576,8 +578,9 @@ def _err_lines(err: str) -> list[str]:
     ],
 )
 def test_s_with_object_s_is_refused(argv, capsys):
-    # --s is the deprecated spelling of --object-s (one place): the last one given won, with
-    # the deprecation line said at parse time
+    # --s is the deprecated spelling of --object-s: both given, the last one won, with the
+    # deprecation line said at parse time (now refused before any work, as every deprecated
+    # spelling with its flag: test_a_deprecated_spelling_with_its_flag_is_refused)
     rc, out, err = run(capsys, *argv)
     assert rc == 2 and out == ""
     assert _err_lines(err) == [
@@ -620,3 +623,156 @@ def test_an_accepted_deprecated_spelling_is_said_once(capsys):
         S_DEPRECATED,
         "orthoscope: warning: --k is deprecated and will be removed; use --exaggeration",
     ]
+
+
+def _deprecated_pairs():
+    """(command, deprecated action) for every deprecated spelling of every command (the
+    registry: a spelling added later is covered without anyone remembering to)."""
+    import importlib
+
+    from orthoscope.cli import COMMANDS, _subparser, build_parser
+    from orthoscope.cli.common import DeprecatedAlias
+
+    parser = build_parser()
+    samples = {}
+    for name in COMMANDS:
+        for argv in getattr(importlib.import_module(f"orthoscope.cli.{name}"), "SAMPLES", []):
+            samples.setdefault(argv[0], argv)
+    out = []
+    for command, argv in samples.items():
+        for a in _subparser(parser, command)._actions:
+            if isinstance(a, DeprecatedAlias):
+                value = a.choices[0] if a.choices else "1"
+                out.append((argv, a.option_strings[0], a.new, a.what, value))
+    return out
+
+
+DEPRECATED_PAIRS = _deprecated_pairs()
+
+
+def test_every_deprecated_spelling_of_the_brief_is_covered():
+    # the pairs that let the last one win silently (issue: --s/--object-s alone was refused)
+    found = {(argv[0], old, new) for argv, old, new, _, _ in DEPRECATED_PAIRS}
+    assert {
+        ("distortion", "--s", "--object-s"),
+        ("distortion", "--k", "--exaggeration"),
+        ("distortion", "--image-distance", "--s-prime"),
+        ("distortion", "--image-from-vertex", "--from-last-vertex"),
+        ("calibrate", "--criterion", "--method"),
+        ("compensate", "--criterion", "--method"),
+        ("compensate", "--M", "--magnification"),
+        ("trace", "--image-distance", "--s-prime"),
+        ("colour", "--image-from-vertex", "--from-last-vertex"),
+        ("camera", "--s", "--object-s"),
+    } <= found
+
+
+@pytest.mark.parametrize("old_first", [True, False], ids=["old-first", "new-first"])
+@pytest.mark.parametrize(
+    "argv,old,new,what,value",
+    DEPRECATED_PAIRS,
+    ids=[f"{p[0][0]}{p[1]}" for p in DEPRECATED_PAIRS],
+)
+def test_a_deprecated_spelling_with_its_flag_is_refused(
+    argv, old, new, what, value, old_first, capsys, tmp_path
+):
+    # before: both stored to one place and the last one given won silently (--k 100
+    # --exaggeration 50 plotted with 50; a repeatable --s-prime took both as two planes), with
+    # a deprecation line; now one line, exit 2, before any work, in every command
+    argv = [a.format(data=DATA, specs=DATA.parent.parent / "lenses" / "specs", tmp=tmp_path)
+            for a in argv]  # fmt: skip
+    both = [old, value, new, value] if old_first else [new, value, old, value]
+    rc, out, err = run(capsys, *argv, *both)
+    assert rc == 2 and out == "", err
+    assert _err_lines(err) == [
+        f"orthoscope {argv[0]}: error: {old} and {new} both give {what} ({old} is the "
+        f"deprecated spelling of {new}): give {new} alone"
+    ]
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_repeated_planes_of_both_spellings_are_refused(capsys):
+    # distortion's --s-prime is repeatable (more planes from one trace), but the README and the
+    # design doc call --image-distance an old spelling, not a second list: mixing them is
+    # refused like any pair (before: two planes, s' = 50 and 51, and a deprecation line)
+    rc, out, err = run(
+        capsys, "distortion", "cooke-triplet-f4", "--s-prime", "50", "--image-distance", "51"
+    )
+    assert rc == 2 and out == ""
+    assert _err_lines(err) == [
+        "orthoscope distortion: error: --image-distance and --s-prime both give the image "
+        "plane's s' (--image-distance is the deprecated spelling of --s-prime): give --s-prime "
+        "alone"
+    ]
+    # each spelling alone, repeated, still gives its planes
+    rc, new, _ = run(capsys, "distortion", "cooke-triplet-f4", "--s-prime", "50", "--s-prime",
+                     "51", "--json")  # fmt: skip
+    assert rc == 0 and len(json.loads(new)["distortion"]["planes"]) == 2
+    rc, old, err = run(capsys, "distortion", "cooke-triplet-f4", "--image-distance", "50",
+                       "--image-distance", "51", "--json")  # fmt: skip
+    assert rc == 0 and old == new
+    assert _err_lines(err) == [
+        "orthoscope: warning: --image-distance is deprecated and will be removed; use --s-prime"
+    ]
+
+
+@pytest.mark.parametrize(
+    "old,new,value",
+    [("--M", "--magnification", "-9"), ("--criterion", "--method", "minimax")],
+)
+def test_compensate_old_spellings_alone_still_run(old, new, value, capsys):
+    base = ["compensate", "topogon-us2031792-fig1", "twinplex-like-55-525", "--fields",
+            "0,10,20,30", "--json"]  # fmt: skip
+    rc, want, err = run(capsys, *base, new, value)
+    assert rc == 0 and _err_lines(err) == [], err
+    rc, got, err = run(capsys, *base, old, value)
+    assert rc == 0 and got == want
+    assert _err_lines(err) == [
+        f"orthoscope: warning: {old} is deprecated and will be removed; use {new}"
+    ]
+
+
+def test_an_alias_of_a_flag_that_does_not_note_it_is_refused():
+    # the refusal of both spellings needs the new flag noted as given (NotedStore,
+    # NotedAppend): a deprecated spelling of a plain flag is a mistake of the code
+    import argparse
+
+    from orthoscope.cli.common import NotedStore, add_alias
+
+    p = argparse.ArgumentParser()
+    p.add_argument("--plain")
+    with pytest.raises(ValueError, match="noting action"):
+        add_alias(p, "--old-plain", "--plain", "plain", what="a value")
+    with pytest.raises(ValueError, match="add '--missing' first"):
+        add_alias(p, "--old-missing", "--missing", "missing", what="a value")
+    p.add_argument("--noted", action=NotedStore)
+    add_alias(p, "--old-noted", "--noted", "noted", what="a value")
+    assert p.parse_args(["--old-noted", "x"]).noted == "x"
+
+
+@pytest.mark.parametrize(
+    "argv,flags",
+    [
+        (["trace", "cooke-triplet-f4", "--s", "-1000", "--object-distance", "1m"],
+         "--s and --object-distance"),
+        (["trace", "cooke-triplet-f4", "--object-distance", "1m", "--s", "-1000"],
+         "--object-distance and --s"),
+        (["paraxial", "cooke-triplet-f4", "--object-scale", "12", "--object-s=-1m"],
+         "--object-scale and --object-s"),
+        (["distortion", "cooke-triplet-f4", "--object-distance", "1m", "--object-scale", "12"],
+         "--object-distance and --object-scale"),
+        (["pupils", "cooke-triplet-f4", "--object-s", "-1000", "--object-scale", "12",
+          "--object-distance", "1m"], "--object-s and --object-scale and --object-distance"),
+        (["colour", "cooke-triplet-f4", "--object-d", "1m", "--object-sc", "12"],
+         "--object-distance and --object-scale"),  # abbreviations: the flags they stand for
+        (["fan", "cooke-triplet-f4", "--s", "-1000", "--object-scale", "12"],
+         "--s and --object-scale"),
+        (["report", "cooke-triplet-f4", "--object-scale", "12", "--object-distance", "1m"],
+         "--object-scale and --object-distance"),
+    ],
+)  # fmt: skip
+def test_two_object_flags_are_named_as_flags(argv, flags, capsys):
+    # before: the API's keywords, "give the object one way, not object_distance and object_s"
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2 and out == ""
+    assert _err_lines(err) == [f"orthoscope {argv[0]}: error: give the object one way, not {flags}"]

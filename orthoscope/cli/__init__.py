@@ -333,6 +333,9 @@ def _run(argv: Sequence[str] | None) -> int:
             return e.code if isinstance(e.code, int) else EXIT_USAGE
         command = f"orthoscope {args.command}"
         _HELD["command"] = command
+        from .common import refuse_both_spellings
+
+        refuse_both_spellings(args)  # a deprecated spelling with its flag, before any work
         if args.threads is not None:
             _set_threads(args.threads)
         if args.command not in NO_KERNELS:

@@ -23,7 +23,6 @@ import math
 
 from . import EXIT_USAGE, Parser
 from .common import (
-    S_AND_OBJECT_S,
     CliError,
     Noted,
     add_force_arg,
@@ -38,6 +37,7 @@ from .common import (
     given_flags,
     length,
     load,
+    object_flags_given,
     print_json,
     save_plot,
     warn,
@@ -139,20 +139,11 @@ def _grid(text: str | None):
 FOCUS_KEYS = ("focus", "focus_s", "focus_scale", "s_prime", "from_last_vertex", "defocus")
 
 
-#: the object flags of ``camera LENS`` / ``compare`` (``--s``: the deprecated ``--object-s``)
-OBJECT_FLAGS = ("--object-distance", "--object-s", "--object-scale", "--s")
-
-
 def _check_object_flags(args) -> None:
     """The object and focus flags of ``camera LENS`` / ``compare`` before any work: given one
     way, each value readable, named as given (``--s`` where that was typed). Object distances
     are positive and Pestrecov's s negative (a real object); the lens decides the rest."""
-    given = given_flags(args)
-    obj = [f for f in given if f in OBJECT_FLAGS]
-    if "--s" in obj and "--object-s" in obj:
-        raise CliError(S_AND_OBJECT_S)
-    if len(obj) > 1:
-        raise CliError(f"give the object one way, not {' and '.join(obj)}")
+    obj = object_flags_given(args)  # --s with --object-s: refused at parse time
     if getattr(args, "object_distances", None) is not None and obj:
         raise CliError(f"--object-distances are the table's rows: leave out {obj[0]}")
     focus = [k for k in FOCUS_KEYS if getattr(args, k, None) is not None]

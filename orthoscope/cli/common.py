@@ -50,15 +50,17 @@ class CliError(OrthoscopeError):
 
 #: the namespace attributes of the flags given: the option strings of the noting actions
 #: (:class:`Noted`) in the order given, the deprecated spellings given (each with the flag it
-#: spells), and whether their deprecation lines were said
+#: spells), what each deprecated spelling given gives (for :func:`refuse_both_spellings`), and
+#: whether their deprecation lines were said
 GIVEN_FLAGS = "_noted_flags"
 DEPRECATED_GIVEN = "_deprecated_given"
+DEPRECATED_WHAT = "_deprecated_what"
 DEPRECATIONS_SAID = "_deprecations_said"
 
-#: the refusal of the deprecated --s with --object-s (each command that reads them)
-S_AND_OBJECT_S = (
-    "--s and --object-s both give the object's s (--s is the deprecated spelling of --object-s): "
-    "give --object-s alone"
+#: the refusal of a deprecated spelling given with the flag it spells (every command, one place:
+#: :func:`refuse_both_spellings`)
+BOTH_SPELLINGS = (
+    "{old} and {new} both give {what} ({old} is the deprecated spelling of {new}): give {new} alone"
 )
 
 
@@ -74,7 +76,8 @@ def note_given(namespace, option_string: str) -> None:
 def given_flags(args) -> list[str]:
     """The flags of noting actions (:class:`Noted`) given, in the order given, each once: a
     deprecated spelling (:class:`DeprecatedAlias`), the flags that have one
-    (:class:`NotedStore`), and every flag of a parser that notes them all (``camera``)."""
+    (:class:`NotedStore`, :class:`NotedAppend`), the object flags (:func:`add_object_args`),
+    and every flag of a parser that notes them all (``camera``)."""
     return list(dict.fromkeys(getattr(args, GIVEN_FLAGS, ())))
 
 
@@ -92,24 +95,31 @@ class NotedStore(Noted, argparse._StoreAction):
     both spellings given are told apart from one (the two store to one place)."""
 
 
+class NotedAppend(Noted, argparse._AppendAction):
+    """A repeatable flag (``action="append"``) noted as given (as :class:`NotedStore`)."""
+
+
 class DeprecatedAlias(Noted, argparse.Action):
     """An old flag spelling that still works for one release: stored like the flag ``new`` it
-    spells, and noted (:func:`given_flags`); its warning on stderr is said once, after the
-    command's checks (:func:`warn_deprecated`), so that a refused run prints the refusal
-    alone."""
+    spells, and noted (:func:`given_flags`); given with ``new`` it is refused before any work
+    (:func:`refuse_both_spellings`, naming ``what`` the two give); its warning on stderr is said
+    once, after the command's checks (:func:`warn_deprecated`), so that a refused run prints
+    the refusal alone."""
 
-    def __init__(self, option_strings, dest, new: str = "", **kw) -> None:
+    def __init__(self, option_strings, dest, new: str = "", what: str = "", **kw) -> None:
         self.new = new
+        self.what = what
         super().__init__(option_strings, dest, **kw)
 
     def __call__(self, parser, namespace, values, option_string=None) -> None:
         flag = option_string or self.option_strings[0]
         note_given(namespace, flag)
-        deprecated = getattr(namespace, DEPRECATED_GIVEN, None)
-        if deprecated is None:
-            deprecated = {}
-            setattr(namespace, DEPRECATED_GIVEN, deprecated)
-        deprecated[flag] = self.new
+        for attr, value in ((DEPRECATED_GIVEN, self.new), (DEPRECATED_WHAT, self.what)):
+            said = getattr(namespace, attr, None)
+            if said is None:
+                said = {}
+                setattr(namespace, attr, said)
+            said[flag] = value
         if self.nargs == 0:
             setattr(namespace, self.dest, self.const)
         elif isinstance(getattr(namespace, self.dest, None), list) or self.default == []:
@@ -120,9 +130,34 @@ class DeprecatedAlias(Noted, argparse.Action):
             setattr(namespace, self.dest, values)
 
 
-def add_alias(p, old: str, new: str, dest: str, **kw) -> None:
-    """The hidden flag ``old``: a :class:`DeprecatedAlias` of ``new`` (storing to ``dest``)."""
-    p.add_argument(old, dest=dest, action=DeprecatedAlias, new=new, help=argparse.SUPPRESS, **kw)
+def add_alias(p, old: str, new: str, dest: str, *, what: str, **kw) -> None:
+    """The hidden flag ``old``: a :class:`DeprecatedAlias` of ``new`` (storing to ``dest``),
+    which gives ``what`` (the refusal of both given, :func:`refuse_both_spellings`). ``new``
+    must be added to ``p`` first, as a noting action (:class:`Noted`: :class:`NotedStore`,
+    :class:`NotedAppend`), so that both given are told apart from one; a ValueError otherwise
+    (a mistake of the code, said when the parser is built)."""
+    action = p._option_string_actions.get(new)
+    if not isinstance(action, Noted) or action.dest != dest:
+        raise ValueError(
+            f"add_alias({old!r}): add {new!r} first, storing to {dest!r} with a noting action "
+            "(NotedStore, NotedAppend)"
+        )
+    p.add_argument(
+        old, dest=dest, action=DeprecatedAlias, new=new, what=what, help=argparse.SUPPRESS, **kw
+    )
+
+
+def refuse_both_spellings(args) -> None:
+    """CliError (one line, :data:`BOTH_SPELLINGS`) when a deprecated spelling
+    (:class:`DeprecatedAlias`) was given together with the flag it spells: the two store to one
+    place and the last one would win silently (a repeatable flag would take both, which a
+    reader of the command cannot tell from a mistake). Run by :func:`orthoscope.cli.main` once
+    the arguments are parsed, before any work, for every command."""
+    given = given_flags(args)
+    what = getattr(args, DEPRECATED_WHAT, {})
+    for old, new in getattr(args, DEPRECATED_GIVEN, {}).items():
+        if new in given:
+            raise CliError(BOTH_SPELLINGS.format(old=old, new=new, what=what[old]))
 
 
 def warn_deprecated(args) -> None:
@@ -278,26 +313,48 @@ def add_lens_arg(p: argparse.ArgumentParser) -> None:
 
 def add_object_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("object plane (give at most one)", OBJECT_HELP)
+    # noted (given_flags): two of them given are refused naming the flags as typed
     g.add_argument(
-        "--object-distance", metavar="D", help="mm from the object plane to the first vertex."
+        "--object-distance",
+        action=NotedStore,
+        metavar="D",
+        help="mm from the object plane to the first vertex.",
     )
     g.add_argument(
         "--object-s", action=NotedStore, metavar="S", help="Pestrecov's s: mm from H, negative."
     )
-    g.add_argument("--object-scale", metavar="N", help="image scale N (Nx): magnification -1/N.")
-    add_alias(g, "--s", "--object-s", "object_s", metavar="S")
+    g.add_argument(
+        "--object-scale",
+        action=NotedStore,
+        metavar="N",
+        help="image scale N (Nx): magnification -1/N.",
+    )
+    add_alias(g, "--s", "--object-s", "object_s", what="the object's s", metavar="S")
+
+
+#: the object flags (:func:`add_object_args`; ``--s``: the deprecated ``--object-s``)
+OBJECT_FLAGS = ("--object-distance", "--object-s", "--object-scale", "--s")
+
+
+def object_flags_given(args) -> list[str]:
+    """The object flags given (:data:`OBJECT_FLAGS`), as typed and in the order given; two of
+    them are refused in one line naming both."""
+    obj = [f for f in given_flags(args) if f in OBJECT_FLAGS]
+    if len(obj) > 1:
+        raise CliError(f"give the object one way, not {' and '.join(obj)}")
+    return obj
 
 
 def resolve_object(lens, args) -> float:
     """The object distance (mm from the first vertex, or inf) from the object flags
-    (:func:`add_object_args`); the deprecated ``--s`` with ``--object-s`` is refused, and a
-    value of ``--s`` is named as typed."""
+    (:func:`add_object_args`): two of them given are refused, naming the flags as typed and in
+    the order given (the deprecated ``--s`` with ``--object-s`` was refused when the arguments
+    were parsed, :func:`refuse_both_spellings`), and a value of ``--s`` is named as typed."""
     from raytrace.paraxial import resolve_object_distance
     from raytrace.units import UnitError, image_scale
 
     given = given_flags(args)
-    if "--s" in given and "--object-s" in given:
-        raise CliError(S_AND_OBJECT_S)
+    object_flags_given(args)
     s_flag = "--s" if "--s" in given else "--object-s"
     s = None if args.object_s is None else length(args.object_s, s_flag)
     scale = None
@@ -321,9 +378,10 @@ def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> N
         PLANE_HELP,
     )
     act = "append" if repeatable else "store"
-    g.add_argument("--s-prime", type=str, action=act, metavar="S'", help="mm from H'.")
+    noted = NotedAppend if repeatable else NotedStore  # the flags with a deprecated spelling
+    g.add_argument("--s-prime", type=str, action=noted, metavar="S'", help="mm from H'.")
     g.add_argument(
-        "--from-last-vertex", type=str, action=act, metavar="D", help="mm from the last vertex."
+        "--from-last-vertex", type=str, action=noted, metavar="D", help="mm from the last vertex."
     )
     g.add_argument(
         "--defocus", type=str, action=act, metavar="DZ", help="mm from the Gaussian plane."
@@ -333,11 +391,16 @@ def add_plane_args(p: argparse.ArgumentParser, *, repeatable: bool = False) -> N
         action="store_true",
         help="the Gaussian image plane of the object (with the flags above: one plane more).",
     )
-    for old, new, dest in (
-        ("--image-distance", "--s-prime", "s_prime"),
-        ("--image-from-vertex", "--from-last-vertex", "from_last_vertex"),
+    for old, new, dest, what in (
+        ("--image-distance", "--s-prime", "s_prime", "the image plane's s'"),
+        (
+            "--image-from-vertex",
+            "--from-last-vertex",
+            "from_last_vertex",
+            "the image plane's distance from the last vertex",
+        ),
     ):
-        add_alias(g, old, new, dest, metavar="X", default=[] if repeatable else None)
+        add_alias(g, old, new, dest, what=what, metavar="X", default=[] if repeatable else None)
 
 
 def resolve_planes(lens, args) -> list:

@@ -8,6 +8,7 @@ import math
 from .common import (
     METHODS,
     CliError,
+    NotedStore,
     add_alias,
     add_output_args,
     at_fields,
@@ -98,20 +99,31 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("printer", metavar="PRINTER", help="Printer distortion table (.csv) or lens.")
     q.add_argument(
         "--method",
+        action=NotedStore,
         default="given",
         choices=METHODS,
         help="How M is chosen: 'given' (--magnification, default M2: Pestrecov's condition for "
         "characteristic curves) or a calibration method over the camera fields.",
     )
-    add_alias(q, "--criterion", "--method", "method", choices=METHODS)
+    add_alias(
+        q, "--criterion", "--method", "method", what="the method that chooses M", choices=METHODS
+    )
     q.add_argument(
         "--magnification",
+        action=NotedStore,
         type=float,
         metavar="M",
         help="Print magnification factor M for 'given' (default M2): of the sign of M2; more "
         "than 10%% from M2 warns, more than a factor of 2 is refused.",
     )
-    add_alias(q, "--M", "--magnification", "magnification", type=float)
+    add_alias(
+        q,
+        "--M",
+        "--magnification",
+        "magnification",
+        what="the print magnification factor M",
+        type=float,
+    )
     q.add_argument("--at", metavar="A[,B]", help="Field(s) for two-point or zero-at (degrees).")
     q.add_argument(
         "--fields", metavar="F1,F2,...", help="Camera field angles (deg) when CAMERA is a lens."

@@ -9,6 +9,7 @@ from .common import (
     METHODS,
     REFERENCES,
     CliError,
+    NotedStore,
     add_alias,
     add_field_args,
     add_force_arg,
@@ -68,14 +69,27 @@ def add_calibration_args(q: argparse.ArgumentParser, *, required: bool) -> None:
     if required:
         # required, checked by the command (argparse's required=True would refuse the
         # deprecated spelling --criterion, which stores to the same place)
-        g.add_argument("--method", choices=METHODS, help=METHOD_HELP + " Required.")
-        add_alias(g, "--criterion", "--method", "method", choices=METHODS)
+        g.add_argument(
+            "--method", action=NotedStore, choices=METHODS, help=METHOD_HELP + " Required."
+        )
+        add_alias(
+            g, "--criterion", "--method", "method", what="the calibration method", choices=METHODS
+        )
     else:
         g.add_argument("--calibrate", metavar="METHOD", choices=METHODS, help=METHOD_HELP)
     g.add_argument("--at", metavar="A[,B]", help=AT_HELP)
     g.add_argument("--value", type=float, metavar="K", help="Fc (mm) or Mc for 'given'.")
-    g.add_argument("--exaggeration", type=float, default=200.0, metavar="K", help=EXAGGERATION_HELP)
-    add_alias(g, "--k", "--exaggeration", "exaggeration", type=float)
+    g.add_argument(
+        "--exaggeration",
+        action=NotedStore,
+        type=float,
+        default=200.0,
+        metavar="K",
+        help=EXAGGERATION_HELP,
+    )
+    add_alias(
+        g, "--k", "--exaggeration", "exaggeration", what="the plot exaggeration k", type=float
+    )
 
 
 def cmd_distortion(args) -> int:
