@@ -403,6 +403,18 @@ def test_ctrl_c_inside_llvm_is_delivered_again_later(monkeypatch):
         _sigint_handler(signal.SIGINT, sys._getframe())
 
 
+#: a child's 20 s in a function of a module named like numba's compiler, SIGINT handled as the
+#: CLI handles it (the child has imported sys and time, and _sigint_outside_llvm)
+_LONG_COMPILE = (
+    "_sigint_outside_llvm()\n"
+    "ns = {'__name__': 'numba.core.compiler'}\n"
+    "exec('def compile_for_a_while():\\n    import time\\n    t = time.monotonic()\\n'\n"
+    "     '    while time.monotonic() - t < 20:\\n        sum(range(1000))', ns)\n"
+    "print('compiling', file=sys.stderr, flush=True)\n"
+    "ns['compile_for_a_while']()\n"
+)
+
+
 def test_ctrl_c_held_by_a_long_compile_ends_the_run_within_the_hold(tmp_path):
     # The first run on a new machine compiles kernels for about a minute with numba's compiler
     # on the stack all along: the Ctrl-C was held back over and over and the command then ran
@@ -420,13 +432,8 @@ def test_ctrl_c_held_by_a_long_compile_ends_the_run_within_the_hold(tmp_path):
     code = (
         "import sys, time\n"
         "from orthoscope.cli import _sigint_outside_llvm\n"
-        "_sigint_outside_llvm()\n"
-        "ns = {'__name__': 'numba.core.compiler'}\n"
-        "exec('def compile_for_a_while():\\n    import time\\n    t = time.monotonic()\\n'\n"
-        "     '    while time.monotonic() - t < 20:\\n        sum(range(1000))', ns)\n"
-        "print('compiling', file=sys.stderr, flush=True)\n"
-        "ns['compile_for_a_while']()\n"
-        "print('finished', flush=True)\n"
+        + _LONG_COMPILE
+        + "print('finished', flush=True)\n"
     )
     p = subprocess.Popen(
         [sys.executable, "-c", code],
@@ -476,13 +483,7 @@ def test_ctrl_c_held_by_a_long_compile_removes_the_temporary_matplotlib_folder(t
         "import os, sys, time\n"
         "from orthoscope.cli import _matplotlib_folder, _sigint_outside_llvm\n"
         "_matplotlib_folder()\n"
-        "print(os.environ['MPLCONFIGDIR'], flush=True)\n"
-        "_sigint_outside_llvm()\n"
-        "ns = {'__name__': 'numba.core.compiler'}\n"
-        "exec('def compile_for_a_while():\\n    import time\\n    t = time.monotonic()\\n'\n"
-        "     '    while time.monotonic() - t < 20:\\n        sum(range(1000))', ns)\n"
-        "print('compiling', file=sys.stderr, flush=True)\n"
-        "ns['compile_for_a_while']()\n"
+        "print(os.environ['MPLCONFIGDIR'], flush=True)\n" + _LONG_COMPILE
     )
     p = subprocess.Popen(
         [sys.executable, "-c", code],

@@ -97,16 +97,21 @@ if __name__ == "__main__":
 """
 
 
+def _run_ok(script, code: str, timeout: float) -> subprocess.CompletedProcess:
+    """Run ``code`` as the script ``script`` in a fresh Python; it must end with "ok"."""
+    script.write_text(code)
+    r = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=timeout, check=False
+    )
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+    return r
+
+
 def test_local_cluster_workers_leave_the_warnings_to_the_parent(tmp_path):
     # a real LocalCluster of one worker (about 3 s): its tasks warn; only the control warning
     # reaches the terminal (which shows that the worker's warnings would)
     pytest.importorskip("distributed")
-    script = tmp_path / "cluster.py"
-    script.write_text(CLUSTER)
-    r = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, check=False
-    )
-    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+    r = _run_ok(tmp_path / "cluster.py", CLUSTER, 120)
     assert "control (in a worker)" in r.stderr, r.stderr
     assert "OutOfRangeWarning" not in r.stderr and "KernelCacheWarning" not in r.stderr, r.stderr
 
@@ -164,12 +169,7 @@ def test_remote_cluster_workers_leave_the_warnings_to_the_parent_while_connected
     # worker plugin (raytrace.executors.quiet_remote_workers) that ignores them on every worker,
     # also one that joins later, and that its close() removes again (about 5 s)
     pytest.importorskip("distributed")
-    script = tmp_path / "remote.py"
-    script.write_text(REMOTE)
-    r = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, timeout=180, check=False
-    )
-    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+    r = _run_ok(tmp_path / "remote.py", REMOTE, 180)
     err = r.stderr
     assert "no cache (before)" in err and "no cache (after)" in err, err  # the plugin's edges
     assert "control (connected)" in err and "control (late worker)" in err, err

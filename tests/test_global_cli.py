@@ -219,21 +219,28 @@ def test_progress_says_a_start_cut_short_is_not_done(monkeypatch):
     assert not any("done" in x for x in lines)
 
 
+def _interrupt_in_start(monkeypatch, start: int) -> list:
+    """Ctrl-C (a KeyboardInterrupt from the progress callback) in the first local run of
+    ``start``, once: the list that holds the event it was raised at (clear it to re-arm)."""
+    real, hit = GlobalProgress.__call__, []
+
+    def call(self, ev):
+        real(self, ev)
+        if ev.event == "local" and ev.start == start and not hit:
+            hit.append(ev)
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(GlobalProgress, "__call__", call)
+    return hit
+
+
 def test_interrupted_global_counts_the_starts_cut_short(
     refocus: Path, tmp_path: Path, monkeypatch, capsys
 ):
     # Ctrl-C (in this process: one worker) during start 1's first local run: start 0 finished,
     # start 1 is cut short with its best so far; the log and the notes tell them apart
     out = tmp_path / "out.toml"
-    real, hit = GlobalProgress.__call__, []
-
-    def call(self, ev):
-        real(self, ev)
-        if ev.event == "local" and ev.start == 1 and not hit:
-            hit.append(ev)
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(GlobalProgress, "__call__", call)
+    hit = _interrupt_in_start(monkeypatch, 1)
     argv = ["optimize", str(refocus), "-o", str(out), "--global", "--seed", "9", "--starts", "3"]
     assert main([*argv, "--json"]) == 130  # --json: no progress lines (the text run below)
     cap = capsys.readouterr()
@@ -267,15 +274,7 @@ def test_interrupted_global_says_how_far_it_got_not_not_converged(
         REFOCUS.replace("max_evaluations = 60", "max_evaluations = 60\nmerit_goal = 1e-12")
     )
     out = tmp_path / "out.toml"
-    real, hit = GlobalProgress.__call__, []
-
-    def call(self, ev):
-        real(self, ev)
-        if ev.event == "local" and ev.start == 0 and not hit:
-            hit.append(ev)
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(GlobalProgress, "__call__", call)
+    _interrupt_in_start(monkeypatch, 0)
     argv = ["optimize", str(spec), "-o", str(out), "--global", "--seed", "9"]
     assert main(argv) == 130
     cap = capsys.readouterr()
