@@ -63,6 +63,17 @@ def test_impossible_target_is_not_converged():
     res = optimize(lens, spec)
     assert not res.converged
     assert "above the goal" in res.message
+    # why the solver stopped, in the project's words: scipy's sentence ("`ftol` termination
+    # condition is satisfied.") stood in brackets here and in every converged run's message
+    assert "termination condition" not in res.message
+    assert "(the solver stopped: the gradient fell below the tolerance" in res.message
+
+
+def test_a_converged_run_says_why_in_our_words():
+    res = optimize(singlet(), singlet_spec())
+    assert res.converged
+    assert res.message.startswith("converged: "), res.message
+    assert "termination condition" not in res.message
 
 
 @pytest.mark.parametrize(

@@ -93,7 +93,7 @@ class GlobalProgress:
         now = time.monotonic()
         if ev.event == "start" and ev.stopped:  # its merit: its best design by then
             line = (
-                f"start {ev.start} cut short ({STOP_WORDS.get(ev.stopped, ev.stopped)}; "
+                f"start {ev.start} cut short ({_stop_words(ev.stopped)}; "
                 f"{ev.starts_done}/{ev.starts} ended): merit {ev.merit:.6g}, best {ev.best:.6g}, "
                 f"{ev.elapsed_s:.1f} s"
             )
@@ -130,12 +130,14 @@ OUTPUTS = [("-o", ".toml")]
 
 #: how the CLI names the merit of each method (OptimizationResult.merit)
 MERIT_NAMES = {"least_squares": "merit", "minimax": "max weighted residual"}
-#: why a run or a start was cut short (``stopped``), in words
-STOP_WORDS = {
-    "interrupted": "interrupted",
-    "time": "time budget spent",
-    "cluster": "the Dask cluster was lost",
-}
+
+
+def _stop_words(stopped: str) -> str:
+    """Why a run or a start was cut short (``stopped``), in words
+    (:func:`raytrace.optimize.global_search.stop_words`)."""
+    from raytrace.optimize.global_search import stop_words
+
+    return stop_words(stopped)
 
 
 def provenance_notes(lens, spec, res, start_name: str) -> str:
@@ -404,7 +406,7 @@ def _run_split_scan(args, spec, lens, out, inputs) -> int:
         for t in trials
     )
     if stopped:
-        tried += f"; {STOP_WORDS.get(stopped, stopped)} at element {trials[-1].surface}"
+        tried += f"; {_stop_words(stopped)} at element {trials[-1].surface}"
     lens, spec = split_design(lens, spec, best.surface)
     spec = replace(
         spec,
@@ -658,7 +660,7 @@ def _run_global(args, spec, lens, out, inputs, over) -> int:
             print(f"wrote {out}")
         elif res.stopped:  # stopped (time budget, cluster lost) short of the goal: not a failure
             print(
-                f"no lens written: the search stopped ({STOP_WORDS.get(res.stopped, res.stopped)}) "
+                f"no lens written: the search stopped ({_stop_words(res.stopped)}) "
                 "short of the spec's goal (--write-anyway writes it)"
             )
         else:

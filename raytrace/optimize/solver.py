@@ -284,6 +284,17 @@ class EvaluationLog:
         )
 
 
+#: why scipy's least_squares ended (its ``status`` > 0), in the project's words; ``{t}`` the
+#: spec's tolerance (scipy's xtol, ftol and gtol alike)
+SCIPY_STATUS_WORDS = {
+    1: "the gradient fell below the tolerance ({t:g})",
+    2: "the last step changed the merit by less than the tolerance ({t:g}, relative)",
+    3: "the last step changed the variables by less than the tolerance ({t:g}, relative)",
+    4: "the last step changed the merit and the variables by less than the tolerance "
+    "({t:g}, relative)",
+}
+
+
 def limit_message(count: str) -> str:
     """Why a local run ended at its evaluation limit, and how to raise the limit; ``count``:
     the limit as the method counts it ("400", "400 merit evaluations of ...")."""
@@ -462,7 +473,9 @@ def optimize(
     vals = evaluate(final, spec.operands, check=False)
     m = merit(vals)
     converged = status > 0
-    msg = message
+    # why scipy's least squares stopped, in the project's words (not scipy's sentence)
+    why = SCIPY_STATUS_WORDS[status].format(t=spec.tolerance) if status > 0 else message
+    msg = f"converged: {why}" if status > 0 else message
     if status == 0:  # scipy's max_nfev, said in our words (not scipy's sentence)
         msg = limit_message(
             f"{limit} merit evaluations of the solver's steps; {log.n} with its "
@@ -473,7 +486,7 @@ def optimize(
     elif spec.merit_goal is not None and m > spec.merit_goal:
         converged = False
         msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g}" + (
-            f": {msg}" if status == 0 else f" ({message})"
+            f": {msg}" if status == 0 else f" (the solver stopped: {why})"
         )
     msg += log.note()
     return OptimizationResult(
