@@ -777,3 +777,25 @@ def test_two_object_flags_are_named_as_flags(argv, flags, capsys):
     rc, out, err = run(capsys, *argv)
     assert rc == 2 and out == ""
     assert _err_lines(err) == [f"orthoscope {argv[0]}: error: give the object one way, not {flags}"]
+
+
+@pytest.mark.parametrize(
+    "argv,said",
+    [
+        (["distortion", "cooke-triplet-f4", "--image-distance", "50", "--defocus", "1"],
+         "give the image planes one way, not --image-distance, --defocus"),
+        (["distortion", "cooke-triplet-f4", "--image-distance", "abc"], "--image-distance: "),
+        (["distortion", "cooke-triplet-f4", "--image-distance", "50,50"],
+         "--image-distance: the plane 50 is listed twice"),
+        (["trace", "cooke-triplet-f4", "--image-from-vertex", "50", "--defocus", "1"],
+         "give the image planes one way, not --image-from-vertex, --defocus"),
+        (["distortion", "cooke-triplet-f4", "--s", "abc"], "--s: 'abc' is not a number"),
+    ],
+)  # fmt: skip
+def test_a_plane_or_object_flag_is_named_as_typed(argv, said, capsys):
+    # an old spelling was named by its new one in these refusals ("not --s-prime, --defocus"
+    # for --image-distance 50 --defocus 1): the user is told what they wrote
+    rc, out, err = run(capsys, *argv)
+    lines = _err_lines(err)
+    assert rc == 2 and out == "" and len(lines) == 1, err
+    assert lines[0].startswith(f"orthoscope {argv[0]}: error: {said}"), lines[0]

@@ -30,6 +30,7 @@ from .common import (
     add_output_args,
     add_strict_arg,
     add_wavelength_arg,
+    as_typed,
     bundled_or_path,
     check_output_path,
     check_plot_path,
@@ -152,7 +153,7 @@ def _check_object_flags(args) -> None:
         raise CliError(f"give the focus one way, not {flags}")
     if args.gaussian and focus:
         raise CliError("--gaussian (focused on the object) goes alone, without another focus flag")
-    s_flag = "--s" if "--s" in obj else "--object-s"
+    s_flag = as_typed(args, "--object-s")
     for flag, value, signed in (
         ("--object-distance", args.object_distance, s_flag),
         ("--focus", args.focus, "--focus-s"),

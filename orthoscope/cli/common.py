@@ -160,6 +160,15 @@ def refuse_both_spellings(args) -> None:
             raise CliError(BOTH_SPELLINGS.format(old=old, new=new, what=what[old]))
 
 
+def as_typed(args, flag: str) -> str:
+    """``flag`` as the command line gave it: its deprecated spelling (:class:`DeprecatedAlias`)
+    when that was typed instead, so that a message names what the user wrote."""
+    for old, new in getattr(args, DEPRECATED_GIVEN, {}).items():
+        if new == flag:
+            return old
+    return flag
+
+
 def warn_deprecated(args) -> None:
     """The deprecation line of each deprecated spelling given (:class:`DeprecatedAlias`), once
     per run: after the command's checks (a handler may call it once its checks have passed;
@@ -353,9 +362,8 @@ def resolve_object(lens, args) -> float:
     from raytrace.paraxial import resolve_object_distance
     from raytrace.units import UnitError, image_scale
 
-    given = given_flags(args)
     object_flags_given(args)
-    s_flag = "--s" if "--s" in given else "--object-s"
+    s_flag = as_typed(args, "--object-s")
     s = None if args.object_s is None else length(args.object_s, s_flag)
     scale = None
     if args.object_scale is not None:
@@ -409,7 +417,7 @@ def resolve_planes(lens, args) -> list:
     the traced object at the lens's reference wavelength: ``--wavelength`` does not move it)."""
     from raytrace.paraxial import ImagePlane
 
-    given = {}
+    given = {}  # kind: (the flag as typed, its values)
     for key, flag in (
         ("s_prime", "--s-prime"),
         ("from_last_vertex", "--from-last-vertex"),
@@ -418,19 +426,20 @@ def resolve_planes(lens, args) -> list:
         v = getattr(args, key, None)
         if v in (None, []):
             continue
+        flag = as_typed(args, flag)
         vals = v if isinstance(v, list) else [v]
         nums = []
         for item in vals:
             nums.extend(parse_list(item, flag, lengths=True).tolist())
-        given[key] = nums
+        given[key] = (flag, nums)
     if len(given) > 1:
-        flags = ", ".join("--" + k.replace("_", "-") for k in given)
+        flags = ", ".join(flag for flag, _ in given.values())
         raise CliError(f"give the image planes one way, not {flags}")
     if given:  # --gaussian with them adds the Gaussian plane to the list
-        ((kind, vals),) = given.items()
+        ((kind, (flag, vals)),) = given.items()
         dup = first_repeat(vals)
         if dup is not None:
-            raise CliError(f"--{kind.replace('_', '-')}: the plane {dup:g} is listed twice")
+            raise CliError(f"{flag}: the plane {dup:g} is listed twice")
         gauss = [ImagePlane("gaussian")] if args.gaussian else []
         return [ImagePlane(kind, float(v)) for v in vals] + gauss
     if args.gaussian:
