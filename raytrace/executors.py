@@ -61,13 +61,19 @@ WORKER_QUIET_WARNINGS = (
 )
 
 
+def _quiet_categories() -> list[type[Warning]]:
+    """The warning classes :data:`WORKER_QUIET_WARNINGS` names (their modules imported)."""
+    import importlib
+
+    return [getattr(importlib.import_module(m), name) for m, name in WORKER_QUIET_WARNINGS]
+
+
 def ignore_worker_warnings() -> None:
     """In a worker process: ignore the warning categories of :data:`WORKER_QUIET_WARNINGS`."""
-    import importlib
     import warnings
 
-    for module, name in WORKER_QUIET_WARNINGS:
-        warnings.simplefilter("ignore", getattr(importlib.import_module(module), name))
+    for category in _quiet_categories():
+        warnings.simplefilter("ignore", category)
 
 
 #: on a remote Dask worker: the names of the :class:`QuietWarningsPlugin` instances set up
@@ -79,14 +85,13 @@ _QUIET_FILTERS: list[tuple] = []
 def _quiet_worker_warnings(name: str) -> None:
     """:func:`ignore_worker_warnings` for the plugin ``name`` (a remote worker; the filters
     already there are left as they are, and none is added twice)."""
-    import importlib
     import warnings
 
     if not _QUIET_PLUGINS:
-        for module, cname in WORKER_QUIET_WARNINGS:
-            entry = ("ignore", None, getattr(importlib.import_module(module), cname), None, 0)
+        for category in _quiet_categories():
+            entry = ("ignore", None, category, None, 0)  # as simplefilter adds it
             if entry not in warnings.filters:
-                warnings.simplefilter("ignore", entry[2])
+                warnings.simplefilter("ignore", category)
                 _QUIET_FILTERS.append(entry)
     _QUIET_PLUGINS.add(name)
 
