@@ -49,12 +49,11 @@ class CliError(OrthoscopeError):
 
 
 #: the namespace attributes of the flags given: the option strings of the noting actions
-#: (:class:`Noted`) in the order given, the deprecated spellings given (each with the flag it
-#: spells), what each deprecated spelling given gives (for :func:`refuse_both_spellings`), and
-#: whether their deprecation lines were said
+#: (:class:`Noted`) in the order given, the deprecated spellings given (each with its
+#: :class:`DeprecatedAlias`, which knows the flag it spells and what they give), and whether
+#: their deprecation lines were said
 GIVEN_FLAGS = "_noted_flags"
 DEPRECATED_GIVEN = "_deprecated_given"
-DEPRECATED_WHAT = "_deprecated_what"
 DEPRECATIONS_SAID = "_deprecations_said"
 
 #: the refusal of a deprecated spelling given with the flag it spells (every command, one place:
@@ -114,12 +113,11 @@ class DeprecatedAlias(Noted, argparse.Action):
     def __call__(self, parser, namespace, values, option_string=None) -> None:
         flag = option_string or self.option_strings[0]
         note_given(namespace, flag)
-        for attr, value in ((DEPRECATED_GIVEN, self.new), (DEPRECATED_WHAT, self.what)):
-            said = getattr(namespace, attr, None)
-            if said is None:
-                said = {}
-                setattr(namespace, attr, said)
-            said[flag] = value
+        said = getattr(namespace, DEPRECATED_GIVEN, None)
+        if said is None:
+            said = {}
+            setattr(namespace, DEPRECATED_GIVEN, said)
+        said[flag] = self
         if self.nargs == 0:
             setattr(namespace, self.dest, self.const)
         elif isinstance(getattr(namespace, self.dest, None), list) or self.default == []:
@@ -154,17 +152,16 @@ def refuse_both_spellings(args) -> None:
     reader of the command cannot tell from a mistake). Run by :func:`orthoscope.cli.main` once
     the arguments are parsed, before any work, for every command."""
     given = given_flags(args)
-    what = getattr(args, DEPRECATED_WHAT, {})
-    for old, new in getattr(args, DEPRECATED_GIVEN, {}).items():
-        if new in given:
-            raise CliError(BOTH_SPELLINGS.format(old=old, new=new, what=what[old]))
+    for old, alias in getattr(args, DEPRECATED_GIVEN, {}).items():
+        if alias.new in given:
+            raise CliError(BOTH_SPELLINGS.format(old=old, new=alias.new, what=alias.what))
 
 
 def as_typed(args, flag: str) -> str:
     """``flag`` as the command line gave it: its deprecated spelling (:class:`DeprecatedAlias`)
     when that was typed instead, so that a message names what the user wrote."""
-    for old, new in getattr(args, DEPRECATED_GIVEN, {}).items():
-        if new == flag:
+    for old, alias in getattr(args, DEPRECATED_GIVEN, {}).items():
+        if alias.new == flag:
             return old
     return flag
 
@@ -176,8 +173,8 @@ def warn_deprecated(args) -> None:
     if getattr(args, DEPRECATIONS_SAID, False):
         return
     setattr(args, DEPRECATIONS_SAID, True)
-    for old, new in getattr(args, DEPRECATED_GIVEN, {}).items():
-        warn(f"{old} is deprecated and will be removed; use {new}")
+    for old, alias in getattr(args, DEPRECATED_GIVEN, {}).items():
+        warn(f"{old} is deprecated and will be removed; use {alias.new}")
 
 
 def warn(message: str) -> None:
