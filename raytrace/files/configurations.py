@@ -647,7 +647,7 @@ def read_configured(path: str | Path) -> tuple[Lens, Configurations]:
     from .library import resolve_lens_path
 
     p = resolve_lens_path(path)
-    both = _scaled_toml_configured(p)
+    both = _toml_configured(p)
     if both is not None:
         return both
     lens = read_lens_file(p)
@@ -656,11 +656,12 @@ def read_configured(path: str | Path) -> tuple[Lens, Configurations]:
     return lens, configs
 
 
-def _scaled_toml_configured(p: Path) -> tuple[Lens, Configurations] | None:
-    """:func:`read_configured` of a native TOML file with ``scale_to_efl`` and
-    ``[[configurations]]``, the lens built once: the build gives the factor the configurations
-    are scaled by (reading the lens and the configurations apart builds it twice). None for
-    any other file, or one that cannot be read or parsed (the ordinary path says why)."""
+def _toml_configured(p: Path) -> tuple[Lens, Configurations] | None:
+    """:func:`read_configured` of a native TOML file, read, parsed and built once: the build
+    gives the factor ``scale_to_efl`` scales the ``[[configurations]]`` by (reading the lens and
+    the configurations apart parses the file twice and, with ``scale_to_efl``, builds the lens
+    twice). None for a file of another format, or one that cannot be read or parsed (the
+    ordinary path says why)."""
     from . import READ_SUFFIXES
     from .native import WHAT, build_lens
 
@@ -671,8 +672,6 @@ def _scaled_toml_configured(p: Path) -> tuple[Lens, Configurations] | None:
         text = decode_text(read_bytes(p), spath, WHAT, latin1=False)
         data = tomllib.loads(text)
     except (PrescriptionError, tomllib.TOMLDecodeError, RecursionError):
-        return None
-    if not ("scale_to_efl" in data and data.get("configurations")):
         return None
     try:
         lens, factor = build_lens(data, text=text, path=spath)  # checks the configurations too
