@@ -43,7 +43,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from raytrace.errors import LensError, TraceError
 from raytrace.files.configurations import (
@@ -57,6 +56,7 @@ from raytrace.lens import Lens
 from ..errors import DataError
 from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
 from .models import Conjugate, brown_alpha_scales, brown_gamma_scales, brown_interpolate
+from .traced import field_limit, leading_run, radial_profile, resample_spline
 
 DEFAULT_N_FIELDS = 61
 DEFAULT_N_R = 25
@@ -270,16 +270,14 @@ class FocusSetting:
 
 
 def _field_limit(lens: Lens, max_field_deg: float | None) -> float:
-    if max_field_deg is not None:
-        if not 0 < max_field_deg < 90:
-            raise DataError(f"maximum field angle must lie in (0, 90) degrees, got {max_field_deg}")
-        return float(max_field_deg)
-    if lens.field.kind != "angle":
+    """:func:`~distortion.variation.traced.field_limit`, but a lens whose field is an object
+    height needs ``max_field_deg``."""
+    if max_field_deg is None and lens.field.kind != "angle":
         raise DataError(
             f"{lens.name}: its field is an object height; give max_field_deg (degrees) for a "
             "focus study"
         )
-    return float(lens.field.value)
+    return field_limit(lens, max_field_deg)
 
 
 def trace_focus_setting(
@@ -312,7 +310,7 @@ def trace_focus_setting(
     finite = math.isfinite(od)
     k0 = float(cd.constant[0])
     c = k0 * par.p0 if finite else k0
-    yp, y0p, d0 = cd.yp[0], cd.y0p[0], cd.D0[0]
+    r, dr = radial_profile(cd)
     scale = -1.0 / par.m0 if finite else math.inf
     return FocusSetting(
         name=name,
@@ -323,12 +321,12 @@ def trace_focus_setting(
         efl_mm=float(par.efl),
         principal_distance_mm=float(cd.s_prime[0]),
         camera_constant_mm=float(c),
-        principal_point_mm=float(yp[0]) if cd.fields[0] == 0 else math.nan,
+        principal_point_mm=float(cd.yp[0, 0]) if cd.fields[0] == 0 else math.nan,
         from_last_vertex_mm=float(t_img),
         defocus_mm=float(cd.defocus[0]),
         fields_deg=np.asarray(cd.fields, dtype=float),
-        r_mm=np.abs(yp),
-        dr_um=d0 * np.sign(y0p) * 1000.0,
+        r_mm=r,
+        dr_um=dr,
     )
 
 
@@ -403,22 +401,21 @@ class FocusStudy:
 
 
 def _spline(r: np.ndarray, dr: np.ndarray, grid: np.ndarray, label: str) -> np.ndarray:
-    ok = np.isfinite(r) & np.isfinite(dr)
-    n = int(np.argmin(ok)) if not ok.all() else ok.size
-    r, dr = r[:n], dr[:n]
+    """δr of a traced profile on ``grid`` (:func:`~distortion.variation.traced.resample_spline`
+    over its :func:`~distortion.variation.traced.leading_run`), which the radii must reach."""
+    r, dr = leading_run(r, dr)
     if r.size < 4 or not np.all(np.diff(r) > 0):
         raise DataError(f"profile {label}: fewer than 4 traced fields, or r does not grow")
     if grid[-1] > r[-1] * (1 + 1e-12):
         raise DataError(f"profile {label}: the radii reach only {r[-1]:.4g} mm")
-    return CubicSpline(r, dr)(grid)
+    return resample_spline(r, dr, grid, label)
 
 
 def _r_hi(settings: Sequence[FocusSetting]) -> float:
     out = math.inf
     for s in settings:
-        ok = np.isfinite(s.r_mm) & np.isfinite(s.dr_um)
-        n = int(np.argmin(ok)) if not ok.all() else ok.size
-        out = min(out, float(s.r_mm[n - 1]) if n else 0.0)
+        r, _ = leading_run(s.r_mm, s.dr_um)
+        out = min(out, float(r[-1]) if r.size else 0.0)
     return out
 
 

@@ -280,6 +280,14 @@ def leading_run(r: np.ndarray, dr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return r[:n], dr[:n]
 
 
+def radial_profile(cd) -> tuple[np.ndarray, np.ndarray]:
+    """(r, δr) of the first image plane of a characteristic distortion ``cd`` (module docstring,
+    "Radial profiles"): r = |y'| (mm) and δr = D0·sign(y0') (µm, outward positive; 0 on the
+    axis)."""
+    yp, y0p, d0 = cd.yp[0], cd.y0p[0], cd.D0[0]
+    return np.abs(yp), d0 * np.sign(y0p) * 1000.0
+
+
 def _same(a: Conjugate, b: Conjugate) -> bool:
     return a.unit == b.unit and a.value == b.value
 
@@ -323,9 +331,7 @@ def trace_setting(
         )
     except TraceError as e:
         raise DataError(f"{lens.name}, object {obj.label} focused at {focus.label}: {e}") from None
-    yp, y0p, d0 = cd.yp[0], cd.y0p[0], cd.D0[0]
-    r = np.abs(yp)
-    dr = d0 * np.sign(y0p) * 1000.0  # outward positive; 0 on the axis
+    r, dr = radial_profile(cd)
     m0 = cd.gaussian_constant
     return TracedSetting(
         focus=focus,
@@ -376,7 +382,10 @@ class TracedVariation:
         )
 
 
-def _field_limit(lens: Lens, max_field_deg: float | None) -> float:
+def field_limit(lens: Lens, max_field_deg: float | None) -> float:
+    """The largest field angle (degrees) a prescription-mode study traces: ``max_field_deg``,
+    checked to lie in (0, 90), or the lens's field; a field given as an object height h becomes
+    the paraxial angle atan(|h/p0|)."""
     if max_field_deg is not None:
         if not 0 < max_field_deg < 90:
             raise DataError(f"maximum field angle must lie in (0, 90) degrees, got {max_field_deg}")
@@ -466,7 +475,7 @@ def trace_variation(
     if n_r < 2 or n_fields < 8:
         raise DataError("need n_r >= 2 common radii and n_fields >= 8 traced fields")
     efl = paraxial(lens, math.inf, wavelength).efl
-    fmax = _field_limit(lens, max_field_deg)
+    fmax = field_limit(lens, max_field_deg)
     fields = np.linspace(0.0, fmax, n_fields)
 
     gauss: list[Conjugate] = []
