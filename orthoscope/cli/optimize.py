@@ -165,7 +165,7 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
     search cut short by a stop says how many starts finished of how many (those cut short
     counted apart) and that it was stopped; a stopped design that misses the spec's goal says
     so in words, not as NOT CONVERGED (it was stopped, not failed)."""
-    from raytrace.optimize.global_search import starts_count
+    from raytrace.optimize.global_search import goal_missed, starts_count
 
     date = _dt.date.today().isoformat()
     glasses = "; ".join(f"S{g.surface} {g.name} ({g.catalog})" for g in res.glasses)
@@ -196,17 +196,9 @@ def global_provenance_notes(spec, res, start_name: str, dask: str | None = None)
     if res.stopped:
         text += f" Search stopped early ({res.stopped}): the best design found by then."
         if not res.converged:
-            text += f" It does not meet the spec's goal: {_goal_missed(spec, res)}."
+            missed = goal_missed(res.method, res.merit, res.violation, spec.merit_goal)
+            text += f" It does not meet the spec's goal: {missed}."
     return text
-
-
-def _goal_missed(spec, res) -> str:
-    """How a global search's design misses the spec's goal (``res.converged`` false)."""
-    from raytrace.optimize.minimax import bounds_met
-
-    if res.method == "minimax" and not bounds_met(res.violation, res.merit):
-        return f"a bound is not met (largest weighted violation {res.violation:.3g})"
-    return f"{res.merit_is} {res.merit:.6g} is above the merit goal {spec.merit_goal:.6g}"
 
 
 def _aim(op) -> str:

@@ -225,6 +225,27 @@ def starts_count(finished: int, stopped: int, starts: int, search_stopped: bool 
 STOP_WORDS = {"time": "time budget spent", "interrupted": "interrupted"}
 
 
+def goal_missed(
+    method: str,
+    merit: float,
+    violation: float,
+    merit_goal: float | None,
+    *,
+    name_merit: bool = True,
+) -> str:
+    """How a design misses the spec's goal, in words; ``""`` when it meets it (the search's
+    ``converged``). With minimax a design that breaks a bound (:func:`.minimax.bounds_met`)
+    misses it first: "a bound is not met (largest weighted violation 0.012)"; else a merit above
+    ``merit_goal`` (or not a number): "merit 0.5 is above the merit goal 0.01", without the
+    "merit 0.5 is " where ``name_merit`` is false (a text that has just said the merit)."""
+    if method == "minimax" and not bounds_met(violation, merit):
+        return f"a bound is not met (largest weighted violation {violation:.3g})"
+    if merit_goal is None or merit <= merit_goal:
+        return ""
+    above = f"above the merit goal {merit_goal:.6g}"
+    return f"{MERIT_NAMES[method]} {merit:.6g} is {above}" if name_merit else above
+
+
 def stop_words(stopped: str, lost: str = "") -> str:
     """Why the search was stopped, in words (``lost``: what ended the Dask cluster)."""
     if stopped == "cluster":
@@ -686,8 +707,8 @@ def global_optimize(
         if g
     )
     # as a minimax run: a design that breaks a bound has not converged
-    feasible = spec.method != "minimax" or bounds_met(viol, m)
-    converged = feasible and (spec.merit_goal is None or m <= spec.merit_goal)
+    missed = goal_missed(spec.method, m, viol, spec.merit_goal, name_merit=False)
+    converged = not missed
     n_cut = sum(1 for o in done if o.stopped)  # cut short by the stop, with a design
     best_cut = best_k >= 0 and bool(outcomes[best_k].stopped)
     name = MERIT_NAMES[spec.method]
@@ -711,10 +732,8 @@ def global_optimize(
     else:
         count = starts_count(len(done) - n_cut, n_cut, s.starts)
         msg = f"best {name} {m:.6g} from start {best_k} of {count} (seed {s.seed})"
-    if not feasible:
-        msg += f"; a bound is not met (largest weighted violation {viol:.3g})"
-    elif not converged:
-        msg += f"; above the merit goal {spec.merit_goal:.6g}"
+    if missed:
+        msg += f"; {missed}"
     return GlobalResult(
         lens=final,
         merit=m,
