@@ -23,6 +23,7 @@ from distortion.camera.models import OPENCV_ORDERS
 from distortion.errors import DataError
 from raytrace.trace.results import status_name
 
+from .jsonout import copy_fields
 from .text import csv_text
 from .units import PARAMETER_UNITS
 
@@ -71,14 +72,15 @@ def _model_label(camera: CameraModel) -> str:
 
 
 def sensor_to_dict(s: Sensor) -> dict:
-    return {
-        "width_mm": s.width_mm,
-        "height_mm": s.height_mm,
-        "width_px": s.width_px,
-        "height_px": s.height_px,
-        "pixel_pitch_um": list(s.pixel_pitch_um),
-        "principal_point_offset_mm": list(s.principal_point_offset_mm),
-    }
+    return copy_fields(
+        s,
+        "width_mm",
+        "height_mm",
+        "width_px",
+        "height_px",
+        "pixel_pitch_um",
+        "principal_point_offset_mm",
+    )
 
 
 def _sensor_line(s: Sensor) -> str:

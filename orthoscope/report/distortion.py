@@ -9,7 +9,7 @@ from distortion.compensation import CompensationResult
 from distortion.curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
 from raytrace.trace.results import status_name
 
-from .jsonout import float_list
+from .jsonout import copy_fields, float_list
 from .text import csv_text, format_columns, untraced
 
 
@@ -36,10 +36,7 @@ def format_curve(
 def curve_to_dict(curve: DistortionCurve) -> dict:
     """JSON-ready dict of a curve (lists of floats; Dr as a fraction and in per cent)."""
     return {
-        "name": curve.name,
-        "plane": curve.plane,
-        "source": curve.source,
-        "field_kind": curve.field_kind,
+        **copy_fields(curve, "name", "plane", "source", "field_kind"),
         "conjugates": "finite" if curve.finite else "infinite",
         curve.symbol + "0": curve.constant,
         "fields": curve.fields.tolist(),
@@ -159,11 +156,7 @@ def calibration_to_dict(res: CalibrationResult) -> dict:
         "at": list(res.at),
         f"{s}0": res.K0,
         f"{s}c": res.Kc,
-        "scale_error": res.scale_error,
-        "rho_deg": res.rho_deg,
-        "k": res.k,
-        "rho_k_deg": res.rho_k_deg,
-        "Drc_axis": res.Drc_axis,
+        **copy_fields(res, "scale_error", "rho_deg", "k", "rho_k_deg", "Drc_axis"),
         "Drc_axis_pct": 100.0 * res.Drc_axis,
         "Dc_max_abs_mm": res.Dc_max_abs,
         "Dc_spread_mm": res.Dc_spread,
@@ -203,10 +196,7 @@ def compensation_to_dict(res: CompensationResult) -> dict:
     plain numbers, as ``M0`` in the distortion JSON."""
     return {
         "F1_mm": res.F1,
-        "M2": res.M2,
-        "M": res.M,
-        "method": res.method,
-        "alpha_deg": res.alpha_deg.tolist(),
+        **copy_fields(res, "M2", "M", "method", "alpha_deg"),
         "y1_mm": res.y1.tolist(),
         "yp_mm": res.yp.tolist(),
         "D1_mm": res.D1.tolist(),

@@ -5,13 +5,15 @@ decentering and thin-prism parts, and the Brown–Conrady (Fraser 1997) fit."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
 from distortion.grid import BrownConradyFit, DistortionGrid, GridDecomposition
 from raytrace.trace.results import status_name
 
+from .jsonout import copy_fields
 from .units import PARAMETER_UNITS
 
 
@@ -46,6 +48,65 @@ def _corr_lines(free: Sequence[str], corr: np.ndarray, limit: float = 0.5) -> li
     if not pairs:
         return [f"    correlations: none with |r| >= {limit:g}"]
     return [f"    correlations |r| >= {limit:g}: " + ", ".join(pairs)]
+
+
+def _plane_fit_lines(
+    fits: Sequence, p: int, name: Callable[[Any], str], describe: Callable[[Any], list[str]]
+) -> list[str]:
+    """The lines of the fits of plane ``p`` (decompositions or Brown-Conrady fits): ``describe``
+    of a determined fit; for another, one line with its ``name`` and why it is not determined."""
+    out = []
+    for f in fits:
+        if f.plane != p:
+            continue
+        if f.determined:
+            out += describe(f)
+        else:
+            out.append(f"  {name(f)}: not determined - {f.not_determined}")
+    return out
+
+
+def _decomposition_name(d: GridDecomposition) -> str:
+    return (
+        f"Decomposition (principal point {d.principal_point}, camera constant {d.camera_constant})"
+    )
+
+
+def _decomposition_lines(d: GridDecomposition) -> list[str]:
+    lines = [
+        f"  Decomposition (distortion form; principal point {d.principal_point}, camera "
+        f"constant {d.camera_constant}): residual RMS {_g(d.rms_mm * 1000, 4)} um, max "
+        f"{_g(d.max_mm * 1000, 4)} um"
+    ]
+    order = ("c", "x0", "y0", *sorted(k for k in d.values if k[0] == "K"), "P1", "P2",
+             "S1", "S2")  # fmt: skip
+    lines += _param_lines(d.values, d.std_errors, order)
+    J, psi = d.decentering
+    S, chi = d.thin_prism
+    lines.append(
+        f"    decentering profile J r^2: J = {_g(J, 4)} mm^-1, axis {_g(psi, 5)} deg; "
+        f"thin prism S r^2: S = {_g(S, 4)} mm^-1, axis {_g(chi, 5)} deg"
+    )
+    return lines + _corr_lines(d.free, d.correlation)
+
+
+def _brown_lines(b: BrownConradyFit) -> list[str]:
+    lines = [
+        f"  Brown-Conrady, Fraser 1997 {len(b.free)}-parameter model (Australis: a "
+        f"correction, measured radius): RMS {_g(b.rms_mm * 1000, 4)} um, max "
+        f"{_g(b.max_mm * 1000, 4)} um"
+    ]
+    lines += _param_lines(b.values, b.std_errors, b.values.keys())
+    lines += _corr_lines(b.free, b.correlation)
+    if b.opencv is not None:
+        oc = b.opencv_coefficients
+        lines.append(
+            "    OpenCV (refit): "
+            + ", ".join(f"{k} = {_g(v, 6)}" for k, v in oc.items())
+            + f"; fx = fy = c/pitch; refit RMS {_g(b.opencv.rms_px * b.pixel_mm * 1000, 3)}"
+            " um"
+        )
+    return lines + [f"    warning: {w}" for w in b.warnings]
 
 
 def format_grid(
@@ -100,63 +161,22 @@ def format_grid(
             f"  max |D| = {_g(grid.max_distortion(p) * 1000, 5)} um; max |radial| = "
             f"{_g(rmax * 1000, 5)} um, max |tangential| = {_g(tmax * 1000, 5)} um"
         )
-        for d in decompositions:
-            if d.plane != p:
-                continue
-            if not d.determined:
-                lines.append(
-                    f"  Decomposition (principal point {d.principal_point}, camera constant "
-                    f"{d.camera_constant}): not determined - {d.not_determined}"
-                )
-                continue
-            lines.append(
-                f"  Decomposition (distortion form; principal point {d.principal_point}, camera "
-                f"constant {d.camera_constant}): residual RMS {_g(d.rms_mm * 1000, 4)} um, max "
-                f"{_g(d.max_mm * 1000, 4)} um"
-            )
-            order = ("c", "x0", "y0", *sorted(k for k in d.values if k[0] == "K"), "P1", "P2",
-                     "S1", "S2")  # fmt: skip
-            lines += _param_lines(d.values, d.std_errors, order)
-            J, psi = d.decentering
-            S, chi = d.thin_prism
-            lines.append(
-                f"    decentering profile J r^2: J = {_g(J, 4)} mm^-1, axis {_g(psi, 5)} deg; "
-                f"thin prism S r^2: S = {_g(S, 4)} mm^-1, axis {_g(chi, 5)} deg"
-            )
-            lines += _corr_lines(d.free, d.correlation)
-        for b in brown:
-            if b.plane != p:
-                continue
-            if not b.determined:
-                lines.append(
-                    f"  Brown-Conrady, Fraser 1997 model: not determined - {b.not_determined}"
-                )
-                continue
-            lines.append(
-                f"  Brown-Conrady, Fraser 1997 {len(b.free)}-parameter model (Australis: a "
-                f"correction, measured radius): RMS {_g(b.rms_mm * 1000, 4)} um, max "
-                f"{_g(b.max_mm * 1000, 4)} um"
-            )
-            lines += _param_lines(b.values, b.std_errors, b.values.keys())
-            lines += _corr_lines(b.free, b.correlation)
-            if b.opencv is not None:
-                oc = b.opencv_coefficients
-                lines.append(
-                    "    OpenCV (refit): "
-                    + ", ".join(f"{k} = {_g(v, 6)}" for k, v in oc.items())
-                    + f"; fx = fy = c/pitch; refit RMS {_g(b.opencv.rms_px * b.pixel_mm * 1000, 3)}"
-                    " um"
-                )
-            for w in b.warnings:
-                lines.append(f"    warning: {w}")
+        lines += _plane_fit_lines(decompositions, p, _decomposition_name, _decomposition_lines)
+        lines += _plane_fit_lines(
+            brown, p, lambda b: "Brown-Conrady, Fraser 1997 model", _brown_lines
+        )
     return "\n".join(lines)
 
 
-def _named(grid: DistortionGrid) -> dict:
+def _fit_to_dict(f: GridDecomposition | BrownConradyFit, **between) -> dict:
+    """The keys a decomposition and a Brown-Conrady fit share: plane, determined, the reason it
+    is not (null when it is), ``between``, then the values, std errors, free parameters and
+    their correlation."""
     return {
-        "axial_mm": grid.axial_xy,
-        "ppa_mm": grid.ppa_xy,
-        "ppbs_mm": grid.ppbs_xy,
+        **copy_fields(f, "plane", "determined"),
+        "not_determined": f.not_determined or None,
+        **between,
+        **copy_fields(f, "values", "std_errors", "free", "correlation"),
     }
 
 
@@ -164,15 +184,7 @@ def decomposition_to_dict(d: GridDecomposition) -> dict:
     """JSON-ready dict; ``determined`` false (with ``not_determined``, the reason) when the grid
     does not determine the decomposition: its values are then null."""
     return {
-        "plane": d.plane,
-        "determined": d.determined,
-        "not_determined": d.not_determined or None,
-        "principal_point": d.principal_point,
-        "camera_constant": d.camera_constant,
-        "values": dict(d.values),
-        "std_errors": dict(d.std_errors),
-        "free": list(d.free),
-        "correlation": d.correlation,
+        **_fit_to_dict(d, **copy_fields(d, "principal_point", "camera_constant")),
         "decentering_J_per_mm": d.decentering[0],
         "decentering_axis_deg": d.decentering[1],
         "thin_prism_S_per_mm": d.thin_prism[0],
@@ -187,17 +199,8 @@ def brown_to_dict(b: BrownConradyFit) -> dict:
     """JSON-ready dict; ``determined`` false (with ``not_determined``, the reason) when the
     points do not determine the model: its values are then null and there is no OpenCV refit."""
     out = {
-        "plane": b.plane,
-        "determined": b.determined,
-        "not_determined": b.not_determined or None,
-        "model": "australis (Fraser 1997, correction at the measured radius)",
-        "values": dict(b.values),
-        "std_errors": dict(b.std_errors),
-        "free": list(b.free),
-        "correlation": b.correlation,
-        "rms_mm": b.rms_mm,
-        "max_mm": b.max_mm,
-        "warnings": list(b.warnings),
+        **_fit_to_dict(b, model="australis (Fraser 1997, correction at the measured radius)"),
+        **copy_fields(b, "rms_mm", "max_mm", "warnings"),
     }
     if b.opencv is not None:
         out["opencv"] = {
@@ -239,7 +242,9 @@ def grid_to_dict(
                 "defocus_mm": grid.defocus[p],
                 ("M0" if grid.finite else "F0_mm"): grid.constant[p],
                 "camera_constant_mm": grid.camera_constant[p],
-                **{k: v[p] for k, v in _named(grid).items()},
+                "axial_mm": grid.axial_xy[p],
+                "ppa_mm": grid.ppa_xy[p],
+                "ppbs_mm": grid.ppbs_xy[p],
                 "actual_mm": grid.actual[p],
                 "ideal_mm": grid.ideal[p],
                 "D_mm": grid.D[p],

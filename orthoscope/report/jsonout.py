@@ -42,6 +42,13 @@ def float_list(a: Any) -> list[float]:
     return np.asarray(a, dtype=float).ravel().tolist()
 
 
+def copy_fields(obj: Any, *names: str) -> dict[str, Any]:
+    """The attributes ``names`` of ``obj`` under their own names, in that order, each made
+    strict-JSON-ready by :func:`jsonable`: the part of a JSON dict that copies a result's fields
+    as they are."""
+    return {n: jsonable(getattr(obj, n)) for n in names}
+
+
 def dumps(obj: Any) -> str:
     """Strict JSON text of ``obj`` (indented, UTF-8 characters kept)."""
     return json.dumps(jsonable(obj), indent=2, ensure_ascii=False, allow_nan=False)

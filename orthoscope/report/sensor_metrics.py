@@ -8,6 +8,8 @@ from collections.abc import Sequence
 
 from distortion.sensor_metrics import SensorMetrics
 
+from .jsonout import copy_fields
+
 _LINE_LABEL = {
     "top": "top edge",
     "bottom": "bottom edge",
@@ -74,39 +76,37 @@ def format_sensor_metrics(metrics: SensorMetrics | Sequence[SensorMetrics]) -> s
 
 def sensor_metrics_to_dict(m: SensorMetrics) -> dict:
     """JSON-ready dict (fractions as fractions; lengths in mm)."""
-    return {
-        "plane": m.plane,
-        "plane_label": m.plane_label,
-        "width_mm": m.width_mm,
-        "height_mm": m.height_mm,
-        "shape": list(m.shape),
-        "height_left_mm": m.height_left_mm,
-        "height_right_mm": m.height_right_mm,
-        "height_centre_mm": m.height_centre_mm,
-        "width_top_mm": m.width_top_mm,
-        "width_bottom_mm": m.width_bottom_mm,
-        "width_centre_mm": m.width_centre_mm,
-        "tv_distortion_smia": m.tv_distortion_smia,
-        "tv_distortion_traditional": m.tv_distortion_traditional,
-        "tv_distortion_smia_horizontal": m.tv_distortion_smia_horizontal,
-        "tv_distortion_traditional_horizontal": m.tv_distortion_traditional_horizontal,
-        "keystone_vertical": m.keystone_vertical,
-        "keystone_horizontal": m.keystone_horizontal,
-        "straightness": {
-            s.name: {"sag_mm": s.sag_mm, "chord_mm": s.chord_mm, "fraction": s.fraction}
-            for s in m.straightness
-        },
-        "scale_x": m.scale_x,
-        "scale_y": m.scale_y,
-        "anamorphic_ratio": m.anamorphic_ratio,
-        "mean_scale_ratio": m.mean_scale_ratio,
-        "definitions": {
-            "tv_distortion_smia": "(A - B)/B, A = mean imaged height at the left and right "
-            "edges, B = imaged height at the centre (SMIA 1.0 Part 5)",
-            "tv_distortion_traditional": "dH/H = (A - B)/(2B) = SMIA/2",
-            "keystone_vertical": "(W_top - W_bottom)/mean",
-            "straightness": "sag from the chord; edges + toward the picture centre",
-            "anamorphic_ratio": "dx'/dx : dy'/dy at the picture centre",
-        },
-        "notes": list(m.notes),
+    out = copy_fields(
+        m,
+        "plane",
+        "plane_label",
+        "width_mm",
+        "height_mm",
+        "shape",
+        "height_left_mm",
+        "height_right_mm",
+        "height_centre_mm",
+        "width_top_mm",
+        "width_bottom_mm",
+        "width_centre_mm",
+        "tv_distortion_smia",
+        "tv_distortion_traditional",
+        "tv_distortion_smia_horizontal",
+        "tv_distortion_traditional_horizontal",
+        "keystone_vertical",
+        "keystone_horizontal",
+    )
+    out["straightness"] = {
+        s.name: copy_fields(s, "sag_mm", "chord_mm", "fraction") for s in m.straightness
     }
+    out.update(copy_fields(m, "scale_x", "scale_y", "anamorphic_ratio", "mean_scale_ratio"))
+    out["definitions"] = {
+        "tv_distortion_smia": "(A - B)/B, A = mean imaged height at the left and right "
+        "edges, B = imaged height at the centre (SMIA 1.0 Part 5)",
+        "tv_distortion_traditional": "dH/H = (A - B)/(2B) = SMIA/2",
+        "keystone_vertical": "(W_top - W_bottom)/mean",
+        "straightness": "sag from the chord; edges + toward the picture centre",
+        "anamorphic_ratio": "dx'/dx : dy'/dy at the picture centre",
+    }
+    out["notes"] = list(m.notes)
+    return out
