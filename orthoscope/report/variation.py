@@ -14,6 +14,8 @@ from distortion.variation.analysis import FocusSummary, GEstimate, VariationAnal
 from distortion.variation.models import Conjugate
 from distortion.variation.traced import DEFINITION, FOCUSING, TracedVariation
 
+from .jsonout import float_list
+
 
 def _num(x: float, fmt: str = ".3f") -> str:
     return "—" if x is None or not np.isfinite(x) else format(x, fmt)
@@ -137,12 +139,10 @@ def conjugate_to_dict(c: Conjugate) -> dict:
     return {"value": c.value if np.isfinite(c.value) else "inf", "unit": c.unit, "label": c.label}
 
 
-def _f(x: float) -> float | None:
-    return float(x) if x is not None and np.isfinite(x) else None
-
-
-def _arr(a: np.ndarray) -> list:
-    return [_f(v) for v in np.asarray(a, dtype=float)]
+def _f(x: float | None) -> float | None:
+    """A Python float (NaN and infinities stay; :func:`~orthoscope.report.jsonout.jsonable`
+    writes them as null and "inf" / "-inf", as every JSON output does)."""
+    return None if x is None else float(x)
 
 
 def g_estimate_to_dict(e: GEstimate) -> dict:
@@ -155,16 +155,17 @@ def g_estimate_to_dict(e: GEstimate) -> dict:
         "n_used": e.n_used,
         "n_excluded": e.n_excluded,
         "threshold_um": e.threshold_um,
-        "excluded_r_mm": _arr(e.excluded_r_mm),
+        "excluded_r_mm": float_list(e.excluded_r_mm),
         "rms_fit_um": _f(e.rms_fit_um),
-        "r_mm": _arr(e.r_mm),
-        "g_pointwise": _arr(e.g_pointwise),
+        "r_mm": float_list(e.r_mm),
+        "g_pointwise": float_list(e.g_pointwise),
         "weak": [bool(w) for w in e.weak],
     }
 
 
 def variation_to_dict(a: VariationAnalysis) -> dict:
-    """JSON-ready dict of a :class:`VariationAnalysis` (NaN → null; units in the key names)."""
+    """JSON-ready dict of a :class:`VariationAnalysis` (NaN → null, infinities "inf" / "-inf"
+    as in every JSON output; units in the key names)."""
     return {
         "source": a.source,
         "focal_length_mm": a.focal_length_mm,
@@ -177,8 +178,8 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
                 "label": p.label,
                 "focus": conjugate_to_dict(p.focus),
                 "object": conjugate_to_dict(p.obj),
-                "r_mm": _arr(p.r_mm),
-                "dr_um": _arr(p.dr_um),
+                "r_mm": float_list(p.r_mm),
+                "dr_um": float_list(p.dr_um),
             }
             for p in a.profiles
         ],
@@ -197,9 +198,9 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
                 "focus": conjugate_to_dict(b.focus),
                 "object": conjugate_to_dict(b.obj),
                 "gamma": b.gamma,
-                "r_mm": _arr(b.r_mm),
-                "measured_um": _arr(b.measured_um),
-                "predicted_um": _arr(b.predicted_um),
+                "r_mm": float_list(b.r_mm),
+                "measured_um": float_list(b.measured_um),
+                "predicted_um": float_list(b.predicted_um),
                 "rms_um": b.rms_um,
                 "max_abs_um": b.max_abs_um,
             }
@@ -227,9 +228,9 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
             {
                 "focus": conjugate_to_dict(fv.focus),
                 "objects": [conjugate_to_dict(o) for o in fv.objects],
-                "r_mm": _arr(fv.r_mm),
-                "dr_um": [_arr(row) for row in fv.dr_um],
-                "spread_um": _arr(fv.spread_um),
+                "r_mm": float_list(fv.r_mm),
+                "dr_um": [float_list(row) for row in fv.dr_um],
+                "spread_um": float_list(fv.spread_um),
             }
             for fv in a.field_variation
         ],
@@ -239,9 +240,9 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
                 "s1": conjugate_to_dict(c.s1),
                 "s2": conjugate_to_dict(c.s2),
                 "alpha": c.alpha,
-                "r_mm": _arr(c.r_mm),
-                "measured_um": _arr(c.measured_um),
-                "predicted_um": _arr(c.predicted_um),
+                "r_mm": float_list(c.r_mm),
+                "measured_um": float_list(c.measured_um),
+                "predicted_um": float_list(c.predicted_um),
                 "rms_um": c.rms_um,
                 "max_abs_um": c.max_abs_um,
             }
