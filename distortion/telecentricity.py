@@ -159,7 +159,7 @@ def pupil_analysis(
     ksl = orthoscopy_constant_slope(par.m_e, None if par.infinite else par.p0)
     with np.errstate(divide="ignore", invalid="ignore"):
         theta = np.degrees(np.arctan2(cr.M_start, cr.N_start))
-        cra = np.degrees(np.arctan2(cr.M_last, cr.N_last))
+        cra = cr.landing_angle_deg
         cra_par = np.degrees(np.arctan(ksl * x))
         z_x = np.where(
             cr.M_last != 0.0,

@@ -251,8 +251,15 @@ def orthoscopy_abscissa(par: ParaxialResult, fields, field_kind: str) -> np.ndar
         return f.copy()
     if field_kind != "angle":
         raise ValueError(f"unknown field kind {field_kind!r}")
-    t = np.tan(np.radians(f))
-    return t if par.infinite else par.p0 * t
+    return np.tan(np.radians(f)) if par.infinite else nominal_heights(par.p0, f)
+
+
+def nominal_heights(p0: float, fields_deg) -> np.ndarray:
+    """Pestrecov's nominal angles α (degrees) as object heights ``y = p0 tan α`` (mm; §3), with
+    ``p0 = z_object − z_E0`` (mm, < 0 for a real object left of the paraxial entrance pupil E0):
+    the one conversion (:func:`orthoscopy_abscissa`, the chief-ray aims of
+    :mod:`raytrace.trace`)."""
+    return p0 * np.tan(np.radians(fields_deg))
 
 
 def orthoscopy_constants(par: ParaxialResult, s_prime) -> np.ndarray:

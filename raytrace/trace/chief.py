@@ -32,6 +32,7 @@ from ..lens import Lens, require_lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
 from ..paraxial.firstorder import aim_geometry
+from ..paraxial.orthoscopy import nominal_heights
 from .results import RayStatus, field_unit, object_words, status_name
 
 
@@ -72,12 +73,7 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
     r_stop = np.empty(nw)
     sd_stop = float(p.sd[p.stop])
     for i, wl in enumerate(wavelengths):
-        try:
-            z, r_par = aim_geometry(lens, object_distance, wl)
-        except LensError as e:
-            raise TraceError(str(e)) from None
-        z_E0[i] = z
-        r_stop[i] = sd_stop if math.isfinite(sd_stop) else r_par
+        z_E0[i], r_par, r_stop[i] = aim_pupil_and_stop(lens, object_distance, wl, sd_stop)
         if math.isfinite(sd_stop) and r_par > sd_stop * (1.0 + 1e-9):
             warnings.warn(
                 f"{lens.name}: the stop (surface {p.stop + 1}) has a semi-diameter of "
@@ -92,6 +88,21 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
     # wavelength's, so that every wavelength traces the same object points
     z_field = z_E0[0] if nw == 1 else _aim_setup(lens, (lens.wavelength,), object_distance).z_E0[0]
     return _AimSetup(p, z_E0, r_stop, aim_tolerance(r_stop), slope0, hscale, float(z_field))
+
+
+def aim_pupil_and_stop(
+    lens: Lens, object_distance: float, wavelength: float, sd_stop: float
+) -> tuple[float, float, float]:
+    """``(z_E0, r_par, R_stop)`` of a chief-ray aim at ``wavelength`` (nm): the paraxial entrance
+    pupil (absolute z, mm), the paraxial marginal-ray height at the stop (mm;
+    :func:`raytrace.paraxial.firstorder.aim_geometry`, its LensError as TraceError) and the stop
+    radius of the tolerance rule (:func:`aim_tolerance`): ``sd_stop``, the stop's semi-diameter
+    (mm), when finite, else ``r_par``."""
+    try:
+        z_E0, r_par = aim_geometry(lens, object_distance, wavelength)
+    except LensError as e:
+        raise TraceError(str(e)) from None
+    return z_E0, r_par, (sd_stop if math.isfinite(sd_stop) else r_par)
 
 
 def aim_tolerance(r_stop: np.ndarray | float) -> np.ndarray | float:
@@ -496,7 +507,7 @@ def aim(
     if not finite:
         kf = np.radians(f)
     elif fk == "angle":
-        kf = (z_obj - su.z_E0_field) * np.tan(np.radians(f))  # nominal angle → object height
+        kf = nominal_heights(z_obj - su.z_E0_field, f)  # nominal angle → object height
     else:
         kf = f
     n = f.size

@@ -36,12 +36,19 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ..errors import LensError, TraceError
+from ..errors import TraceError
 from ..lens import Lens
 from ..packing import PackedLens, pack
 from ..paraxial.conjugates import checked_wavelength, resolve_object_distance
-from ..paraxial.firstorder import aim_geometry
-from .chief import aim_outputs, aim_start, aim_tolerance, checked_aim_request, transfer
+from ..paraxial.orthoscopy import nominal_heights
+from .chief import (
+    aim_outputs,
+    aim_pupil_and_stop,
+    aim_start,
+    aim_tolerance,
+    checked_aim_request,
+    transfer,
+)
 from .results import RayStatus, field_unit, object_words, status_name
 
 
@@ -56,12 +63,7 @@ class _Setup2D:
 @functools.lru_cache(maxsize=128)
 def _setup(lens: Lens, wavelength: float, object_distance: float) -> _Setup2D:
     p = pack(lens, wavelength=wavelength)
-    try:
-        z_E0, r_par = aim_geometry(lens, object_distance, wavelength)
-    except LensError as e:
-        raise TraceError(str(e)) from None
-    sd = float(p.sd[p.stop])
-    r = sd if math.isfinite(sd) else r_par
+    z_E0, _, r = aim_pupil_and_stop(lens, object_distance, wavelength, float(p.sd[p.stop]))
     return _Setup2D(p, float(z_E0), float(r), float(aim_tolerance(float(r))))
 
 
@@ -292,12 +294,10 @@ def aim_2d(
     shape = fx.shape
     f1 = np.ascontiguousarray(fx.ravel())
     f2 = np.ascontiguousarray(fy.ravel())
-    if field_kind == "angle":
-        f1 = np.tan(np.radians(f1))
-        f2 = np.tan(np.radians(f2))
-        if finite:  # nominal angles → object point p0·(tan αx, tan αy)
-            p0 = z_obj - su.z_E0
-            f1, f2 = p0 * f1, p0 * f2
+    if field_kind == "angle" and finite:  # nominal angles → object point p0·(tan αx, tan αy)
+        f1, f2 = nominal_heights(z_obj - su.z_E0, f1), nominal_heights(z_obj - su.z_E0, f2)
+    elif field_kind == "angle":
+        f1, f2 = np.tan(np.radians(f1)), np.tan(np.radians(f2))
     slope0, hscale = aim_start(np.array([su.z_E0]), od, np.array([su.r_stop]))
     outs = start, last, status, surface, evals, residual = aim_outputs(1, f1.size, 2)
     aim_chief_2d(
