@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from .jsonout import jsonable
+
 #: the scalar spreads listed, in order: (key, label, unit shown, factor from the output's unit)
 SPREADS = (
     ("efl", "EFL (paraxial)", "mm", 1.0),
@@ -41,11 +43,6 @@ G_COLUMN = ("g", False, "Δg", 1.0)
 #: run computed it)
 SENS_SCALARS = ("efl", "k0", "focus_shift", "c", "x0", "y0", "P1", "P2", "P1_raw", "P2_raw")
 MAX_TEXT_FIELDS = 11
-
-
-def _f(x) -> float | None:
-    v = float(x)
-    return v if math.isfinite(v) else None
 
 
 def _cell(v, dec: int = 3, width: int = 10) -> str:
@@ -87,7 +84,8 @@ def _rss(sens, output: str, field) -> float:
 def sensitivity_to_dict(sens) -> dict:
     """JSON of a SensitivityResult: for the distortion at the largest field (calibrated and raw)
     and each scalar output, the items ranked by their largest change and the RSS of the 1-σ
-    changes (the predicted Monte Carlo standard deviation)."""
+    changes (the predicted Monte Carlo standard deviation). Strict-JSON-ready: NaN is null,
+    infinities "inf" / "-inf"."""
     fmax = float(np.max(sens.fields_deg))
     keys = [("D_cal_um", fmax), ("D_um", fmax)] + [(k, None) for k in SENS_SCALARS]
     if _has_g(sens):
@@ -98,16 +96,16 @@ def sensitivity_to_dict(sens) -> dict:
         outputs[label] = {
             "output": name,
             "field_deg": field,
-            "rss_1sigma": _f(_rss(sens, name, field)),
+            "rss_1sigma": float(_rss(sens, name, field)),
             "items": [
                 {
                     "name": r["name"],
                     "unit": r["unit"],
-                    "min": _f(r["min"]),
-                    "max": _f(r["max"]),
-                    "delta_at_min": _f(r["delta_min"]),
-                    "delta_at_max": _f(r["delta_max"]),
-                    "share_of_rss": _f(r["share"]),
+                    "min": float(r["min"]),
+                    "max": float(r["max"]),
+                    "delta_at_min": float(r["delta_min"]),
+                    "delta_at_max": float(r["delta_max"]),
+                    "share_of_rss": float(r["share"]),
                 }
                 for r in sens.table(name, field)
             ],
@@ -120,10 +118,9 @@ def sensitivity_to_dict(sens) -> dict:
         "outputs": outputs,
     }
     if _has_g(sens):
-        od = float(sens.g_object_distance)
-        out["g_object_distance_mm"] = od if math.isfinite(od) else "inf"
-        out["nominal_g"] = _f(np.asarray(sens.nominal.g).reshape(-1)[0])
-    return out
+        out["g_object_distance_mm"] = float(sens.g_object_distance)
+        out["nominal_g"] = float(np.asarray(sens.nominal.g).reshape(-1)[0])
+    return jsonable(out)
 
 
 def _has_g(sens) -> bool:
