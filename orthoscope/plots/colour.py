@@ -16,7 +16,7 @@ from distortion.colour import FocalShift, LateralColour
 from distortion.curve import NOMINAL_ANGLE
 from distortion.errors import DataError
 
-from .common import GRID, ZERO, figure_and_axes, panel_figure, set_title
+from .common import figure_with_zero, label_axes, panel_figure, set_title
 
 
 def wavelength_colour(nm: float) -> tuple[float, float, float]:
@@ -65,17 +65,14 @@ def plot_focal_shift(fs: FocalShift, ax=None):
     """
     if not isinstance(fs, FocalShift):
         raise DataError(f"expected a FocalShift (distortion.colour.focal_shift), got {type(fs)}")
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = figure_with_zero(ax)
     ax.plot(fs.wavelengths, 1000.0 * fs.shift, "-", color="k", lw=1.4)
     if fs.wavelengths.size <= 12:
         for w, v in zip(fs.wavelengths, fs.shift, strict=True):
             ax.plot([w], [1000.0 * v], "o", color=wavelength_colour(w), ms=6)
     ax.axvline(fs.reference_wavelength, color="0.6", lw=0.8, ls="--")
-    ax.set_xlabel("wavelength (nm)")
+    label_axes(ax, "wavelength (nm)", f"focal shift from {fs.reference_wavelength:g} nm (µm)")
     what = "paraxial image" if fs.kind == "paraxial" else "best focus (least RMS spot)"
-    ax.set_ylabel(f"focal shift from {fs.reference_wavelength:g} nm (µm)")
-    ax.grid(True, **GRID)
     set_title(ax, f"{fs.name}: longitudinal colour, {what}")
     return fig
 
@@ -107,18 +104,17 @@ def plot_lateral_colour(lc: LateralColour, ax=None, *, plane: int = 0, relative:
         raise DataError(f"expected a LateralColour (distortion.colour), got {type(lc)}")
     if not 0 <= plane < lc.n_planes:
         raise DataError(f"plane={plane}: the result has {lc.n_planes} image plane(s) (0-based)")
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = figure_with_zero(ax)
     y = 100.0 * lc.relative[plane] if relative else 1000.0 * lc.linear[plane]
     ax.plot(lc.fields, y, "o-", color="tab:purple", ms=4)
     w1, w2 = lc.wavelengths
-    ax.set_xlabel(_field_label(lc.field_kind))
-    ax.set_ylabel(
+    label_axes(
+        ax,
+        _field_label(lc.field_kind),
         f"(y'({w1:g}) − y'({w2:g})) / y'({lc.reference_wavelength:g}) (%)"
         if relative
-        else f"y'({w1:g} nm) − y'({w2:g} nm) (µm)"
+        else f"y'({w1:g} nm) − y'({w2:g} nm) (µm)",
     )
-    ax.grid(True, **GRID)
     set_title(ax, f"{lc.name}: lateral colour, {lc.plane_label(plane)}")
     return fig
 
@@ -158,16 +154,12 @@ def plot_distortion_by_wavelength(
         )
     if not 0 <= plane < cd[0].n_planes:
         raise DataError(f"plane={plane}: the result has {cd[0].n_planes} image plane(s)")
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = figure_with_zero(ax)
     for k, w in enumerate(cd.wavelengths):
         v = 100.0 * cd.Dr[k, plane] if relative else cd.D0[k, plane]
         ok = np.isfinite(v)
         ax.plot(cd.fields[ok], v[ok], "o-", ms=3, color=wavelength_colour(w), label=f"{w:g} nm")
-    r0 = cd[0]
-    ax.set_xlabel(_field_label(r0.field_kind))
-    ax.set_ylabel("Dr (%)" if relative else "D0 (mm)")
-    ax.grid(True, **GRID)
+    label_axes(ax, _field_label(cd[0].field_kind), "Dr (%)" if relative else "D0 (mm)")
     ax.legend(fontsize=8, frameon=False)
     set_title(ax, f"{cd.name}: distortion per wavelength, {cd.scale_description}")
     return fig

@@ -83,6 +83,21 @@ def figure_and_axes(ax=None, *, figsize: tuple[float, float] = FIGSIZE):
     return fig, ax
 
 
+def figure_with_zero(ax=None, *, figsize: tuple[float, float] = FIGSIZE):
+    """:func:`figure_and_axes`, with the horizontal zero line (style :data:`ZERO`) drawn first."""
+    fig, ax = figure_and_axes(ax, figsize=figsize)
+    ax.axhline(0.0, **ZERO)
+    return fig, ax
+
+
+def label_axes(ax, xlabel: str, ylabel: str, **ylabel_kw) -> None:
+    """The x and y axis labels (``ylabel_kw`` to :meth:`Axes.set_ylabel`, e.g. ``color``) and
+    the light grid (style :data:`GRID`)."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel, **ylabel_kw)
+    ax.grid(True, **GRID)
+
+
 def blank_figure(figsize: tuple[float, float]):
     """A new figure of ``figsize`` inches with no Axes (made as :func:`figure_and_axes` makes
     one: pyplot's, or a plain ``Figure`` inside :func:`offscreen_figures`)."""

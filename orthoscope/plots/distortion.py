@@ -39,7 +39,9 @@ from .common import (
     ZERO,
     dense_and_markers,
     figure_and_axes,
+    figure_with_zero,
     fmt,
+    label_axes,
     legend,
     monotone_spline,
     set_title,
@@ -143,6 +145,13 @@ def _interp(x, y, dense_x=None, dense_y=None):
 # ------------------------------------------------------------------ Figs. 2 and 3
 
 
+def _grid_from_zero(ax, x) -> None:
+    """The light grid; the abscissa from 0 when no ``x`` is negative."""
+    if np.nanmin(x) >= 0:
+        ax.set_xlim(left=0.0)
+    ax.grid(True, **GRID)
+
+
 def _linear_and_relative(ax, x, lin, rel, dense, xlabel, lin_label, rel_label, title):
     """Linear distortion (mm, left axis, black solid) and relative (%, right axis, blue dashed),
     zero lines shared. ``dense`` is ``(x, lin, rel)`` dense arrays or None (spline the points)."""
@@ -157,9 +166,7 @@ def _linear_and_relative(ax, x, lin, rel, dense, xlabel, lin_label, rel_label, t
     ax2.set_ylabel(rel_label, color=RELATIVE)
     ax2.tick_params(axis="y", colors=RELATIVE)
     shared_zero(ax, ax2, np.concatenate([lin, dl[1]]), np.concatenate([rel, dr[1]]))
-    if np.nanmin(x) >= 0:
-        ax.set_xlim(left=0.0)
-    ax.grid(True, **GRID)
+    _grid_from_zero(ax, x)
     legend(ax, [h1, h2], [lin_label, rel_label], loc="upper left")
     set_title(ax, title)
     return ax2
@@ -313,9 +320,7 @@ def plot_rotation(res: CalibrationResult, *, ax=None, title: str | None = None):
     cal = "calibrated, " + _constant_text(res.symbol, "c", res.Kc, c.finite)
     ax.set_xlabel("image size $X'$ (rotated) / $y_c'$ (calibrated) (mm)")
     ax.set_ylabel("linear distortion (mm)")
-    if np.nanmin(Xp) >= 0:
-        ax.set_xlim(left=0.0)
-    ax.grid(True, **GRID)
+    _grid_from_zero(ax, Xp)
     legend(ax, [h1, h2], [rho, cal], loc="lower left")
     set_title(ax, title or _heading("Shapes of characteristic and calibrated distortion curves", c))
     return fig
@@ -358,8 +363,7 @@ def plot_planes(
         raise DataError("no curves to plot")
     if against not in ("field", "image"):
         raise ValueError(f"against must be 'field' or 'image', got {against!r}")
-    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = figure_with_zero(ax, figsize=FIGSIZE)
     handles, labels = [], []
     traces: dict = {}
     for i, c in enumerate(curves):
@@ -379,11 +383,11 @@ def plot_planes(
         handles.append(h)
         labels.append(_plane_text(c) or f"plane {i + 1}")
     c0 = curves[0]
-    ax.set_xlabel(
-        _field_axis_label(c0.field_kind) if against == "field" else "ideal image size $y_0'$ (mm)"
+    label_axes(
+        ax,
+        _field_axis_label(c0.field_kind) if against == "field" else "ideal image size $y_0'$ (mm)",
+        "linear distortion $D_0$ (mm)",
     )
-    ax.set_ylabel("linear distortion $D_0$ (mm)")
-    ax.grid(True, **GRID)
     legend(ax, handles, labels)
     head = "Characteristic linear distortion in several image planes"
     set_title(ax, title or (f"{head} — {c0.name}" if c0.name else head))

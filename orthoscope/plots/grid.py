@@ -15,7 +15,7 @@ import numpy as np
 from distortion.errors import DataError
 from distortion.grid import DistortionGrid, GridDecomposition, RadialByAzimuth
 
-from .common import GRID, ZERO, figure_and_axes, fmt, legend, set_title
+from .common import GRID, figure_and_axes, figure_with_zero, fmt, legend, set_title
 
 IDEAL = "0.65"
 REAL = "tab:red"
@@ -65,6 +65,14 @@ def _lines(ax, pts: np.ndarray, **kw):
     return first
 
 
+def _frame(ax, grid: DistortionGrid, p: int) -> None:
+    """The black cross at the reference point of plane ``p``, equal axes, x' and y' in mm."""
+    ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x' (mm)")
+    ax.set_ylabel("y' (mm)")
+
+
 def plot_grid_distortion(
     grid: DistortionGrid,
     plane: int = 0,
@@ -111,10 +119,7 @@ def plot_grid_distortion(
     shown = ideal + k * grid.D[p]
     hi = _lines(ax, ideal, color=IDEAL, lw=0.8, zorder=1)
     hr = _lines(ax, shown, color=REAL, lw=1.1, zorder=2)
-    ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x' (mm)")
-    ax.set_ylabel("y' (mm)")
+    _frame(ax, grid, p)
     legend(ax, [hi, hr], ["ideal (Eq. 8, 2-D)", f"real, distortion x {fmt(k, 3)}"], loc="best")
     dmax = grid.max_distortion(p)
     set_title(
@@ -193,10 +198,7 @@ def plot_distortion_vectors(
         lambda key: f"{fmt(key * 1000, 3)} um",
     )
     ax.plot(pos[:, 0], pos[:, 1], ".", color=IDEAL, ms=2.5, zorder=1)
-    ax.plot(*grid.reference_xy[p], marker="+", color="k", ms=9, ls="none", zorder=3)
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x' (mm)")
-    ax.set_ylabel("y' (mm)")
+    _frame(ax, grid, p)
     set_title(
         ax,
         title
@@ -297,8 +299,7 @@ def plot_radial_by_azimuth(
     """
     g = curves.grid
     p = _plane(g, plane)
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = figure_with_zero(ax)
     ax.grid(True, **GRID)
     handles, labels = [], []
     colors = _colors(curves.azimuths_deg.size)

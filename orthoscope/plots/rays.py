@@ -13,11 +13,20 @@ import numpy as np
 
 from raytrace.trace import RayFan, SpotDiagram
 
-from .common import GRID, ZERO, figure_and_axes, fmt, set_title
+from .common import GRID, ZERO, figure_and_axes, figure_with_zero, fmt, set_title
 
 
 def _field_label(field: float, kind: str) -> str:
     return f"{fmt(field)}°" if kind == "angle" else f"y = {fmt(field)} mm"
+
+
+def _listed(items, cls: type, refusal: str) -> list:
+    """``items`` as a list (one ``cls`` or a sequence of them); ``TypeError(refusal)`` when
+    empty."""
+    items = [items] if isinstance(items, cls) else list(items)
+    if not items:
+        raise TypeError(refusal)
+    return items
 
 
 def plot_ray_fan(fans: RayFan | Sequence[RayFan], *, ax=None, title: str | None = None):
@@ -42,11 +51,10 @@ def plot_ray_fan(fans: RayFan | Sequence[RayFan], *, ax=None, title: str | None 
     -------
     matplotlib.figure.Figure
     """
-    fans = [fans] if isinstance(fans, RayFan) else list(fans)
-    if not fans:
-        raise TypeError("plot_ray_fan needs at least one RayFan (osc.ray_fan(lens, field))")
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fans = _listed(
+        fans, RayFan, "plot_ray_fan needs at least one RayFan (osc.ray_fan(lens, field))"
+    )
+    fig, ax = figure_with_zero(ax)
     ax.axvline(0.0, **ZERO)
     fields = sorted({(f.field, f.field_kind) for f in fans})
     colour = {key: f"C{i}" for i, key in enumerate(fields)}
@@ -92,9 +100,11 @@ def plot_spot(spots: SpotDiagram | Sequence[SpotDiagram], *, ax=None, title: str
     -------
     matplotlib.figure.Figure
     """
-    spots = [spots] if isinstance(spots, SpotDiagram) else list(spots)
-    if not spots:
-        raise TypeError("plot_spot needs at least one SpotDiagram (osc.spot_diagram(lens, field))")
+    spots = _listed(
+        spots,
+        SpotDiagram,
+        "plot_spot needs at least one SpotDiagram (osc.spot_diagram(lens, field))",
+    )
     fig, ax = figure_and_axes(ax, figsize=(2.6 * max(1, len(spots)) + 1.0, 3.2))
     span = max(
         (

@@ -10,7 +10,7 @@ from distortion.curve import HEIGHT
 from distortion.errors import DataError
 from distortion.telecentricity import PupilAnalysis
 
-from .common import GRID, ZERO, figure_and_axes, fmt, panel_figure, set_title
+from .common import figure_with_zero, fmt, label_axes, panel_figure, set_title
 
 
 def _check(pa) -> None:
@@ -30,6 +30,25 @@ def _xlabel(pa: PupilAnalysis) -> str:
 def _ok(pa: PupilAnalysis, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     m = np.isfinite(v)
     return pa.fields[m], v[m]
+
+
+def _axes(pa, ax):
+    """Check ``pa``; ``(figure, ax)`` with the zero line drawn (:func:`figure_with_zero`)."""
+    _check(pa)
+    return figure_with_zero(ax)
+
+
+def _twin(ax, pa: PupilAnalysis, v: np.ndarray, style: str, color: str, ms: float, ylabel: str):
+    """The finite values ``v`` on a right scale (``ax.twinx()``) labelled in their colour;
+    returns the line."""
+    tw = ax.twinx()
+    (line,) = tw.plot(*_ok(pa, v), style, color=color, ms=ms)
+    tw.set_ylabel(ylabel, color=color)
+    return line
+
+
+def _legend(ax, handles: list, labels: list[str]) -> None:
+    ax.legend(handles, labels, fontsize=8, frameon=False)
 
 
 def plot_chief_ray_angle(pa: PupilAnalysis, *, ax=None, title: str | None = None):
@@ -56,23 +75,14 @@ def plot_chief_ray_angle(pa: PupilAnalysis, *, ax=None, title: str | None = None
     -------
     matplotlib.figure.Figure
     """
-    _check(pa)
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = _axes(pa, ax)
     (a,) = ax.plot(*_ok(pa, pa.cra_deg), "o-", color="tab:blue", ms=4)
     (b,) = ax.plot(pa.fields, pa.cra_paraxial_deg, "--", color="0.35", lw=1.0)
-    ax.set_xlabel(_xlabel(pa))
-    ax.set_ylabel("chief-ray angle in image space (deg)", color="tab:blue")
-    ax.grid(True, **GRID)
-    tw = ax.twinx()
-    (c,) = tw.plot(*_ok(pa, pa.cra_deg - pa.cra_paraxial_deg), "s:", color="tab:orange", ms=3)
-    tw.set_ylabel("real − paraxial (deg)", color="tab:orange")
-    ax.legend(
-        [a, b, c],
-        [f"real (max |CRA| {fmt(pa.max_abs_cra_deg, 4)}°)", "paraxial", "real − paraxial"],
-        fontsize=8,
-        frameon=False,
-    )
+    label_axes(ax, _xlabel(pa), "chief-ray angle in image space (deg)", color="tab:blue")
+    diff = pa.cra_deg - pa.cra_paraxial_deg
+    c = _twin(ax, pa, diff, "s:", "tab:orange", 3, "real − paraxial (deg)")
+    cra = f"real (max |CRA| {fmt(pa.max_abs_cra_deg, 4)}°)"
+    _legend(ax, [a, b, c], [cra, "paraxial", "real − paraxial"])
     set_title(ax, title or f"{pa.name}: image-side chief-ray angle")
     return fig
 
@@ -99,14 +109,9 @@ def plot_distortion_slope(pa: PupilAnalysis, *, ax=None, title: str | None = Non
     -------
     matplotlib.figure.Figure
     """
-    _check(pa)
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
-    f, v = _ok(pa, 1000.0 * pa.slope)
-    ax.plot(f, v, "o-", color="tab:red", ms=4)
-    ax.set_xlabel(_xlabel(pa))
-    ax.set_ylabel("∂D0/∂s' (µm per mm)")
-    ax.grid(True, **GRID)
+    fig, ax = _axes(pa, ax)
+    ax.plot(*_ok(pa, 1000.0 * pa.slope), "o-", color="tab:red", ms=4)
+    label_axes(ax, _xlabel(pa), "∂D0/∂s' (µm per mm)")
     set_title(ax, title or f"{pa.name}: change of distortion with the image plane")
     return fig
 
@@ -134,22 +139,11 @@ def plot_entrance_pupil(pa: PupilAnalysis, *, ax=None, title: str | None = None)
     -------
     matplotlib.figure.Figure
     """
-    _check(pa)
-    fig, ax = figure_and_axes(ax)
-    ax.axhline(0.0, **ZERO)
+    fig, ax = _axes(pa, ax)
     (a,) = ax.plot(*_ok(pa, pa.entrance_pupil_shift), "o-", color="tab:green", ms=4)
-    ax.set_xlabel(_xlabel(pa))
-    ax.set_ylabel("entrance pupil shift from E0 (mm)", color="tab:green")
-    ax.grid(True, **GRID)
-    tw = ax.twinx()
-    (b,) = tw.plot(*_ok(pa, pa.viewpoint_offset), "s--", color="tab:purple", ms=3.5)
-    tw.set_ylabel("viewpoint offset (mm)", color="tab:purple")
-    ax.legend(
-        [a, b],
-        ["entrance pupil shift (axial)", "viewpoint offset (lateral)"],
-        fontsize=8,
-        frameon=False,
-    )
+    label_axes(ax, _xlabel(pa), "entrance pupil shift from E0 (mm)", color="tab:green")
+    b = _twin(ax, pa, pa.viewpoint_offset, "s--", "tab:purple", 3.5, "viewpoint offset (mm)")
+    _legend(ax, [a, b], ["entrance pupil shift (axial)", "viewpoint offset (lateral)"])
     set_title(ax, title or f"{pa.name}: entrance pupil (viewpoint) with field")
     return fig
 

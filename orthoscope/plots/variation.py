@@ -66,6 +66,14 @@ def _analysis(a) -> VariationAnalysis:
     return a
 
 
+def _start(a, ax):
+    """``(analysis, figure, ax, colours)``: the analysis of ``a`` (:func:`_analysis`), the figure
+    and its Axes (:func:`figure_and_axes`) and the colour cycle."""
+    a = _analysis(a)
+    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
+    return a, fig, ax, _colours()
+
+
 def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
     """Radial distortion profiles i×(j×) of an analysis (Fraser & Shortis Figs. 1–4 style):
     δr (µm) against the radial distance r (mm); Gaussian profiles (object plane = plane of
@@ -84,9 +92,7 @@ def plot_profiles(a: VariationAnalysis, *, ax=None, title: str | None = None):
     -------
     matplotlib.figure.Figure
     """
-    a = _analysis(a)
-    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
-    colours = _colours()
+    a, fig, ax, colours = _start(a, ax)
     handles, labels = [], []
     for i, p in enumerate(a.profiles):
         gauss = p.focus == p.obj
@@ -146,9 +152,7 @@ def plot_g(a: VariationAnalysis, *, ax=None, title: str | None = None):
     -------
     matplotlib.figure.Figure
     """
-    a = _analysis(a)
-    fig, ax = figure_and_axes(ax, figsize=FIGSIZE)
-    colours = _colours()
+    a, fig, ax, colours = _start(a, ax)
     k = 0
     finite = []
     handles, labels = [], []
