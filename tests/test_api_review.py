@@ -19,11 +19,6 @@ from raytrace.optimize.spec import SpecError
 matplotlib.use("Agg")
 
 
-@pytest.fixture(scope="module")
-def cooke():
-    return osc.load_lens("cooke-triplet-f4")
-
-
 def test_plot_distortion_refuses_a_calibration_of_another_curve(cooke):
     # it drew the calibration's own (Topogon) curve and ignored the Cooke curve given
     t = osc.load_lens("topogon-us2031792-fig1")

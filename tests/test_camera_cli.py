@@ -37,9 +37,11 @@ def run(argv, cwd=None, monkeypatch=None):
     return run_cli(argv)
 
 
-@pytest.fixture(scope="module")
-def cooke():
-    return osc.load_lens("cooke-triplet-f4")
+def _camera_spec(directory, text: str):
+    """``directory / "cam.toml"`` holding ``text``: a ``--camera`` spec."""
+    spec = directory / "cam.toml"
+    spec.write_text(text, encoding="utf-8")
+    return spec
 
 
 @pytest.fixture(scope="module")
@@ -99,11 +101,10 @@ def test_calibration_file_written_is_what_cv2_reads(tmp_path, monkeypatch, cooke
 
 
 def test_camera_spec_toml_and_flags(tmp_path, monkeypatch, cooke):
-    spec = tmp_path / "cam.toml"
-    spec.write_text(
+    spec = _camera_spec(
+        tmp_path,
         '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[focus]\ndistance = "2m"\n'
         "[trace]\ngrid = [9, 7]\n",
-        encoding="utf-8",
     )
     rc, out, err = run(["camera", "cooke-triplet-f4", "--camera", str(spec), "--json",
                         "--object-distance", "1m"], tmp_path, monkeypatch)  # fmt: skip
@@ -538,10 +539,9 @@ def test_form_flags_are_the_help_pages_and_cover_the_parser():
 def test_principal_point_replaces_the_specs_offset_in_compare(tmp_path):
     # with --camera and no --sensor / --pitch, compare took the spec's sensor whole and dropped
     # --principal-point (camera LENS --camera ... --principal-point replaced the offset)
-    spec = tmp_path / "cam.toml"
-    spec.write_text(
+    spec = _camera_spec(
+        tmp_path,
         '[sensor]\nsize = "24x16"\npixels = "3000x2000"\nprincipal_point_offset_mm = [1.0, 1.0]\n',
-        encoding="utf-8",
     )
     argv = ["camera", "compare", "cooke-triplet-f4", _CAL, "--camera", str(spec), "--grid",
             "9x7", "--json"]  # fmt: skip
@@ -562,11 +562,10 @@ def test_principal_point_replaces_the_specs_offset_in_compare(tmp_path):
 def test_gaussian_replaces_the_specs_focus(tmp_path):
     # --gaussian was ignored with a spec that sets [focus] (focused at 2m), while --defocus
     # replaced it
-    spec = tmp_path / "cam.toml"
-    spec.write_text(
+    spec = _camera_spec(
+        tmp_path,
         '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[focus]\ndistance = "2m"\n'
         '[object]\ndistance = "5m"\n[trace]\ngrid = [9, 7]\n',
-        encoding="utf-8",
     )
     rc, out, err = run(["camera", "cooke-triplet-f4", "--camera", str(spec), "--gaussian",
                         "--json"])  # fmt: skip
@@ -820,10 +819,10 @@ def test_each_refusal_names_the_flag_in_the_command_line_words(argv, words, tmp_
 def test_a_setup_the_lens_cannot_image_is_named_where_it_was_given(tmp_path, monkeypatch):
     # the lens decides these (after the flags' own checks): the API said "sensor at s_prime =
     # -5 mm"; a value of the --camera spec is named by its key there, not by a flag not given
-    (tmp_path / "cam.toml").write_text(
+    _camera_spec(
+        tmp_path,
         '[sensor]\nsize = "24x16"\npixels = "1200x800"\n[focus]\ns_prime = "-5"\n'
         "[trace]\ngrid = [9, 7]\n",
-        encoding="utf-8",
     )
     spec = ["camera", "cooke-triplet-f4", "--camera", "cam.toml"]
     for argv, said in (
@@ -843,7 +842,7 @@ def test_an_object_value_of_the_spec_is_named_by_its_key(tmp_path, monkeypatch):
         ('[object]\ns = "abc"\n', "cam.toml [object] s: 'abc' is not a number"),
         ("[object]\ns = 100\n", "cam.toml [object] s must be negative"),
     ):
-        (tmp_path / "cam.toml").write_text(head + table, encoding="utf-8")
+        _camera_spec(tmp_path, head + table)
         rc, _, err = run(["camera", "cooke-triplet-f4", "--camera", "cam.toml"], tmp_path,
                          monkeypatch)  # fmt: skip
         assert rc == 2 and said in _one_line(err) and "object_" not in err, err

@@ -70,11 +70,6 @@ from distortion.errors import DataError
 DATA = TEST_DATA / "camera"
 
 
-@pytest.fixture(scope="module")
-def cooke():
-    return osc.load_lens("cooke-triplet-f4")
-
-
 def _load(name: str):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

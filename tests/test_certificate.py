@@ -46,11 +46,6 @@ DATE = "2026-01-31"
 
 
 @pytest.fixture(scope="module")
-def topogon():
-    return load_lens("topogon-like-pestrecov")
-
-
-@pytest.fixture(scope="module")
 def topogon_cert(topogon):
     return calibration_certificate(topogon, date=DATE, field_step_deg=2.5)
 

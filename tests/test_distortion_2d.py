@@ -80,11 +80,6 @@ BUNDLED = [
 ]
 
 
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
-
-
 # ---------------------------------------------------------------- the model written out here
 def brown_distortion(t, c, x0, y0, K=(), P=(0.0, 0.0), S=(0.0, 0.0)):
     """Image points of the distortion-form model (Brown 1966 decentering with Fraser's P1/P2

@@ -15,11 +15,6 @@ from raytrace.errors import TraceError
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.fixture(scope="module")
-def cooke():
-    return osc.load_lens("cooke-triplet-f4")
-
-
 def test_fan_is_centred_on_the_real_chief_ray(cooke):
     # the middle ray of an odd fan is the chief ray itself: zero aberration to the aim tolerance,
     # also far off axis where the real chief ray misses the paraxial pupil centre

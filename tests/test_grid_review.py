@@ -42,11 +42,6 @@ from raytrace.files.library import load_lens
 
 
 @pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
-
-
-@pytest.fixture(scope="module")
 def small(cooke):
     return distortion_grid(cooke, grid=(3, 3), sensor="24x24")
 

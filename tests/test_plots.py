@@ -70,11 +70,6 @@ def cal(table1):
 
 
 @pytest.fixture(scope="module")
-def topogon():
-    return osc.load_lens("topogon-like-pestrecov")
-
-
-@pytest.fixture(scope="module")
 def traced(topogon):
     return osc.characteristic_distortion(topogon, TABLE1_FIELDS)
 

@@ -38,16 +38,8 @@ from raytrace.files.library import load_lens
 from raytrace.limits import MAX_FIELDS
 
 DATE = "2026-01-31"
-
-
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")  # lens field 20 deg, semi-diagonals at 45 + k 90 deg
-
-
-@pytest.fixture(scope="module")
-def topogon():
-    return load_lens("topogon-like-pestrecov")  # lens field 45 deg
+# the fixtures cooke (lens field 20 deg, semi-diagonals at 45 + k 90 deg) and topogon (lens
+# field 45 deg): tests/conftest.py
 
 
 def _no_trace(monkeypatch):

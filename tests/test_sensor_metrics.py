@@ -36,12 +36,6 @@ from distortion.errors import DataError
 from distortion.grid import distortion_grid
 from distortion.sensor_metrics import sensor_metrics, sensor_metrics_from_points
 from orthoscope.cli import COMPILE_NOTICE
-from raytrace.files.library import load_lens
-
-
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
 
 
 @pytest.fixture(scope="module")

@@ -23,11 +23,6 @@ LENS = "cooke-triplet-f4"  # its chief ray of 30 deg fails (aim_failed); 0 and 2
 
 
 @pytest.fixture(scope="module")
-def cooke():
-    return osc.load_lens(LENS)
-
-
-@pytest.fixture(scope="module")
 def pinhole_front(tmp_path_factory, cooke):
     """The Cooke triplet with a 0.5 mm semi-diameter on its first surface: at 20 deg the chief
     ray traces (aimed without clipping) but every ray of the bundle is clipped."""

@@ -24,11 +24,6 @@ from raytrace.tolerance import ToleranceSpecError, spec_from_dict
 CENTRED_ITEM = {"type": "TRAD", "surface": 1, "limit": 0.05}
 
 
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
-
-
 def _conjugate(v) -> Conjugate:
     if isinstance(v, str):
         return Conjugate.scale(float(v[:-1]))

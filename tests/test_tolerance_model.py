@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from distortion.tolerance import evaluate, prepare, sensitivity
-from raytrace.files.library import load_lens
 from raytrace.paraxial import paraxial
 from raytrace.tolerance import (
     ToleranceSpecError,
@@ -23,11 +22,6 @@ from raytrace.tolerance import (
     perturbed_lens,
     spec_from_dict,
 )
-
-
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
 
 
 # ---------------------------------------------------------------------------- spec errors

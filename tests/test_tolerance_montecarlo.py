@@ -11,15 +11,9 @@ from support import interrupt_after
 
 from distortion.tolerance import monte_carlo, prepare, sensitivity
 from raytrace.errors import OutputError
-from raytrace.files.library import load_lens
 from raytrace.tolerance import spec_from_dict
 
 FIELDS = np.linspace(0.0, 20.0, 6)
-
-
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
 
 
 def _spec(scale=1.0, compensator="paraxial-refocus"):

@@ -14,7 +14,6 @@ from support import interrupt_after, run_cli
 
 from distortion.tolerance import monte_carlo, prepare
 from distortion.tolerance.summary import StreamingSummary
-from raytrace.files.library import load_lens
 from raytrace.tolerance import spec_from_dict
 
 FIELDS = np.linspace(0.0, 20.0, 6)
@@ -22,11 +21,6 @@ N = 300
 BLOCK = 64  # small blocks and bins so that a short run has many of each
 BINS = 512
 LIMITS = [(115.0, 20.0), (20.0, 13.0)]  # µm at deg: each cuts the batch (D@20° ≈ 96..125 µm)
-
-
-@pytest.fixture(scope="module")
-def cooke():
-    return load_lens("cooke-triplet-f4")
 
 
 def _spec():
