@@ -293,3 +293,18 @@ def test_coefficients_r_max_cuts_a_csv_profile(capsys):
     assert rc == rc2 == 0
     full, cut = json.loads(out)["profile"]["r_mm"], json.loads(out2)["profile"]["r_mm"]
     assert max(full) > 16 and cut == [r for r in full if r <= 16]
+
+
+def test_prescription_json_writes_an_infinite_scale_as_inf(capsys):
+    # README, "JSON output": infinite values are the strings "inf" / "-inf", values that do not
+    # exist are null. The image scale number N = s/f - 1 (distortion/variation/models.py) of an
+    # object at infinity is infinite; the variation JSON wrote it as null.
+    rc, out, _ = run(
+        capsys, "variation", "--lens", "cooke-triplet-f4", "--focus", "2m", "--objects",
+        "inf,1m,5m", "--json",
+    )  # fmt: skip
+    assert rc == 0
+    gammas = json.loads(out)["variation"]["gamma"]
+    at_inf = [g for g in gammas if g["object"]["value"] == "inf"]
+    assert at_inf and all(g["scale_object"] == "inf" for g in at_inf)
+    assert all(isinstance(g["scale_object"], float) for g in gammas if g not in at_inf)
