@@ -12,9 +12,9 @@ from .common import (
     add_table_layout_arg,
     at_fields,
     bundled_or_path,
-    check_plot_path,
+    check_plot_paths,
     print_result,
-    save_plot,
+    save_plots,
 )
 from .distortion import add_calibration_args
 
@@ -51,8 +51,7 @@ def cmd_calibrate(args) -> int:
         raise CliError(f"the following argument is required: --method {{{','.join(METHODS)}}}")
     table = table_path(args.table)
     args._inputs = [table]
-    for flag in ("plot", "plot_rotation"):
-        check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
+    check_plot_paths(args, "plot", "plot_rotation")
     curve = read_distortion_table(table, constant=args.constant)
     res = calibrate(
         curve, args.method, at=at_fields(args.at), value=args.value, k=args.exaggeration
@@ -66,9 +65,7 @@ def cmd_calibrate(args) -> int:
     if args.plot or args.plot_rotation:
         from ..plots.distortion import plot_calibrated, plot_rotation
 
-        for path, plot in ((args.plot, plot_calibrated), (args.plot_rotation, plot_rotation)):
-            if path:
-                save_plot(lambda plot=plot: plot(res), path, args)
+        save_plots(((args.plot, plot_calibrated), (args.plot_rotation, plot_rotation)), res, args)
     return 0
 
 

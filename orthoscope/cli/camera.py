@@ -37,7 +37,7 @@ from .common import (
     first_repeat,
     given_flags,
     length,
-    load,
+    load_recorded,
     object_flags_given,
     print_json,
     save_plot,
@@ -586,8 +586,7 @@ def _cmd_lens(args, lens_name: str) -> int:
         traced_camera_to_dict,
     )
 
-    lens = load(lens_name, strict=getattr(args, "strict", False))
-    args._inputs = [p for p in (lens.path, args.camera) if p]
+    lens = load_recorded(args, lens_name, args.camera)
     check_plot_path(args.plot, "--plot", args)
     for path in (args.output, args.picture, args.maps):
         check_output_path(path, args)
@@ -707,8 +706,7 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     from ..report.camera import comparison_csv, comparison_to_dict, format_comparison
 
     cal_path = calibration_path(cal_word)
-    lens = load(lens_name, strict=getattr(args, "strict", False))
-    args._inputs = [p for p in (lens.path, cal_path, args.camera) if p]
+    lens = load_recorded(args, lens_name, cal_path, args.camera)
     check_plot_path(args.plot, "--plot", args)
     check_output_path(args.output, args)
     kind = _table_kind(args.output, "a comparison") if args.output else None  # before the trace

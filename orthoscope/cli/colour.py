@@ -7,12 +7,9 @@ import argparse
 
 from .common import (
     CliError,
-    add_field_args,
     add_force_arg,
-    add_lens_arg,
-    add_object_args,
+    add_lens_object_args,
     add_output_args,
-    add_plane_args,
     check_plot_path,
     field_keyword,
     load_input,
@@ -136,10 +133,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope colour tessar-fr1066698 --focus best-focus --scale own --plot colour.png"
         ),
     )
-    add_lens_arg(q)
-    add_object_args(q)
-    add_field_args(q)
-    add_plane_args(q, repeatable=True)
+    add_lens_object_args(q, repeatable=True)
     add_wavelengths_arg(q)
     q.add_argument(
         "--pair",

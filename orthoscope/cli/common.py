@@ -261,12 +261,19 @@ def load(name: str, strict: bool = False):
     return load_lens(name, strict=strict)
 
 
+def load_recorded(args, name: str, *others):
+    """The lens ``name`` (:func:`load`, with ``--strict`` when the command has it), recorded
+    with the other input files ``others`` (None or empty: left out) as the command's inputs
+    (``args._inputs``) so that no output is ever written onto one of them."""
+    lens = load(name, strict=getattr(args, "strict", False))
+    args._inputs = [p for p in (lens.path, *others) if p]
+    return lens
+
+
 def load_input(args):
     """The lens of ``args.lens`` (:func:`load`), recorded as the command's input
-    (``args._inputs``) so that no output is ever written onto it."""
-    lens = load(args.lens, strict=getattr(args, "strict", False))
-    args._inputs = [lens.path] if lens.path else []
-    return lens
+    (``args._inputs``, :func:`load_recorded`) so that no output is ever written onto it."""
+    return load_recorded(args, args.lens)
 
 
 def save_plot(make, path, args) -> None:
@@ -279,6 +286,21 @@ def save_plot(make, path, args) -> None:
     with offscreen_figures():
         fig = make()
     save_figure(fig, path, overwrite=args.force, inputs=args._inputs, flag="--force")
+
+
+def save_plots(plots, data, args) -> None:
+    """:func:`save_plot` of ``plot(data)`` to ``path`` for each ``(path, plot)`` of ``plots``
+    whose path is given, in that order."""
+    for path, plot in plots:
+        if path:
+            save_plot(lambda plot=plot: plot(data), path, args)
+
+
+def check_traced_any(traced_any: bool, see: str = " (see the table)") -> None:
+    """Refuse a plot when no field could be traced (``traced_any`` false): CliError, ``see``
+    saying where the run's output lists them."""
+    if not traced_any:
+        raise CliError(f"no field could be traced{see}: there is nothing to plot")
 
 
 def strict_check(args, status, what: str = "field(s)", see: str = " (see the table)") -> None:
@@ -295,10 +317,11 @@ def strict_check(args, status, what: str = "field(s)", see: str = " (see the tab
 
 
 def load_scaled(args):
-    """The lens of ``--lens``, scaled to ``--scale-to-efl`` mm when given."""
+    """The lens of ``--lens`` (:func:`load_input`: recorded as the command's input), scaled to
+    ``--scale-to-efl`` mm when given."""
     from raytrace.paraxial import paraxial
 
-    lens = load(args.lens, strict=getattr(args, "strict", False))
+    lens = load_input(args)
     if args.scale_to_efl is not None:
         if not (args.scale_to_efl > 0 and math.isfinite(args.scale_to_efl)):
             raise CliError(
@@ -315,6 +338,25 @@ def load_scaled(args):
 def add_lens_arg(p: argparse.ArgumentParser) -> None:
     """The positional LENS argument: a lens file or a bundled lens name."""
     p.add_argument("lens", metavar="LENS", help="Lens file path or bundled lens name.")
+
+
+def add_lens_object_args(
+    p: argparse.ArgumentParser,
+    *,
+    fields: bool = True,
+    planes: bool = True,
+    repeatable: bool = False,
+) -> None:
+    """LENS (:func:`add_lens_arg`) and the object flags (:func:`add_object_args`), then the
+    field flags (:func:`add_field_args`) and the image-plane flags (:func:`add_plane_args`,
+    ``repeatable``) unless ``fields`` / ``planes`` is false: what a command that traces a lens
+    takes first, in this order."""
+    add_lens_arg(p)
+    add_object_args(p)
+    if fields:
+        add_field_args(p)
+    if planes:
+        add_plane_args(p, repeatable=repeatable)
 
 
 def add_object_args(p: argparse.ArgumentParser) -> None:
@@ -444,6 +486,15 @@ def resolve_planes(lens, args) -> list:
     if lens.image_solve == "gaussian":  # the file's solve: for the traced object, at the
         return [ImagePlane("gaussian_reference")]  # reference wavelength (not --wavelength's)
     return [ImagePlane("file")]
+
+
+def resolve_one_plane(lens, args, message: str) -> list:
+    """The image plane of the plane flags (:func:`resolve_planes`), a list of one, for a command
+    that takes one plane; CliError ``message`` when they give several."""
+    planes = resolve_planes(lens, args)
+    if len(planes) != 1:
+        raise CliError(message)
+    return planes
 
 
 def plane_origin(args) -> str:
@@ -622,6 +673,13 @@ def check_plot_path(path: str | None, flag: str, args) -> None:
         return
     check_output_path(path, args)
     check_plot_suffix(path, flag)
+
+
+def check_plot_paths(args, *dests: str) -> None:
+    """:func:`check_plot_path` of each plot flag named by its namespace attribute in ``dests``
+    (``plot_rotation`` is ``--plot-rotation``), in that order."""
+    for dest in dests:
+        check_plot_path(getattr(args, dest), "--" + dest.replace("_", "-"), args)
 
 
 def check_plot_suffix(path: str, flag: str) -> None:

@@ -11,19 +11,17 @@ from .common import (
     CliError,
     NotedStore,
     add_alias,
-    add_field_args,
     add_force_arg,
-    add_lens_arg,
-    add_object_args,
+    add_lens_object_args,
     add_output_args,
-    add_plane_args,
     add_strict_arg,
     add_table_layout_arg,
     add_wavelength_arg,
     at_fields,
     check_finite_object,
-    check_plot_path,
+    check_plot_paths,
     check_size,
+    check_traced_any,
     field_keyword,
     load_input,
     print_json,
@@ -33,6 +31,7 @@ from .common import (
     resolve_object,
     resolve_planes,
     save_plot,
+    save_plots,
     strict_check,
 )
 
@@ -113,8 +112,7 @@ def cmd_distortion(args) -> int:
     at = at_fields(args.at)
     if at:
         fields = np.union1d(fields, np.array(at))
-    for flag in ("plot", "plot_rotation", "layout"):
-        check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
+    check_plot_paths(args, "plot", "plot_rotation", "layout")
     planes = resolve_planes(lens, args)
     check_finite_object(kind, od)
     if args.definition is not None:  # named definitions: orthoscope/cli/definitions.py
@@ -205,8 +203,8 @@ def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
 def _plots(res, cals, args, lens) -> None:
     import numpy as np
 
-    if (args.plot or args.plot_rotation or args.layout) and not np.isfinite(res.yp).any():
-        raise CliError("no field could be traced (see the table): there is nothing to plot")
+    if args.plot or args.plot_rotation or args.layout:
+        check_traced_any(np.isfinite(res.yp).any())
 
     if args.plot_rotation and not cals:
         raise CliError("--plot-rotation (Fig. 4) needs --calibrate")
@@ -262,10 +260,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "--s-prime 425,525,625"
         ),
     )
-    add_lens_arg(q)
-    add_object_args(q)
-    add_field_args(q)
-    add_plane_args(q, repeatable=True)
+    add_lens_object_args(q, repeatable=True)
     q.add_argument("--reference", default="characteristic", choices=REFERENCES, help=REFERENCE_HELP)
     add_calibration_args(q, required=False)
     add_wavelength_arg(q)
@@ -378,8 +373,7 @@ def _grid(args, lens) -> int:
     nx, ny = _grid_size(args.grid)
     check_size(nx * ny, MAX_FIELDS, "--grid (fields)", args, per_item_bytes=400)
     _check_sensor_metrics(args, nx, ny)
-    for flag in ("plot_grid", "plot_vectors"):
-        check_plot_path(getattr(args, flag), "--" + flag.replace("_", "-"), args)
+    check_plot_paths(args, "plot_grid", "plot_vectors")
     od = resolve_object(lens, args)
     planes = resolve_planes(lens, args)
     kw = {}
@@ -423,15 +417,15 @@ def _grid(args, lens) -> int:
         json=lambda: {"distortion_grid": grid_to_dict(g, decs, fits), **metrics[0]},
         text=lambda: format_grid(g, decs, fits) + metrics[1],
     )
-    if (args.plot_grid or args.plot_vectors) and not np.isfinite(g.actual).any():
-        raise CliError("no field could be traced: there is nothing to plot")
     if args.plot_grid or args.plot_vectors:
+        check_traced_any(np.isfinite(g.actual).any(), see="")
         from ..plots.grid import plot_distortion_vectors, plot_grid_distortion
 
-        if args.plot_grid:
-            save_plot(lambda: plot_grid_distortion(g), args.plot_grid, args)
-        if args.plot_vectors:
-            save_plot(lambda: plot_distortion_vectors(g), args.plot_vectors, args)
+        save_plots(
+            ((args.plot_grid, plot_grid_distortion), (args.plot_vectors, plot_distortion_vectors)),
+            g,
+            args,
+        )
     strict_check(args, g.status, see="")
     return 0
 

@@ -16,12 +16,13 @@ from .common import (
     add_strict_arg,
     add_wavelength_arg,
     check_plot_path,
+    check_traced_any,
     load_input,
     number,
     print_result,
     resolve_fields,
     resolve_object,
-    resolve_planes,
+    resolve_one_plane,
     save_plot,
     strict_check,
 )
@@ -37,10 +38,8 @@ OUTPUTS = [("--plot", ".png")]
 
 def _common(lens, args):
     od = resolve_object(lens, args)
-    planes = resolve_planes(lens, args)
-    if len(planes) != 1:
-        raise CliError("give one image plane")
-    return {"object_distance": od, "plane": planes[0], "wavelength": args.wavelength}
+    (plane,) = resolve_one_plane(lens, args, "give one image plane")
+    return {"object_distance": od, "plane": plane, "wavelength": args.wavelength}
 
 
 def _field_kw(value: float, kind: str) -> dict:
@@ -99,8 +98,7 @@ def _output(args, lens, key, items, to_dict, to_csv, to_text, what) -> None:
     )
     if args.plot:
         traced = [i for i in items if not isinstance(i, NotTraced)]
-        if not traced:
-            raise CliError("no field could be traced (see the output): there is nothing to plot")
+        check_traced_any(bool(traced), see=" (see the output)")
         from ..plots.rays import plot_ray_fan, plot_spot
 
         plot = plot_ray_fan if key == "fans" else plot_spot

@@ -5,11 +5,10 @@ from __future__ import annotations
 import argparse
 
 from .common import (
-    add_lens_arg,
-    add_object_args,
+    add_lens_object_args,
     add_output_args,
     add_wavelength_arg,
-    load,
+    load_input,
     print_result,
     resolve_object,
 )
@@ -26,7 +25,7 @@ def cmd_paraxial(args) -> int:
 
     from ..report.paraxial import format_paraxial, paraxial_to_dict
 
-    lens = load(args.lens)
+    lens = load_input(args)
     od = resolve_object(lens, args)
     par = paraxial(lens, od, args.wavelength)
     print_result(
@@ -46,8 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "first vertex.",
         epilog="Example: orthoscope paraxial twinplex-like-55-525 --object-s -55.0009",
     )
-    add_lens_arg(q)
-    add_object_args(q)
+    add_lens_object_args(q, fields=False, planes=False)
     add_wavelength_arg(q)
     add_output_args(q, csv=False, json_help="Print JSON (keys as in the README).")
     q.set_defaults(func=cmd_paraxial)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_lens_arg, add_output_args, load, print_result
+from .common import add_lens_arg, add_output_args, load_input, print_result
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -18,7 +18,7 @@ def cmd_prescription(args) -> int:
 
     from ..report.prescription import prescription_to_dict
 
-    lens = load(args.lens)
+    lens = load_input(args)
     print_result(
         args, json=lambda: prescription_to_dict(lens), text=lambda: format_prescription(lens)
     )

@@ -7,16 +7,14 @@ from __future__ import annotations
 import argparse
 
 from .common import (
-    CliError,
-    add_field_args,
     add_force_arg,
-    add_lens_arg,
-    add_object_args,
+    add_lens_object_args,
     add_output_args,
     add_strict_arg,
     add_table_layout_arg,
     add_wavelength_arg,
     check_plot_path,
+    check_traced_any,
     field_keyword,
     load_input,
     print_result,
@@ -55,8 +53,7 @@ def cmd_pupils(args) -> int:
         text=lambda: format_pupils(pa, layout=args.table_layout),
     )
     if args.plot:
-        if not np.isfinite(pa.cra_deg).any():
-            raise CliError("no field could be traced (see the table): there is nothing to plot")
+        check_traced_any(np.isfinite(pa.cra_deg).any())
         from ..plots.telecentricity import plot_pupils
 
         save_plot(lambda: plot_pupils(pa), args.plot, args)
@@ -83,9 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope pupils twinplex-like-55-525 --object-s -55.0009 --json"
         ),
     )
-    add_lens_arg(q)
-    add_object_args(q)
-    add_field_args(q)
+    add_lens_object_args(q, planes=False)
     add_wavelength_arg(q)
     add_table_layout_arg(q)
     add_strict_arg(q)

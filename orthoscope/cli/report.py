@@ -11,16 +11,14 @@ from raytrace.limits import MAX_FIELDS
 from .common import (
     CliError,
     add_force_arg,
-    add_lens_arg,
-    add_object_args,
+    add_lens_object_args,
     add_output_args,
-    add_plane_args,
     add_wavelength_arg,
     check_plot_path,
     load_input,
     print_result,
     resolve_object,
-    resolve_planes,
+    resolve_one_plane,
     save_plot,
 )
 
@@ -53,9 +51,7 @@ def cmd_report(args) -> int:
     if args.sensor is not None and args.max_field is not None:
         raise CliError("give --sensor or --max-field, not both")
     od = resolve_object(lens, args)
-    planes = resolve_planes(lens, args)
-    if len(planes) != 1:
-        raise CliError("a certificate is for one image plane: give one value")
+    planes = resolve_one_plane(lens, args, "a certificate is for one image plane: give one value")
     # the work limit is checked there, before any trace (its message in flags: cli_words)
     cert = calibration_certificate(
         lens,
@@ -120,9 +116,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "  orthoscope report cooke-triplet-f4 --sensor 36x24 --object-distance 2m --json"
         ),
     )
-    add_lens_arg(q)
-    add_object_args(q)
-    add_plane_args(q)
+    add_lens_object_args(q, fields=False)
     add_wavelength_arg(q)
     g = q.add_argument_group("format and form")
     g.add_argument(

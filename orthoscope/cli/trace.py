@@ -5,12 +5,8 @@ from __future__ import annotations
 import argparse
 
 from .common import (
-    CliError,
-    add_field_args,
-    add_lens_arg,
-    add_object_args,
+    add_lens_object_args,
     add_output_args,
-    add_plane_args,
     add_strict_arg,
     add_wavelength_arg,
     check_finite_object,
@@ -19,7 +15,7 @@ from .common import (
     print_result,
     resolve_fields,
     resolve_object,
-    resolve_planes,
+    resolve_one_plane,
     strict_check,
 )
 
@@ -40,9 +36,9 @@ def cmd_trace(args) -> int:
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
     par = paraxial(lens, od, args.wavelength)
-    planes = resolve_planes(lens, args)
-    if len(planes) != 1:
-        raise CliError("trace takes one image plane; 'orthoscope distortion' takes several")
+    planes = resolve_one_plane(
+        lens, args, "trace takes one image plane; 'orthoscope distortion' takes several"
+    )
     z_img = float(plane_z(par, planes)[0])
     check_finite_object(kind, od)
     cr = aim(lens, fields, kind, od, args.wavelength)
@@ -66,10 +62,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "entrance-pupil position (z from the first vertex) and the ray status.",
         epilog="Example: orthoscope trace topogon-us2031792-fig1 --max-field 50 --steps 10 --json",
     )
-    add_lens_arg(q)
-    add_object_args(q)
-    add_field_args(q)
-    add_plane_args(q)
+    add_lens_object_args(q)
     add_wavelength_arg(q)
     add_strict_arg(q)
     add_output_args(q)

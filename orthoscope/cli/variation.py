@@ -18,7 +18,7 @@ from .common import (
     load_scaled,
     print_result,
     refuse_flags,
-    save_plot,
+    save_plots,
 )
 
 CONJ_HELP = (
@@ -121,8 +121,7 @@ def cmd_variation(args) -> int:
     from .common import MAX_FIELDS, check_size
 
     check_size(args.n_r, MAX_FIELDS, "--n-r", args, per_item_bytes=2000)
-    lens = load_scaled(args)
-    args._inputs = [lens.path] if lens.path else []
+    lens = load_scaled(args)  # recorded as the input (args._inputs)
     _check_outputs(args)
     tv = trace_variation(
         lens,
@@ -173,9 +172,7 @@ def _plots(a, args) -> None:
         return
     from ..plots.variation import plot_g, plot_profiles
 
-    for path, plot in ((args.plot, plot_profiles), (args.plot_g, plot_g)):
-        if path:
-            save_plot(lambda plot=plot: plot(a), path, args)
+    save_plots(((args.plot, plot_profiles), (args.plot_g, plot_g)), a, args)
 
 
 def _g_csv(a) -> str:
