@@ -14,7 +14,7 @@ from distortion.variation.analysis import FocusSummary, GEstimate, VariationAnal
 from distortion.variation.models import Conjugate
 from distortion.variation.traced import DEFINITION, FOCUSING, TracedVariation
 
-from .jsonout import float_list
+from .jsonout import float_list, jsonable
 
 
 def _num(x: float, fmt: str = ".3f") -> str:
@@ -140,8 +140,8 @@ def conjugate_to_dict(c: Conjugate) -> dict:
 
 
 def _f(x: float | None) -> float | None:
-    """A Python float (NaN and infinities stay; :func:`~orthoscope.report.jsonout.jsonable`
-    writes them as null and "inf" / "-inf", as every JSON output does)."""
+    """A Python float (NaN and infinities stay: :func:`variation_to_dict` makes them null and
+    "inf" / "-inf" with :func:`~orthoscope.report.jsonout.jsonable`, as every JSON output)."""
     return None if x is None else float(x)
 
 
@@ -166,7 +166,7 @@ def g_estimate_to_dict(e: GEstimate) -> dict:
 def variation_to_dict(a: VariationAnalysis) -> dict:
     """JSON-ready dict of a :class:`VariationAnalysis` (NaN → null, infinities "inf" / "-inf"
     as in every JSON output; units in the key names)."""
-    return {
+    out = {
         "source": a.source,
         "focal_length_mm": a.focal_length_mm,
         "interpolation": a.interpolation,
@@ -250,6 +250,7 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
         ],
         "messages": list(a.messages),
     }
+    return jsonable(out)
 
 
 def format_traced_variation(tv: TracedVariation) -> str:
