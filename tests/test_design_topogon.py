@@ -13,7 +13,12 @@ with spherical surfaces only and catalog glasses, designed by the minimax spec
 lenses/specs/topogon-like-spherical.toml; it misses the 3 µm target at seven of the nine angles
 (max 5.90 µm), and the tests below hold each Table I entry to its measured error with the reason,
 check the spec's operands against an independent trace and re-run the spec (section
-"all-spherical lens").
+"all-spherical lens"). The third, ``topogon-like-spherical-heights``, has the same construction,
+glasses and rules, designed to Table I's image heights (F0 tan alpha + D0) with its EFL free;
+its EFL is not the table's (section "all spherical, to image heights"). It meets 3 µm per entry
+measured against the table's F0; Table II by two-point calibration to 3.72 µm. The edge and
+|c| h rules, which both specs hold through fixed-height stand-ins, are checked at each lens's own
+real-ray footprints.
 """
 
 from __future__ import annotations
@@ -33,6 +38,9 @@ from raytrace.paraxial import paraxial
 DATA = Path(__file__).parent / "data"
 SPEC = Path(__file__).parents[1] / "lenses" / "specs" / "topogon-like-pestrecov.toml"
 SPHERICAL_SPEC = Path(__file__).parents[1] / "lenses" / "specs" / "topogon-like-spherical.toml"
+HEIGHTS_SPEC = SPHERICAL_SPEC.with_name("topogon-like-spherical-heights.toml")
+SPHERICAL_NAMES = ("topogon-like-spherical", "topogon-like-spherical-heights")
+SPECS = {"topogon-like-spherical": SPHERICAL_SPEC, "topogon-like-spherical-heights": HEIGHTS_SPEC}
 F0 = 153.706  # Pestrecov 1958 Table I heading: F0 = EFL = 153.706 mm
 FC = 154.059  # Pestrecov 1958 Table II heading: F_c = 154.059 mm
 
@@ -137,9 +145,11 @@ def spherical_traced(spherical, table1):
     return characteristic_distortion(spherical, table1.fields).curve(0)
 
 
-def test_spherical_lens_is_four_spherical_menisci_in_catalog_glass(spherical):
+@pytest.mark.parametrize("name", SPHERICAL_NAMES)
+def test_spherical_lens_is_four_spherical_menisci_in_catalog_glass(name):
     from raytrace.glass import lookup_glass
 
+    spherical = load_lens(name)
     s = spherical.surfaces
     assert len(s) == 9 and s[4].stop and s[4].curvature == 0.0
     glass = [i for i, x in enumerate(s) if not x.material.is_air]
@@ -165,6 +175,11 @@ def test_spherical_lens_is_four_spherical_menisci_in_catalog_glass(spherical):
             assert t <= 3.0
     for i in (1, 6):  # the outer air spaces: thin, as in the patent
         assert 0.05 <= s[i].thickness <= 5.0
+    # nearly symmetric about the stop (the notes' type rules): mirrored curvatures and the two
+    # stop spaces within a factor 1.6
+    for a, b in ((0, 8), (1, 7), (2, 6), (3, 5)):
+        assert 1 / 1.6 <= s[a].curvature / -s[b].curvature <= 1.6, (a + 1, b + 1)
+    assert 1 / 1.6 - 1e-12 <= s[3].thickness / s[4].thickness <= 1.6 + 1e-12
 
 
 def test_spherical_efl_is_table1_f0(spherical):
@@ -265,3 +280,173 @@ def test_table1_polynomial_floor_quoted_in_the_notes(spherical, table1):
         floors.append(1e3 * res.x[-1])
     np.testing.assert_allclose(floors, [6.70, 4.25, 1.39], atol=0.01)
     assert "6.70 um" in spherical.notes and "5.19 um" in spherical.notes
+
+
+# --------------------------------------------------------------------------- real-ray footprints
+# Both spherical specs hold the edge-thickness and stop-clearance rules (at the clear
+# semi-diameter + 0.5 mm) through edge_thickness operands at FIXED heights, and |c| h <= 0.975
+# through curvature bounds; the stand-ins are sound only if the lens's own footprints lie inside
+# them. Footprints as the specs define them: the rim of the paraxial entrance pupil scaled by the
+# notes' vignetting model (full f/6.3 beam to 30 deg, 0.75 of the pupil at 37.5, 0.5 at 45,
+# linear between), 0-45 deg in 0.5 deg steps, every ray passing.
+
+
+def _footprints(lens) -> np.ndarray:
+    """Largest ray height (mm) on each surface over the vignetted rim beams."""
+    from raytrace.trace.rays import ray_paths
+
+    par = paraxial(lens)
+    th = np.linspace(0.0, 2.0 * np.pi, 72, endpoint=False)
+    h = np.zeros(len(lens.surfaces))
+    for alpha in np.arange(0.0, 45.01, 0.5):
+        a = 0.5 * par.epd * float(np.interp(alpha, [0, 30, 37.5, 45], [1.0, 1.0, 0.75, 0.5]))
+        t = np.tan(np.radians(alpha))
+        d = np.array([0.0, t, 1.0]) / np.hypot(1.0, t)
+        back = -(2.0 * par.epd + 1.0) / d[2]  # start well before the first vertex
+        o = np.c_[a * np.cos(th), a * np.sin(th), np.full(th.size, par.z_E0)] + back * d
+        p = ray_paths(lens, o, np.tile(d, (th.size, 1)))
+        assert np.all(p.status == 0), f"{lens.name}: a ray of the {alpha} deg beam fails"
+        h = np.maximum(h, np.max(np.hypot(p.x, p.y), axis=0))
+    return h
+
+
+@pytest.mark.parametrize("name", SPHERICAL_NAMES)
+def test_edge_and_curvature_rules_hold_on_the_real_footprints(name):
+    """The rules themselves, at each lens's own clear semi-diameters (footprints) + 0.5 mm: the
+    edge thickness of every glass (>= 1.0 mm) and air space (>= 0.1 mm), the stop clearances
+    (surface 4 to the stop plane, the stop plane to surface 6, >= 0.5 mm), each with the minimum
+    its spec's stand-in operand states; |c| h <= 0.975 at the footprint; and the spec's own
+    curvature bounds keep |c| h <= 0.975 too (but the c2 / c8 boxes, which stand in for the
+    mirrored-curvature rule)."""
+    lens = load_lens(name)
+    s, h = lens.surfaces, _footprints(lens)
+    spec = read_spec(SPECS[name])
+    edges = [o for o in spec.operands if o.type == "edge_thickness"]
+    assert sorted(int(o.params["surface"]) for o in edges) == list(range(1, 9))
+    for o in edges:
+        k = int(o.params["surface"]) - 1  # the gap after surface k (0-based)
+        foot = {3: h[3], 4: h[5]}.get(k, max(h[k], h[k + 1]))
+        he = foot + 0.5
+        edge = s[k].thickness + s[k + 1].sag(he) - s[k].sag(he)
+        assert edge >= o.limits[0], (name, k + 1, he, edge)
+        assert he <= o.params["height"]  # and the stand-in's height lies outside the footprint
+    for v in spec.variables:
+        if v.kind == "curvature":
+            i = v.surface - 1
+            assert abs(s[i].curvature) * h[i] <= 0.975, (v.surface, h[i])
+            if v.surface not in (2, 8):
+                assert max(abs(v.lower), abs(v.upper)) * h[i] <= 0.975, (v.surface, h[i])
+
+
+# ------------------------------------------------------------- all spherical, to image heights
+# lenses/topogon-like-spherical-heights.toml (issue 19, item 4): the construction, glasses and
+# rules of topogon-like-spherical, designed to Table I read as image heights y' = F0 tan(alpha)
+# + D0 (F0 = 153.706, the table's) with the EFL free: the lens's distortion against F0 = 153.706
+# (the 'given' calibration) is Table I's D0 column, and Table II's two-point calibration follows
+# from y' alone. Its EFL (153.774) is not the table's F0, so its characteristic distortion is not
+# Table I's (the notes say why). The measured numbers below are REGRESSION PINS of our own design
+# run (2026-11-28), not published values; the published ones are Tables I and II.
+HEIGHTS_MAX_ERR_UM = 2.711  # regression pin: the spec's minimax merit on the shipped lens
+HEIGHTS_EFL = 153.77398  # regression pin
+
+
+@pytest.fixture(scope="module")
+def heights():
+    return load_lens("topogon-like-spherical-heights")
+
+
+@pytest.fixture(scope="module")
+def heights_traced(heights, table1):
+    return characteristic_distortion(heights, table1.fields).curve(0)
+
+
+def test_heights_lens_measured_against_table1_f0_is_table1(heights, heights_traced, table1):
+    assert paraxial(heights).efl == pytest.approx(HEIGHTS_EFL, abs=1e-5)
+    cal = calibrate(heights_traced, "given", value=F0)  # D_c = y' - F0 tan(alpha)
+    err_um = 1e3 * (cal.Dc - table1.D0)
+    assert np.all(np.abs(err_um) <= 3.0), np.round(err_um, 2)  # the issue's 3 µm per entry
+    assert np.max(np.abs(err_um)) == pytest.approx(HEIGHTS_MAX_ERR_UM, abs=1e-3)
+
+
+def test_heights_two_point_calibration_reproduces_table2(heights_traced, table2):
+    cal = calibrate(heights_traced, "two-point", at=(37.5, 45))
+    assert cal.Kc == pytest.approx(FC, abs=0.001)  # within 1 µm of Table II (measured 154.0596)
+    err = cal.Dc - table2[:, 2]
+    # measured max 3.72 µm at 42.5 deg (regression pin): the 2.71 µm of y', Table II's F_c
+    # rounded to 154.059 and its D_c rounded to 1 µm add there
+    assert np.max(np.abs(err)) <= 0.00375, f"D_c - Table II (mm): {np.round(err, 4)}"
+
+
+def test_heights_spec_operands_match_an_independent_trace(heights, heights_traced, table1):
+    """The spec's targets are Table I's image heights F0 tan(alpha) + D0, its residuals (weight
+    1000 per mm: µm) this file's D_c - Table I with the given calibration, and every bound
+    operand (EFL range, the y'(45) stand-in, RMS caps, BFL, edge thicknesses) is met."""
+    spec = read_spec(HEIGHTS_SPEC)
+    values = evaluate(heights, spec.operands)
+    cal = calibrate(heights_traced, "given", value=F0)
+    targets = [v for v in values if v.operand.type == "image_height" and not v.operand.bounded]
+    assert len(targets) == 9
+    for v in targets:
+        i = int(np.flatnonzero(np.isclose(table1.fields, v.operand.params["field"]))[0])
+        y_table = F0 * np.tan(np.radians(table1.fields[i])) + table1.D0[i]
+        assert v.operand.target == pytest.approx(y_table, abs=1e-6)  # written to 1e-6 mm
+        assert v.operand.weight == 1000.0
+        assert v.residual == pytest.approx(1e3 * (cal.Dc[i] - table1.D0[i]), abs=2e-3)
+    assert max(abs(v.residual) for v in targets) == pytest.approx(HEIGHTS_MAX_ERR_UM, abs=1e-3)
+    for v in values:
+        if v.operand.bounded:
+            assert abs(v.residual) <= 1e-9, (v.operand, v.value)
+
+
+def test_heights_design_is_reproducible_from_its_spec(heights):
+    """The design run itself (about 4 s on one core, 989 evaluations): the spec's minimax from its
+    start lens (the global-search design, rounded) converges to the shipped lens."""
+    spec = read_spec(HEIGHTS_SPEC)
+    res = optimize(start_lens(spec), spec)
+    assert res.converged, res.message
+    assert res.violation <= 1e-9
+    assert res.merit == pytest.approx(HEIGHTS_MAX_ERR_UM, abs=1e-3)
+    for a, b in zip(res.lens.surfaces, heights.surfaces, strict=True):
+        assert a.curvature == pytest.approx(b.curvature, rel=1e-6)
+        assert a.thickness == pytest.approx(b.thickness, rel=1e-6)
+
+
+def test_table1_scale_term_quoted_in_the_notes(heights, table1):
+    """The evidence the notes give, recomputed from Table I alone: allowing a term a1 tan(alpha)
+    (a reference scale that is not the lens's paraxial EFL) in the minimax odd-polynomial fit
+    lowers the floor from 6.70 to 3.22 µm (to t^9) and from 4.25 to 2.65 µm (to t^11), with a1 =
+    0.075 / 0.067 mm; near the axis Table I rises as D0(10)/D0(20) = 0.193, a cubic as 0.114."""
+    from scipy.optimize import linprog
+
+    keep = table1.fields > 0
+    t, y = np.tan(np.radians(table1.fields[keep])), table1.D0[keep]
+    got = []
+    for top in (9, 11):
+        A = np.stack([t**k for k in range(1, top + 1, 2)], axis=1)
+        m, ones = A.shape[1], np.ones((len(t), 1))
+        res = linprog(
+            np.r_[np.zeros(m), 1.0],
+            A_ub=np.r_[np.c_[A, -ones], np.c_[-A, -ones]],
+            b_ub=np.r_[y, -y],
+            bounds=[(None, None)] * m + [(0.0, None)],
+        )
+        assert res.success
+        got.append((1e3 * res.x[-1], res.x[0]))
+    floors, a1 = np.array(got).T
+    np.testing.assert_allclose(floors, [3.22, 2.65], atol=0.005)  # quoted to 0.01 µm
+    np.testing.assert_allclose(a1, [0.075, 0.067], atol=5e-4)  # quoted to 1 µm
+    assert y[0] / y[1] == pytest.approx(0.193, abs=5e-4)
+    assert (t[0] / t[1]) ** 3 == pytest.approx(0.114, abs=5e-4)
+    for quoted in ("3.22 and 2.65 um", "a1 = 0.075 and 0.067 mm", "153.774", "0.193"):
+        assert quoted in heights.notes, quoted
+
+
+def test_heights_notes_quote_the_lens_as_it_is(heights):
+    """The BFL, vertex length and clear semi-diameters the notes quote are this lens's."""
+    par = paraxial(heights)
+    assert f"BFL {par.bfl:.2f} mm" in heights.notes
+    length = sum(x.thickness for x in heights.surfaces[:-1])
+    assert f"vertex length {length:.1f} mm" in heights.notes
+    h = _footprints(heights)
+    quoted = ", ".join(f"{x:.1f}" + (" (stop)" if i == 4 else "") for i, x in enumerate(h))
+    assert f"clear semi-diameters {quoted} mm" in heights.notes

@@ -49,7 +49,12 @@ def test_library_holds_the_bundled_files() -> None:
     assert set(bundled_names()) - set(PUBLISHED) <= DESIGNED
 
 
-DESIGNED = {"topogon-like-pestrecov", "topogon-like-spherical", "twinplex-like-55-525"}
+DESIGNED = {
+    "topogon-like-pestrecov",
+    "topogon-like-spherical",
+    "topogon-like-spherical-heights",
+    "twinplex-like-55-525",
+}
 
 
 @pytest.mark.parametrize("name", sorted(PUBLISHED))
