@@ -876,10 +876,37 @@ def test_camera_id_reaches_the_colmap_file_of_two(tmp_path, monkeypatch):
     assert rc == 0 and same == out, err
 
 
+def test_each_calibration_file_is_read_once(tmp_path, monkeypatch):
+    """compare, convert and variation read each calibration file once: the text read to tell its
+    format (a .txt or .xml by its content) is the text parsed (it was read a second time)."""
+    from pathlib import Path
+
+    (tmp_path / "cameras.txt").write_text("1 PINHOLE 3000 2000 6000 6000 1500 1000\n")
+    reads = []
+    read_text = Path.read_text
+
+    def counted(self, *args, **kw):
+        reads.append(self.name)
+        return read_text(self, *args, **kw)
+
+    monkeypatch.setattr(Path, "read_text", counted)
+    for argv, names in (
+        (_FORM_ARGV["compare"], ["cooke-measured-2m.yml"]),
+        (["camera", "convert", _CAL, "--model", "metashape"], ["cooke-measured-2m.yml"]),
+        (["camera", "convert", str(tmp_path / "cameras.txt"), "--model", "opencv"],
+         ["cameras.txt"]),
+        (_VAR, ["cooke-measured-1m.yml", "cooke-measured-5m.yml"]),
+    ):  # fmt: skip
+        reads.clear()
+        rc, _, err = run(argv)
+        assert rc == 0, err
+        assert sorted(n for n in reads if n in names) == names, (argv, reads)
+
+
 def test_the_table_kind_is_found_once_and_before_the_work(tmp_path, monkeypatch):
     """The suffix of -o of a table (lens --object-distances, compare, variation) is read once
     per run, before any work (variation read it after the calibrations)."""
-    import orthoscope.cli.camera as camera
+    import orthoscope.cli.camera.actions as actions  # where the actions look table_kind up
 
     calls = []
 
@@ -887,8 +914,8 @@ def test_the_table_kind_is_found_once_and_before_the_work(tmp_path, monkeypatch)
         calls.append(path)
         return kind(path, what)
 
-    kind = camera._table_kind
-    monkeypatch.setattr(camera, "_table_kind", counted)
+    kind = actions.table_kind
+    monkeypatch.setattr(actions, "table_kind", counted)
     for argv in (
         [*BASE, "--object-distances", "1m,inf", "-o", str(tmp_path / "t.csv")],
         [*_FORM_ARGV["compare"], "-o", str(tmp_path / "c.json")],

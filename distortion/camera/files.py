@@ -96,7 +96,11 @@ def _check_format(fmt: str) -> str:
 
 # ---- reading ------------------------------------------------------------------------------------
 def read_calibration(
-    path: str | os.PathLike, *, format: str | None = None, camera_id: int | None = None
+    path: str | os.PathLike,
+    *,
+    format: str | None = None,
+    camera_id: int | None = None,
+    text: str | None = None,
 ) -> CameraModel:
     """Read a calibration file into a :class:`~distortion.camera.models.CameraModel`.
 
@@ -115,6 +119,9 @@ def read_calibration(
         (COLMAP, or this package's Australis text by its first line), ``.aus``/``.australis``.
     camera_id : int, optional
         The COLMAP camera id to read (a COLMAP file only).
+    text : str, optional
+        The file's content, already read (``utf-8-sig``): it is parsed and the file is not read
+        again; ``path`` still names the file in the messages and tells the format.
 
     Returns
     -------
@@ -129,10 +136,11 @@ def read_calibration(
         ``camera_id`` for a file that is not COLMAP.
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except OSError as e:
-        raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
+    if text is None:
+        try:
+            text = p.read_text(encoding="utf-8-sig")
+        except OSError as e:
+            raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
     fmt = _check_format(format) if format else detect_format(p, text)
     if camera_id is not None and fmt != "colmap":
         raise DataError(
