@@ -255,29 +255,32 @@ def test_spherical_design_is_reproducible_from_its_spec(spherical):
         assert a.thickness == pytest.approx(b.thickness, rel=1e-6)
 
 
+def _minimax_odd_fit(table1, lowest: int, top: int) -> tuple[float, np.ndarray]:
+    """The minimax fit of Table I's nine non-zero D0 by a_lowest t^lowest + ... + a_top t^top
+    (odd powers, t = tan alpha): (largest error in µm, the coefficients a in mm), by a linear
+    programme over the published points."""
+    from scipy.optimize import linprog
+
+    keep = table1.fields > 0  # the nine non-zero angles of Table I
+    t, y = np.tan(np.radians(table1.fields[keep])), table1.D0[keep]
+    assert t.size == 9
+    A = np.stack([t**k for k in range(lowest, top + 1, 2)], axis=1)
+    m, ones = A.shape[1], np.ones((t.size, 1))
+    res = linprog(
+        np.r_[np.zeros(m), 1.0],
+        A_ub=np.r_[np.c_[A, -ones], np.c_[-A, -ones]],
+        b_ub=np.r_[y, -y],
+        bounds=[(None, None)] * m + [(0.0, None)],
+    )
+    assert res.success
+    return 1e3 * res.x[-1], res.x[:-1]
+
+
 def test_table1_polynomial_floor_quoted_in_the_notes(spherical, table1):
     """The evidence the lens notes give for the miss, recomputed from Table I alone: the minimax
     fit of D0 by a3 t^3 + ... + a9 t^9 (t = tan alpha) leaves 6.70 µm, with t^11 4.25 µm, with
     t^13 1.39 µm (linear programme over the nine published points)."""
-    from scipy.optimize import linprog
-
-    keep = table1.fields > 0  # the nine non-zero angles of Table I
-    a, y = table1.fields[keep], table1.D0[keep]
-    assert a.size == 9
-    t = np.tan(np.radians(a))
-    floors = []
-    for top in (9, 11, 13):
-        A = np.stack([t**k for k in range(3, top + 1, 2)], axis=1)
-        m = A.shape[1]
-        ones = np.ones((len(t), 1))
-        res = linprog(
-            np.r_[np.zeros(m), 1.0],
-            A_ub=np.r_[np.c_[A, -ones], np.c_[-A, -ones]],
-            b_ub=np.r_[y, -y],
-            bounds=[(None, None)] * m + [(0.0, None)],
-        )
-        assert res.success
-        floors.append(1e3 * res.x[-1])
+    floors = [_minimax_odd_fit(table1, 3, top)[0] for top in (9, 11, 13)]
     np.testing.assert_allclose(floors, [6.70, 4.25, 1.39], atol=0.01)
     assert "6.70 um" in spherical.notes and "5.19 um" in spherical.notes
 
@@ -416,26 +419,12 @@ def test_table1_scale_term_quoted_in_the_notes(heights, table1):
     (a reference scale that is not the lens's paraxial EFL) in the minimax odd-polynomial fit
     lowers the floor from 6.70 to 3.22 µm (to t^9) and from 4.25 to 2.65 µm (to t^11), with a1 =
     0.075 / 0.067 mm; near the axis Table I rises as D0(10)/D0(20) = 0.193, a cubic as 0.114."""
-    from scipy.optimize import linprog
-
-    keep = table1.fields > 0
-    t, y = np.tan(np.radians(table1.fields[keep])), table1.D0[keep]
-    got = []
-    for top in (9, 11):
-        A = np.stack([t**k for k in range(1, top + 1, 2)], axis=1)
-        m, ones = A.shape[1], np.ones((len(t), 1))
-        res = linprog(
-            np.r_[np.zeros(m), 1.0],
-            A_ub=np.r_[np.c_[A, -ones], np.c_[-A, -ones]],
-            b_ub=np.r_[y, -y],
-            bounds=[(None, None)] * m + [(0.0, None)],
-        )
-        assert res.success
-        got.append((1e3 * res.x[-1], res.x[0]))
-    floors, a1 = np.array(got).T
-    np.testing.assert_allclose(floors, [3.22, 2.65], atol=0.005)  # quoted to 0.01 µm
-    np.testing.assert_allclose(a1, [0.075, 0.067], atol=5e-4)  # quoted to 1 µm
-    assert y[0] / y[1] == pytest.approx(0.193, abs=5e-4)
+    fits = [_minimax_odd_fit(table1, 1, top) for top in (9, 11)]
+    np.testing.assert_allclose([f for f, _ in fits], [3.22, 2.65], atol=0.005)  # to 0.01 µm
+    np.testing.assert_allclose([a[0] for _, a in fits], [0.075, 0.067], atol=5e-4)  # to 1 µm
+    d0, t = table1.D0[1:3], np.tan(np.radians(table1.fields[1:3]))  # 10 and 20 deg
+    assert table1.fields[1:3].tolist() == [10.0, 20.0]
+    assert d0[0] / d0[1] == pytest.approx(0.193, abs=5e-4)
     assert (t[0] / t[1]) ** 3 == pytest.approx(0.114, abs=5e-4)
     for quoted in ("3.22 and 2.65 um", "a1 = 0.075 and 0.067 mm", "153.774", "0.193"):
         assert quoted in heights.notes, quoted
