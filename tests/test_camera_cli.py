@@ -903,6 +903,40 @@ def test_each_calibration_file_is_read_once(tmp_path, monkeypatch):
         assert sorted(n for n in reads if n in names) == names, (argv, reads)
 
 
+def test_each_camera_spec_is_read_once(tmp_path, monkeypatch):
+    """camera LENS and compare read and parse the --camera SPEC.toml once: the spec the sensor
+    is built from is the spec the camera setup is built from (it was read a second time);
+    convert and variation, which read only its sensor, once too. The spec's pixels are the
+    calibration's (3000x2000)."""
+    from pathlib import Path
+
+    _camera_spec(
+        tmp_path,
+        '[sensor]\nsize = "24x16"\npixels = "3000x2000"\n[focus]\ndistance = "2m"\n'
+        "[trace]\ngrid = [9, 7]\n",
+    )
+    reads = []
+    read_text = Path.read_text
+
+    def counted(self, *args, **kw):
+        reads.append(self.name)
+        return read_text(self, *args, **kw)
+
+    monkeypatch.setattr(Path, "read_text", counted)
+    spec = ["--camera", "cam.toml"]
+    for argv in (
+        ["camera", "cooke-triplet-f4", *spec],
+        ["camera", "cooke-triplet-f4", *spec, "--object-distances", "1m,2m"],
+        ["camera", "compare", "cooke-triplet-f4", _CAL, *spec, "--object-distance", "2m"],
+        ["camera", "convert", _CAL, "--model", "metashape", *spec],
+        [*_VAR[:-2], *spec],  # variation: --camera in place of --sensor
+    ):
+        reads.clear()
+        rc, _, err = run(argv, tmp_path, monkeypatch)
+        assert rc == 0, (argv, err)
+        assert reads.count("cam.toml") == 1, (argv, reads)
+
+
 def test_the_table_kind_is_found_once_and_before_the_work(tmp_path, monkeypatch):
     """The suffix of -o of a table (lens --object-distances, compare, variation) is read once
     per run, before any work (variation read it after the calibrations)."""

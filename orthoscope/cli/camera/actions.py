@@ -33,6 +33,7 @@ from .setup import (
     check_object_flags,
     sensor_from_flags,
     setup_from_flags,
+    spec_and_sensor,
 )
 from .values import check_object_distance, parse_distances
 
@@ -65,8 +66,8 @@ def _cmd_lens(args, lens_name: str) -> int:
         raise CliError(f"--picture {args.picture}: the picture is a .png image")
     if args.maps and not str(args.maps).lower().endswith(".npz"):
         raise CliError(f"--maps {args.maps}: the maps are written as a numpy .npz file")
-    sensor = sensor_from_flags(args)
-    setup = setup_from_flags(args, sensor)
+    spec, sensor = spec_and_sensor(args)
+    setup = setup_from_flags(args, sensor, spec)
     n = args.coefficients
     if args.object_distances is not None:
         unread = [f for f in given_flags(args) if f in ONE_DISTANCE_ONLY]
@@ -145,8 +146,8 @@ def _cmd_compare(args, lens_name: str, cal_word: str) -> int:
     check_output_path(args.output, args)
     kind = table_kind(args.output, "a comparison") if args.output else None  # before the trace
     (cal,) = read_calibrations(args, cal_path)
-    sensor = sensor_from_flags(args, cal)
-    setup = setup_from_flags(args, sensor)
+    spec, sensor = spec_and_sensor(args, cal)
+    setup = setup_from_flags(args, sensor, spec)
     cmp = compare_calibration(lens, cal, setup, label=f"measured ({cal_word})")
     if args.output:
         from ...report.jsonout import dumps

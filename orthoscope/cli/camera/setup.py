@@ -185,19 +185,28 @@ def _sensor_words(message: str, args, calibration) -> str:
 def sensor_from_flags(args, calibration=None):
     """The Sensor from --camera / --sensor / --pixels / --pitch / --principal-point (a
     calibration's pixel count when one is given); its refusals in the flags' words."""
+    return spec_and_sensor(args, calibration)[1]
+
+
+def spec_and_sensor(args, calibration=None):
+    """``(spec, sensor)``: the --camera SPEC.toml read and parsed once (None without --camera),
+    for :func:`setup_from_flags` too, and :func:`sensor_from_flags`'s Sensor; the refusals of
+    both (the spec's first) in the flags' words."""
+    from distortion.camera import read_camera_setup
     from distortion.errors import DataError
 
     try:
-        return _sensor_of(args, calibration)
+        spec = read_camera_setup(args.camera) if args.camera else None
+        return spec, _sensor_of(args, calibration, spec)
     except DataError as e:
         raise CliError(_sensor_words(str(e), args, calibration)) from e
 
 
-def _sensor_of(args, calibration=None):
-    from distortion.camera import Sensor, read_camera_setup
+def _sensor_of(args, calibration, spec):
+    from distortion.camera import Sensor
     from distortion.camera.traced import sensor_for_calibration
 
-    base = read_camera_setup(args.camera).sensor if args.camera else None
+    base = spec.sensor if spec is not None else None
     off = args.principal_point
     if calibration is not None:
         if args.pixels is not None:
@@ -242,12 +251,13 @@ def _sensor_of(args, calibration=None):
     )
 
 
-def setup_from_flags(args, sensor):
-    from distortion.camera import CameraSetup, read_camera_setup
+def setup_from_flags(args, sensor, spec):
+    """The CameraSetup of the flags on ``sensor``: the --camera spec ``spec`` as read by
+    :func:`spec_and_sensor` (None without --camera) with the flags' keywords replacing its own."""
+    from distortion.camera import CameraSetup
 
     kw = _setup_keywords(args)
-    if args.camera:
-        spec = read_camera_setup(args.camera)
+    if spec is not None:
         if getattr(args, "gaussian", False):  # replaces the spec's focus, as --defocus does
             spec = spec.replace(**dict.fromkeys(FOCUS_KEYS))
         return spec.replace(sensor=sensor, **kw)
