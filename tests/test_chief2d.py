@@ -247,3 +247,29 @@ def test_finite_object_heights_agree_with_optiland():
     cr = chief_rays_2d(lens, object_x_mm=X, object_y_mm=Y)
     ours = cr.positions_at(paraxial(lens).z_image_file)
     assert np.max(np.abs(ours - _optiland_chief_points(op, lens, X, Y))) <= 1e-9
+
+
+def test_a_stop_smaller_than_the_aperture_says_so_in_2d_too():
+    # The 1-D aim warned (tests/test_trace.py) and the 2-D aim, behind distortion grids and
+    # camera fits, did not: the same lens traced on a grid clipped its marginal rays silently.
+    # The warning points at the caller of the public function (stacklevel).
+    import warnings
+
+    from raytrace.trace.chief import ApertureWarning
+
+    lens = load_lens("cooke-triplet-f4")
+    s = list(lens.surfaces)
+    # 3.1 mm, not the 3.0 of tests/test_trace.py: the aims cache their setup per lens (and warn
+    # once), so an equal lens traced here first would silence the warning there
+    s[3] = dataclasses.replace(s[3], semi_diameter=3.1)  # f/4 needs 4.75 mm at the stop
+    small = dataclasses.replace(lens, surfaces=tuple(s))
+    for trace in (chief_rays_2d, chief_rays):
+        with pytest.warns(ApertureWarning, match="clipped at the stop") as got:
+            trace(small, [0.0, 10.0], [0.0, 5.0]) if trace is chief_rays_2d else trace(
+                small, [0.0, 10.0]
+            )
+        assert got[0].filename == __file__, trace.__name__
+    s[3] = dataclasses.replace(s[3], semi_diameter=5.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ApertureWarning)
+        chief_rays_2d(dataclasses.replace(lens, surfaces=tuple(s)), [0.0, 10.0], [0.0, 5.0])

@@ -74,15 +74,7 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
     sd_stop = float(p.sd[p.stop])
     for i, wl in enumerate(wavelengths):
         z_E0[i], r_par, r_stop[i] = aim_pupil_and_stop(lens, object_distance, wl, sd_stop)
-        if math.isfinite(sd_stop) and r_par > sd_stop * (1.0 + 1e-9):
-            warnings.warn(
-                f"{lens.name}: the stop (surface {p.stop + 1}) has a semi-diameter of "
-                f"{sd_stop:g} mm but the aperture ({lens.aperture.kind} {lens.aperture.value:g}) "
-                f"asks it to pass {r_par:.6g} mm: the marginal rays are clipped at the stop — "
-                "enlarge the stop's semi-diameter or reduce the aperture",
-                ApertureWarning,
-                stacklevel=4,
-            )
+        warn_if_the_stop_clips(lens, p.stop, sd_stop, r_par)
     slope0, hscale = aim_start(z_E0, object_distance, r_stop)
     # one wavelength: its own pupil (as a monochromatic lens); several: the reference
     # wavelength's, so that every wavelength traces the same object points
@@ -103,6 +95,23 @@ def aim_pupil_and_stop(
     except LensError as e:
         raise TraceError(str(e)) from None
     return z_E0, r_par, (sd_stop if math.isfinite(sd_stop) else r_par)
+
+
+def warn_if_the_stop_clips(lens: Lens, stop: int, sd_stop: float, r_par: float) -> None:
+    """:class:`ApertureWarning` when the stop (0-based surface ``stop``) has a semi-diameter
+    ``sd_stop`` (mm) smaller than the paraxial marginal-ray height ``r_par`` (mm) the lens's
+    aperture asks it to pass: the chief rays are still aimed at its centre, but the marginal
+    rays are clipped. Pointed at the caller of the public tracing function (the aims' setups
+    are three frames below it)."""
+    if math.isfinite(sd_stop) and r_par > sd_stop * (1.0 + 1e-9):
+        warnings.warn(
+            f"{lens.name}: the stop (surface {stop + 1}) has a semi-diameter of "
+            f"{sd_stop:g} mm but the aperture ({lens.aperture.kind} {lens.aperture.value:g}) "
+            f"asks it to pass {r_par:.6g} mm: the marginal rays are clipped at the stop — "
+            "enlarge the stop's semi-diameter or reduce the aperture",
+            ApertureWarning,
+            stacklevel=5,
+        )
 
 
 def aim_tolerance(r_stop: np.ndarray | float) -> np.ndarray | float:

@@ -48,6 +48,7 @@ from .chief import (
     aim_tolerance,
     checked_aim_request,
     transfer,
+    warn_if_the_stop_clips,
 )
 from .results import RayStatus, field_unit, object_words, status_name
 
@@ -63,7 +64,9 @@ class _Setup2D:
 @functools.lru_cache(maxsize=128)
 def _setup(lens: Lens, wavelength: float, object_distance: float) -> _Setup2D:
     p = pack(lens, wavelength=wavelength)
-    z_E0, _, r = aim_pupil_and_stop(lens, object_distance, wavelength, float(p.sd[p.stop]))
+    sd_stop = float(p.sd[p.stop])
+    z_E0, r_par, r = aim_pupil_and_stop(lens, object_distance, wavelength, sd_stop)
+    warn_if_the_stop_clips(lens, p.stop, sd_stop, r_par)
     return _Setup2D(p, float(z_E0), float(r), float(aim_tolerance(float(r))))
 
 
