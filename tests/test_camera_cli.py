@@ -876,12 +876,10 @@ def test_camera_id_reaches_the_colmap_file_of_two(tmp_path, monkeypatch):
     assert rc == 0 and same == out, err
 
 
-def test_each_calibration_file_is_read_once(tmp_path, monkeypatch):
-    """compare, convert and variation read each calibration file once: the text read to tell its
-    format (a .txt or .xml by its content) is the text parsed (it was read a second time)."""
+def _count_reads(monkeypatch) -> list[str]:
+    """The names of the files ``Path.read_text`` reads from now on (in order, appended)."""
     from pathlib import Path
 
-    (tmp_path / "cameras.txt").write_text("1 PINHOLE 3000 2000 6000 6000 1500 1000\n")
     reads = []
     read_text = Path.read_text
 
@@ -890,6 +888,14 @@ def test_each_calibration_file_is_read_once(tmp_path, monkeypatch):
         return read_text(self, *args, **kw)
 
     monkeypatch.setattr(Path, "read_text", counted)
+    return reads
+
+
+def test_each_calibration_file_is_read_once(tmp_path, monkeypatch):
+    """compare, convert and variation read each calibration file once: the text read to tell its
+    format (a .txt or .xml by its content) is the text parsed (it was read a second time)."""
+    (tmp_path / "cameras.txt").write_text("1 PINHOLE 3000 2000 6000 6000 1500 1000\n")
+    reads = _count_reads(monkeypatch)
     for argv, names in (
         (_FORM_ARGV["compare"], ["cooke-measured-2m.yml"]),
         (["camera", "convert", _CAL, "--model", "metashape"], ["cooke-measured-2m.yml"]),
@@ -908,21 +914,12 @@ def test_each_camera_spec_is_read_once(tmp_path, monkeypatch):
     is built from is the spec the camera setup is built from (it was read a second time);
     convert and variation, which read only its sensor, once too. The spec's pixels are the
     calibration's (3000x2000)."""
-    from pathlib import Path
-
     _camera_spec(
         tmp_path,
         '[sensor]\nsize = "24x16"\npixels = "3000x2000"\n[focus]\ndistance = "2m"\n'
         "[trace]\ngrid = [9, 7]\n",
     )
-    reads = []
-    read_text = Path.read_text
-
-    def counted(self, *args, **kw):
-        reads.append(self.name)
-        return read_text(self, *args, **kw)
-
-    monkeypatch.setattr(Path, "read_text", counted)
+    reads = _count_reads(monkeypatch)
     spec = ["--camera", "cam.toml"]
     for argv in (
         ["camera", "cooke-triplet-f4", *spec],
