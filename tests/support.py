@@ -285,3 +285,36 @@ def interrupt_group(argv: list[str], *, cwd, ready: Callable[[str], bool]):
             os.killpg(p.pid, signal.SIGKILL)
             p.wait()
     return before, p.returncode, out, err
+
+
+def rim_footprints(lens: Lens, par, beams, n_rim: int):
+    """The largest real-ray height (mm) on each surface over rim beams: for each ``(field,
+    fraction)`` of ``beams`` (field a nominal angle in degrees), ``n_rim`` rays through the rim of
+    the paraxial entrance pupil of ``par`` (:func:`raytrace.paraxial.paraxial`) scaled by
+    ``fraction`` (the vignetting), from the object point p0 tan(field) for a finite object, as a
+    parallel beam for an object at infinity. Every ray must pass (asserted): a clear
+    semi-diameter is a footprint of rays that reach the image."""
+    import math
+
+    import numpy as np
+
+    from raytrace.trace import STATUS_OK, ray_paths
+
+    th = np.linspace(0.0, 2.0 * np.pi, n_rim, endpoint=False)
+    foot = np.zeros(len(lens.surfaces))
+    for field, frac in beams:
+        px, py = 0.5 * par.epd * frac * np.cos(th), 0.5 * par.epd * frac * np.sin(th)
+        t = math.tan(math.radians(field))
+        if par.infinite:  # a parallel beam, started well before the first vertex
+            d = np.tile(np.array([0.0, t, 1.0]) / math.hypot(1.0, t), (n_rim, 1)).T
+            back = -(2.0 * par.epd + 1.0) / d[2]
+            start = (px + back * d[0], py + back * d[1], par.z_E0 + back * d[2])
+        else:  # from the object point, nominal angle: object height p0 tan(alpha)
+            y_obj = par.p0 * t
+            d = np.stack([px, py - y_obj, np.full_like(px, par.z_E0 - par.z_object)])
+            d /= np.linalg.norm(d, axis=0)
+            start = (np.zeros_like(px), np.full_like(px, y_obj), np.full_like(px, par.z_object))
+        paths = ray_paths(lens, start, tuple(d))
+        assert np.all(paths.status == STATUS_OK), f"{lens.name}: a ray of the {field} deg beam"
+        foot = np.maximum(foot, np.hypot(paths.x, paths.y).max(axis=0))
+    return foot

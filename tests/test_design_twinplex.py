@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import rim_footprints
 
 from distortion.characteristic import characteristic_distortion
 from raytrace.files.library import load_lens
@@ -420,22 +421,8 @@ def test_shop_rules_hold_on_the_lens_own_footprints(lens, par):
     the paraxial entrance pupil (144 rays a field, aimed here from the object point), glass edges
     >= 0.8 mm and the stop clearance >= 0.3 mm at the clear semi-diameter + 0.3 mm, |c| h <= 0.975
     there; and the spec's ray_height bounds (14 surfaces, 6 rim rays each) hold the full rims."""
-    from raytrace.trace import ray_paths
-
     _, od = projection_setting(lens, par)
-    p = paraxial(lens, od)
-    a = p.epd / 2.0
-    th = np.linspace(0.0, 2 * np.pi, 144, endpoint=False)
-    foot = np.zeros(len(lens.surfaces))
-    for field, frac in VIGNETTING:
-        y_obj = p.p0 * math.tan(math.radians(field))  # nominal angle: object height p0 tan(alpha)
-        px, py = a * frac * np.cos(th), a * frac * np.sin(th)
-        d = np.stack([px, py - y_obj, np.full_like(px, p.z_E0 - p.z_object)])
-        d /= np.linalg.norm(d, axis=0)
-        start = (np.zeros_like(px), np.full_like(px, y_obj), np.full_like(px, p.z_object))
-        paths = ray_paths(lens, start, tuple(d))
-        assert np.all(paths.status == STATUS_OK)
-        foot = np.maximum(foot, np.hypot(paths.x, paths.y).max(axis=0))
+    foot = rim_footprints(lens, paraxial(lens, od), VIGNETTING, 144)
     h = foot + MARGIN
     s = lens.surfaces
 
