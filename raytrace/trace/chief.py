@@ -71,10 +71,8 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
     nw = len(wavelengths)
     z_E0 = np.empty(nw)
     r_stop = np.empty(nw)
-    sd_stop = float(p.sd[p.stop])
     for i, wl in enumerate(wavelengths):
-        z_E0[i], r_par, r_stop[i] = aim_pupil_and_stop(lens, object_distance, wl, sd_stop)
-        warn_if_the_stop_clips(lens, p.stop, sd_stop, r_par)
+        z_E0[i], r_stop[i] = aim_pupil_and_stop(lens, p, object_distance, wl)
     slope0, hscale = aim_start(z_E0, object_distance, r_stop)
     # one wavelength: its own pupil (as a monochromatic lens); several: the reference
     # wavelength's, so that every wavelength traces the same object points
@@ -83,35 +81,33 @@ def _aim_setup(lens: Lens, wavelengths: tuple[float, ...], object_distance: floa
 
 
 def aim_pupil_and_stop(
-    lens: Lens, object_distance: float, wavelength: float, sd_stop: float
-) -> tuple[float, float, float]:
-    """``(z_E0, r_par, R_stop)`` of a chief-ray aim at ``wavelength`` (nm): the paraxial entrance
-    pupil (absolute z, mm), the paraxial marginal-ray height at the stop (mm;
+    lens: Lens, p: PackedLens, object_distance: float, wavelength: float
+) -> tuple[float, float]:
+    """``(z_E0, R_stop)`` of a chief-ray aim at ``wavelength`` (nm) through ``lens`` (packed as
+    ``p``): the paraxial entrance pupil (absolute z, mm;
     :func:`raytrace.paraxial.firstorder.aim_geometry`, its LensError as TraceError) and the stop
-    radius of the tolerance rule (:func:`aim_tolerance`): ``sd_stop``, the stop's semi-diameter
-    (mm), when finite, else ``r_par``."""
+    radius of the tolerance rule (:func:`aim_tolerance`): the stop's semi-diameter (mm) when
+    finite, else the paraxial marginal-ray height at the stop.
+
+    :class:`ApertureWarning` when the stop's semi-diameter is smaller than that marginal-ray
+    height, which the lens's aperture asks it to pass: the chief rays are still aimed at its
+    centre, but the marginal rays are clipped. The warning points at the caller of the public
+    tracing function (the aims' setups are three frames below it)."""
     try:
         z_E0, r_par = aim_geometry(lens, object_distance, wavelength)
     except LensError as e:
         raise TraceError(str(e)) from None
-    return z_E0, r_par, (sd_stop if math.isfinite(sd_stop) else r_par)
-
-
-def warn_if_the_stop_clips(lens: Lens, stop: int, sd_stop: float, r_par: float) -> None:
-    """:class:`ApertureWarning` when the stop (0-based surface ``stop``) has a semi-diameter
-    ``sd_stop`` (mm) smaller than the paraxial marginal-ray height ``r_par`` (mm) the lens's
-    aperture asks it to pass: the chief rays are still aimed at its centre, but the marginal
-    rays are clipped. Pointed at the caller of the public tracing function (the aims' setups
-    are three frames below it)."""
+    sd_stop = float(p.sd[p.stop])
     if math.isfinite(sd_stop) and r_par > sd_stop * (1.0 + 1e-9):
         warnings.warn(
-            f"{lens.name}: the stop (surface {stop + 1}) has a semi-diameter of "
+            f"{lens.name}: the stop (surface {p.stop + 1}) has a semi-diameter of "
             f"{sd_stop:g} mm but the aperture ({lens.aperture.kind} {lens.aperture.value:g}) "
             f"asks it to pass {r_par:.6g} mm: the marginal rays are clipped at the stop — "
             "enlarge the stop's semi-diameter or reduce the aperture",
             ApertureWarning,
             stacklevel=5,
         )
+    return z_E0, (sd_stop if math.isfinite(sd_stop) else r_par)
 
 
 def aim_tolerance(r_stop: np.ndarray | float) -> np.ndarray | float:

@@ -48,7 +48,6 @@ from .chief import (
     aim_tolerance,
     checked_aim_request,
     transfer,
-    warn_if_the_stop_clips,
 )
 from .results import RayStatus, field_unit, object_words, status_name
 
@@ -64,9 +63,7 @@ class _Setup2D:
 @functools.lru_cache(maxsize=128)
 def _setup(lens: Lens, wavelength: float, object_distance: float) -> _Setup2D:
     p = pack(lens, wavelength=wavelength)
-    sd_stop = float(p.sd[p.stop])
-    z_E0, r_par, r = aim_pupil_and_stop(lens, object_distance, wavelength, sd_stop)
-    warn_if_the_stop_clips(lens, p.stop, sd_stop, r_par)
+    z_E0, r = aim_pupil_and_stop(lens, p, object_distance, wavelength)
     return _Setup2D(p, float(z_E0), float(r), float(aim_tolerance(float(r))))
 
 
