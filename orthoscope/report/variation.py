@@ -136,19 +136,13 @@ def format_variation(a: VariationAnalysis) -> str:
 
 
 def conjugate_to_dict(c: Conjugate) -> dict:
-    return {"value": c.value if np.isfinite(c.value) else "inf", "unit": c.unit, "label": c.label}
-
-
-def _f(x: float | None) -> float | None:
-    """A Python float (NaN and infinities stay: :func:`variation_to_dict` makes them null and
-    "inf" / "-inf" with :func:`~orthoscope.report.jsonout.jsonable`, as every JSON output)."""
-    return None if x is None else float(x)
+    return {"value": c.value, "unit": c.unit, "label": c.label}
 
 
 def g_estimate_to_dict(e: GEstimate) -> dict:
     return {
-        "g": _f(e.g),
-        "se": _f(e.se),
+        "g": e.g,
+        "se": e.se,
         "status": e.status,
         "message": e.message,
         "method": e.method,
@@ -156,7 +150,7 @@ def g_estimate_to_dict(e: GEstimate) -> dict:
         "n_excluded": e.n_excluded,
         "threshold_um": e.threshold_um,
         "excluded_r_mm": float_list(e.excluded_r_mm),
-        "rms_fit_um": _f(e.rms_fit_um),
+        "rms_fit_um": e.rms_fit_um,
         "r_mm": float_list(e.r_mm),
         "g_pointwise": float_list(e.g_pointwise),
         "weak": [bool(w) for w in e.weak],
@@ -187,8 +181,8 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
             {
                 "focus": conjugate_to_dict(g.focus),
                 "object": conjugate_to_dict(g.obj),
-                "scale_focus": _f(g.scale_focus),
-                "scale_object": _f(g.scale_object),
+                "scale_focus": g.scale_focus,
+                "scale_object": g.scale_object,
                 "gamma": g.gamma,
             }
             for g in a.gammas
@@ -209,14 +203,14 @@ def variation_to_dict(a: VariationAnalysis) -> dict:
         "g": [
             {
                 "focus": conjugate_to_dict(fs.focus),
-                "mean_g": _f(fs.summary.mean),
-                "precision": _f(fs.summary.precision),
-                "sem": _f(fs.summary.sem),
+                "mean_g": fs.summary.mean,
+                "precision": fs.summary.precision,
+                "sem": fs.summary.sem,
                 "n_planes": fs.summary.n,
                 "planes": [
                     {
                         "object": conjugate_to_dict(p.obj),
-                        "rms_mean_g_um": _f(p.rms_mean_g_um),
+                        "rms_mean_g_um": p.rms_mean_g_um,
                         **g_estimate_to_dict(p.estimate),
                     }
                     for p in fs.planes
