@@ -217,7 +217,14 @@ def _optiland_chief_points(op, lens, X, Y):
 
 
 @pytest.mark.parametrize(
-    "name", ["cooke-triplet-f4", "topogon-us2031792-fig1", "topogon-like-pestrecov"]
+    "name",
+    [
+        "cooke-triplet-f4",
+        "topogon-us2031792-fig1",
+        "topogon-like-pestrecov",
+        # the image heights its notes compare with Pestrecov's Table I
+        "topogon-like-spherical-heights",
+    ],
 )
 def test_2d_chief_ray_image_points_agree_with_optiland(name):
     """optiland 0.6.3: its own chief rays (Px = Py = 0) aimed at the stop centre by its iterative
