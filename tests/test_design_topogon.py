@@ -430,3 +430,24 @@ def test_heights_notes_quote_the_lens_as_it_is(heights):
     h = _footprints(heights)
     quoted = ", ".join(f"{x:.1f}" + (" (stop)" if i == 4 else "") for i, x in enumerate(h))
     assert f"clear semi-diameters {quoted} mm" in heights.notes
+
+
+def test_a_film_plane_off_gaussian_adds_no_scale_term(spherical):
+    """lenses/README.md rules out a non-Gaussian film plane as the source of Table I's apparent
+    a1 tan(alpha) term: Pestrecov's constant of orthoscopy follows the plane, so D0 moves by
+    delta * dD0/ds' (pupil aberration only; exact, D0 is affine in s'), nothing linear in
+    tan(alpha). Checked against the slope of ``pupil_analysis``; the µm the README quotes for a
+    0.07 mm defocus (-0.01 at 10 deg, -4.9 at 45 deg) are regression pins of this run."""
+    from distortion.telecentricity import pupil_analysis
+
+    fields, delta = np.array([10.0, 45.0]), 0.07
+    gauss = characteristic_distortion(spherical, fields).curve(0).D0
+    moved = characteristic_distortion(spherical, fields, defocus=delta).curve(0).D0
+    change = (moved - gauss) * 1000  # µm
+    slope = pupil_analysis(spherical, fields).slope
+    np.testing.assert_allclose(change, delta * slope * 1000, atol=1e-6)
+    np.testing.assert_allclose(change, [-0.01, -4.9], atol=0.006)  # regression pin (README)
+    a1 = 0.068 * np.tan(np.radians(fields)) * 1000  # the heights lens's scale term, µm
+    assert np.all(np.abs(change) < 0.1 * a1)
+    readme = (Path(__file__).parents[1] / "lenses" / "README.md").read_text(encoding="utf-8")
+    assert "by −0.01 µm at 10° and −4.9 µm at 45°" in " ".join(readme.split())
