@@ -3,6 +3,9 @@ so a caller can catch every project error with one class)."""
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 from raytrace.errors import OrthoscopeError
 
 
@@ -19,3 +22,21 @@ class CalibrationError(DataError, ValueError):
 class UnitWarning(UserWarning):
     """A value that was read in the unit the input defines but looks like another unit (e.g. a
     plain distance read as metres that looks like millimetres)."""
+
+
+def read_text(path: str | os.PathLike, what: str) -> str:
+    """The text of the file ``path`` (UTF-8; a byte-order mark is dropped).
+
+    Raises
+    ------
+    DataError
+        Naming the file: it cannot be read (the system's reason), or it is not UTF-8 text
+        (``what`` names what it should hold, e.g. ``"a calibration file"``).
+    """
+    p = Path(path)
+    try:
+        return p.read_text(encoding="utf-8-sig")
+    except OSError as e:
+        raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
+    except UnicodeDecodeError:
+        raise DataError(f"{p}: not UTF-8 text; {what} is a text file") from None

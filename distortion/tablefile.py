@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from .curve import ANGLE, HEIGHT, NOMINAL_ANGLE, DistortionCurve
-from .errors import DataError
+from .errors import DataError, read_text
 
 _ALIASES = {
     "alpha": "angle",
@@ -114,12 +114,7 @@ def read_distortion_table(
     """
     where = str(path)
     if text is None:
-        try:
-            text = Path(path).read_text(encoding="utf-8-sig")
-        except OSError as exc:
-            raise DataError(f"{where}: cannot read distortion table ({exc.strerror})") from None
-        except UnicodeDecodeError:
-            raise DataError(f"{where}: not a text file (UTF-8 expected)") from None
+        text = read_text(path, "a distortion table")
     rows: list[tuple[int, list[str]]] = []
     comments: list[str] = []
     for lineno, line in enumerate(text.splitlines(), start=1):

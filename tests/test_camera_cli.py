@@ -958,3 +958,29 @@ def test_the_table_kind_is_found_once_and_before_the_work(tmp_path, monkeypatch)
     rc, _, err = run(["camera", "variation", "no-such-1.yml", "no-such-2.yml", *_VAR[4:], "-o",
                       str(tmp_path / "v.txt")])  # fmt: skip
     assert rc == 2 and "-o " in _one_line(err) and "written as .csv or .json" in err, err
+
+
+def test_a_binary_file_is_refused_in_one_line_by_every_text_reader(tmp_path, monkeypatch):
+    # a --camera spec that is not UTF-8 text was "internal error: UnicodeDecodeError", exit 1;
+    # the API's readers raised the UnicodeDecodeError itself
+    from distortion.camera import read_camera_setup, read_colmap_cameras
+    from distortion.errors import DataError
+    from distortion.tablefile import read_distortion_table
+    from distortion.variation.profiles import read_profiles_csv
+
+    data = b"\x89PNG\r\n\x1a\n\xd0\xff" * 40
+    for name in ("cam.toml", "cal.yml", "cameras.txt", "t.csv"):
+        (tmp_path / name).write_bytes(data)
+    rc, _, err = run(["camera", "cooke-triplet-f4", "--camera", "cam.toml"], tmp_path, monkeypatch)
+    assert rc == 2 and _one_line(err).endswith(
+        "error: cam.toml: not UTF-8 text; a camera spec is a text file"
+    ), err
+    for read, name in (
+        (read_camera_setup, "cam.toml"),
+        (read_calibration, "cal.yml"),
+        (read_colmap_cameras, "cameras.txt"),
+        (read_distortion_table, "t.csv"),
+        (read_profiles_csv, "t.csv"),
+    ):
+        with pytest.raises(DataError, match=rf"{name}: not UTF-8 text; an? [\w .]+ is a text file"):
+            read(tmp_path / name)

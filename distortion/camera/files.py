@@ -48,7 +48,7 @@ import numpy as np
 
 from raytrace.files.output import write_atomic
 
-from ..errors import DataError
+from ..errors import DataError, read_text
 from .convert import smallest_exact
 from .models import OPENCV_ORDERS, CameraModel, NotRepresentable, model_spec
 
@@ -137,10 +137,7 @@ def read_calibration(
     """
     p = Path(path)
     if text is None:
-        try:
-            text = p.read_text(encoding="utf-8-sig")
-        except OSError as e:
-            raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
+        text = read_text(p, "a calibration file")
     fmt = _check_format(format) if format else detect_format(p, text)
     if camera_id is not None and fmt != "colmap":
         raise DataError(
@@ -301,10 +298,7 @@ def read_colmap_cameras(path: str | os.PathLike, *, text: str | None = None) -> 
     """All cameras of a COLMAP ``cameras.txt``: {camera_id: CameraModel}."""
     p = Path(path)
     if text is None:
-        try:
-            text = p.read_text(encoding="utf-8-sig")
-        except OSError as e:
-            raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
+        text = read_text(p, "a COLMAP cameras.txt")
     cams: dict[int, CameraModel] = {}
     for n, line in enumerate(text.splitlines(), start=1):
         s = line.strip()

@@ -67,7 +67,7 @@ from pathlib import Path
 from raytrace.trace.results import object_words
 from raytrace.units import UnitError, image_scale, length_mm, wavelength_nm
 
-from ..errors import DataError
+from ..errors import DataError, read_text
 from .sensor import Sensor
 
 #: chief rays over the sensor (columns, rows) unless a setup says otherwise
@@ -491,10 +491,7 @@ def read_camera_setup(path: str | os.PathLike) -> CameraSetup:
     import tomllib
 
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as e:
-        raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
+    text = read_text(p, "a camera spec")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

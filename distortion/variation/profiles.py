@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from ..coefficients import MAX_RADIUS_RATIO, check_profile_units
-from ..errors import DataError, UnitWarning
+from ..errors import DataError, UnitWarning, read_text
 from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
 from .models import PLAIN_METRES_WARN, WEAK_THRESHOLD_UM, Conjugate
 
@@ -118,12 +118,7 @@ def read_profiles_csv(
         When distances in metres are so large that they look like millimetres.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise DataError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise DataError(f"{path}: not a UTF-8 text file") from None
+    text = read_text(path, "a distortion profile")
     meta: dict[str, str] = {}
     notes: list[str] = []
     header: list[str] | None = None
