@@ -142,10 +142,10 @@ def compare_file(path: Path, extra_fields: int = 3) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         lens = osc.load_lens(path)
+    from optiland_adapter import surface_group
+
     op = _read_optiland(path)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        g = op.surface_group
+    g = surface_group(op)
     out: dict = {"file": str(path.relative_to(ROOT) if path.is_relative_to(ROOT) else path)}
     out["lens"] = lens.name
     out["wavelengths_nm"] = list(lens.wavelengths)

@@ -39,6 +39,13 @@ def available() -> tuple[bool, str]:
         return True, "unknown"
 
 
+def surface_group(op):
+    """The optic's ``SurfaceGroup``: ``op.surfaces`` where it is one, else ``op.surface_group``
+    (the older name, deprecated in optiland 0.6)."""
+    group = getattr(op, "surfaces", None)
+    return group if hasattr(group, "trace") else op.surface_group
+
+
 def build_optic(lens, wavelength_nm: float | None = None):
     """optiland ``Optic`` equivalent to ``lens`` at ``wavelength_nm`` (default the lens's)."""
     from optiland.materials import IdealMaterial
@@ -50,8 +57,17 @@ def build_optic(lens, wavelength_nm: float | None = None):
     wl = lens.wavelength if wavelength_nm is None else wavelength_nm
     p = pack(lens, wl)
     op = Optic()
-    op.add_surface(index=0, thickness=np.inf if not math.isfinite(lens.object_distance)
-                   else lens.object_distance)  # fmt: skip
+    # optiland deprecates Optic.add_surface / add_field / set_field_type / add_wavelength for
+    # op.surfaces.add / op.fields.add / op.fields.set_type / op.wavelengths.add (the old names
+    # warn, and go in 0.7); the old ones serve older versions
+    group, fields = surface_group(op), getattr(op, "fields", None)
+    add_surface = group.add if hasattr(group, "add") else op.add_surface
+    new_fields = hasattr(fields, "add") and hasattr(fields, "set_type")
+    add_field = fields.add if new_fields else op.add_field
+    set_field_type = fields.set_type if new_fields else op.set_field_type
+    add_wavelength = getattr(getattr(op, "wavelengths", None), "add", op.add_wavelength)
+    add_surface(index=0, thickness=np.inf if not math.isfinite(lens.object_distance)
+                else lens.object_distance)  # fmt: skip
     ns = p.n_surfaces
     for j, s in enumerate(lens.surfaces):
         radius = np.inf if s.curvature == 0.0 else 1.0 / s.curvature
@@ -68,19 +84,19 @@ def build_optic(lens, wavelength_nm: float | None = None):
         if any(a != 0.0 for a in s.aspheric):
             kw["surface_type"] = "even_asphere"
             kw["coefficients"] = [0.0, *[float(a) for a in s.aspheric]]
-        op.add_surface(**kw)
-    op.add_surface(index=ns + 1)
+        add_surface(**kw)
+    add_surface(index=ns + 1)
     # optiland's even-asphere Newton stops at |sag residual| < tol, 1e-6 mm by default: image
     # heights then differ by ~5e-7 mm. Tighten it so both programs solve the same intersection.
-    for s in op.surfaces.surfaces:
+    for s in group.surfaces:
         if hasattr(s.geometry, "tol"):
             s.geometry.tol = NEWTON_TOL
     par = paraxial(lens, lens.object_distance, wl)
     op.set_aperture(aperture_type="EPD", value=float(par.epd))
-    op.set_field_type(field_type="angle")
-    op.add_field(y=0.0)
-    op.add_field(y=float(lens.field.value) if lens.field.kind == "angle" else 20.0)
-    op.add_wavelength(value=wl / 1000.0, is_primary=True)
+    set_field_type(field_type="angle")
+    add_field(y=0.0)
+    add_field(y=float(lens.field.value) if lens.field.kind == "angle" else 20.0)
+    add_wavelength(value=wl / 1000.0, is_primary=True)
     return op
 
 
@@ -92,8 +108,7 @@ def trace_bulk(op, x, y, z, L, M, N, wavelength_nm: float):
     n = x.shape[0]
     rays = RealRays(x.copy(), y.copy(), z.copy(), L.copy(), M.copy(), N.copy(),
                     np.ones(n), np.full(n, wavelength_nm / 1000.0))  # fmt: skip
-    group = op.surfaces if hasattr(op.surfaces, "trace") else op.surface_group
-    group.trace(rays, skip=1, record=False)
+    surface_group(op).trace(rays, skip=1, record=False)
     return np.asarray(rays.x), np.asarray(rays.y)
 
 

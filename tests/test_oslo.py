@@ -17,12 +17,12 @@ test is about reading the file and tracing it, not about glass data (tests/test_
 from __future__ import annotations
 
 import math
-import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
+from support import benchmark_module
 
 from raytrace.errors import PrescriptionError
 from raytrace.files.oslo import read_len
@@ -52,7 +52,7 @@ def _theirs(name: str, lens, wavelength: float):
         warnings.simplefilter("ignore")
         op = load_oslo_file(str(LEN_DIR / f"{name}.len"))
     n = lens.indices(wavelength)[0]
-    for i, s in enumerate(op.surface_group.surfaces):
+    for i, s in enumerate(benchmark_module("optiland_adapter").surface_group(op).surfaces):
         s.material_post = IdealMaterial(float(n[min(i, len(n) - 1)]))
     return op
 
@@ -77,7 +77,7 @@ def test_prescription_equals_optilands_reading(name):
     pytest.importorskip("optiland")
     lens = _ours(name)
     op = _theirs(name, lens, lens.wavelength)
-    sg = op.surface_group
+    sg = benchmark_module("optiland_adapter").surface_group(op)
     body = sg.surfaces[1:-1]
     assert len(body) == len(lens.surfaces)
     radii = [float(np.ravel(s.geometry.radius)[0]) for s in body]
@@ -108,8 +108,7 @@ def test_efl_equals_optiland_at_every_wavelength(name):
 def test_chief_rays_equal_optilands(name):
     pytest.importorskip("optiland")
     pytest.importorskip("scipy")
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import referees as R
+    R = benchmark_module("referees")
 
     lens = _ours(name)
     op = _theirs(name, lens, lens.wavelength)
