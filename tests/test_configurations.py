@@ -10,11 +10,11 @@ single-configuration files with operand rows appended (said so in each test).
 from __future__ import annotations
 
 import math
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
-import tomllib
 
 from distortion.variation.focus import (
     focus_configurations,

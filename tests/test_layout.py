@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import ast
 import re
+import tomllib
 from pathlib import Path
 
 import pytest
-import tomllib
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS = {"raytrace": 0, "distortion": 1, "orthoscope": 2}

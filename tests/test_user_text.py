@@ -6,9 +6,9 @@ list. Comments of the files and code are not checked (nobody reads them in a com
 from __future__ import annotations
 
 import re
+import tomllib
 
 import pytest
-import tomllib
 from support import ROOT, run_cli
 
 from orthoscope.cli import COMMANDS, build_parser

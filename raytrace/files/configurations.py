@@ -41,11 +41,10 @@ from __future__ import annotations
 
 import math
 import re
+import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
-
-import tomllib
 
 from ..errors import LensError, PrescriptionError
 from ..lens import Lens

@@ -71,13 +71,13 @@ from __future__ import annotations
 import difflib
 import math
 import re
+import tomllib
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 
 from ..errors import LensError, PrescriptionError
 from ..frames import AFTER_MODES, ORDERS, Placement

@@ -14,10 +14,9 @@ import difflib
 import math
 import numbers
 import re
+import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-
-import tomllib
 
 from ..errors import OrthoscopeError, PrescriptionError
 from ..lens import Lens

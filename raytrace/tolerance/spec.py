@@ -53,11 +53,10 @@ from __future__ import annotations
 import difflib
 import math
 import re
+import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
-
-import tomllib
 
 from ..errors import OrthoscopeError
 
