@@ -7,6 +7,7 @@ import os
 from pathlib import Path
 
 from raytrace.errors import OrthoscopeError
+from raytrace.files.text import read_capped
 
 
 class DataError(OrthoscopeError):
@@ -30,12 +31,13 @@ def read_text(path: str | os.PathLike, what: str) -> str:
     Raises
     ------
     DataError
-        Naming the file: it cannot be read (the system's reason), or it is not UTF-8 text
-        (``what`` names what it should hold, e.g. ``"a calibration file"``).
+        Naming the file: it cannot be read (the system's reason, or larger than
+        :data:`raytrace.files.text.MAX_FILE_BYTES`), or it is not UTF-8 text (``what`` names what
+        it should hold, e.g. ``"a calibration file"``).
     """
     p = Path(path)
     try:
-        return p.read_text(encoding="utf-8-sig")
+        return read_capped(p).decode("utf-8-sig")
     except OSError as e:
         raise DataError(f"{p}: cannot read: {e.strerror or e}") from None
     except UnicodeDecodeError:

@@ -275,3 +275,64 @@ def test_two_threads_trace_at_once():
     assert not errors and len(results) == 10
     for r in results:
         np.testing.assert_array_equal(r.y, ref.y)
+
+
+# ------------------------------------------------------------ files too large or nested too deeply
+def _readers():
+    """(reader, suffix, project error) for every user file the API reads as text."""
+    import orthoscope as osc
+    from distortion.camera import read_calibration, read_camera_setup
+    from distortion.errors import DataError
+    from raytrace.errors import PrescriptionError
+    from raytrace.optimize import SpecError
+    from raytrace.tolerance import ToleranceSpecError
+
+    return [
+        (osc.load_lens, ".toml", PrescriptionError),
+        (osc.read_configurations, ".toml", PrescriptionError),
+        (osc.read_spec, ".toml", SpecError),
+        (osc.read_tolerance_spec, ".toml", ToleranceSpecError),
+        (osc.read_tolerance_spec, ".zmx", ToleranceSpecError),
+        (osc.read_distortion_table, ".csv", DataError),
+        (osc.read_profiles_csv, ".csv", DataError),
+        (read_camera_setup, ".toml", DataError),
+        (read_calibration, ".yml", DataError),
+    ]
+
+
+def test_a_file_too_large_to_read_is_refused_by_every_reader(tmp_path):
+    # /dev/zero, or a video given by mistake, filled the memory: killed, or "internal error:
+    # MemoryError"; only the lens reader had a cap. A sparse file over the cap costs no disk.
+    from raytrace.files.text import MAX_FILE_BYTES
+
+    for read, suffix, error in _readers():
+        big = tmp_path / f"big{suffix}"
+        with open(big, "wb") as fh:
+            fh.truncate(MAX_FILE_BYTES + 1)
+        with pytest.raises(error, match=r"big\.\w+.*larger than 64 MB"):
+            read(big)
+    rc, _, err = run_cli(["camera", "cooke-triplet-f4", "--camera", str(big.with_suffix(".toml"))])
+    assert rc == 2 and err.count("\n") == 1 and "larger than 64 MB" in err, err
+
+
+def test_toml_nested_too_deeply_is_one_error_not_a_recursion_error(tmp_path):
+    # tomllib recurses per nesting level: 5,000 brackets raised RecursionError from read_spec,
+    # read_camera_setup and read_configurations ("internal error" in the CLI)
+    deep = tmp_path / "deep.toml"
+    deep.write_text("a = " + "[" * 5000 + "]" * 5000 + "\n", encoding="utf-8")
+    for read, suffix, error in _readers():
+        if suffix == ".toml":
+            with pytest.raises(error, match="deep.toml"):
+                read(deep)
+    rc, _, err = run_cli(["optimize", str(deep), "-o", str(tmp_path / "o.toml")])
+    assert rc == 2 and err.count("\n") == 1 and "nested too deeply" in err, err
+
+
+def test_configurations_of_an_oslo_file_say_where_configurations_come_from():
+    # an OSLO .len was parsed as TOML: "TOML syntax error: Invalid statement"
+    import orthoscope as osc
+    from raytrace.errors import PrescriptionError
+
+    path = Path(__file__).parent / "data" / "corpus" / "optiland" / "test_cooke_triplet.len"
+    with pytest.raises(PrescriptionError, match=r"OSLO \.len file holds no configurations"):
+        osc.read_configurations(path)

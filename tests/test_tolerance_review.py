@@ -218,6 +218,20 @@ def test_a_folder_with_other_files_and_no_manifest_is_refused_without_force(tmp_
     assert (run / "manifest.json").exists()
 
 
+def test_a_damaged_manifest_is_one_line_naming_it(tmp_path):
+    # deep JSON raised RecursionError, and "done": [1e400] OverflowError ("internal error");
+    # "done": [10**400] reached the file system as a chunk name: "File name too long"
+    spec = ROOT / "lenses" / "tolerances" / "cooke-triplet-f4.toml"
+    run = tmp_path / "mc"
+    argv = [spec, "--samples", "4", "--chunk", "2", "-o", run]
+    assert _cli(*argv)[0] == 0
+    manifest = run / "manifest.json"
+    for text in ("[" * 100000, '{"done": [1e400]}', '{"done": [' + "9" * 400 + "]}"):
+        manifest.write_text(text)
+        line = _one_line_error(*_cli(*argv)[::2])
+        assert f"{manifest}: unreadable run manifest" in line and "--force" in line, line
+
+
 # ------------------------------------------------------------------------------ 8: messages
 def test_overlapping_elements_name_the_spec_and_items(tmp_path):
     p = _spec_file(tmp_path, '{ type = "TEDY", surfaces = [1, 3], limit = 0.02 },\n'

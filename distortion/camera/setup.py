@@ -496,6 +496,8 @@ def read_camera_setup(path: str | os.PathLike) -> CameraSetup:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise DataError(f"{p}: not valid TOML: {e}") from None
+    except RecursionError:
+        raise DataError(f"{p}: nested too deeply to be a camera spec") from None
     return camera_setup_from_dict(doc, str(p))
 
 

@@ -169,7 +169,9 @@ class _Store:
                 if not isinstance(old, dict):
                     raise ValueError("not a JSON object")
                 done = [int(k) for k in old.get("done", [])]
-            except (OSError, ValueError, TypeError) as e:
+                if any(not 0 <= k < 2**31 for k in done):
+                    raise ValueError("a chunk number out of range")
+            except (OSError, ValueError, TypeError, OverflowError, RecursionError) as e:
                 if not overwrite:
                     raise OutputError(
                         f"{self.mpath}: unreadable run manifest ({e}); give a new out_dir, or "

@@ -263,9 +263,11 @@ def _toml_table(path: Path) -> dict | None:
     """The TOML table of the file ``path``, or None when it cannot be read as one."""
     import tomllib
 
+    from raytrace.files.text import read_capped
+
     try:
-        return tomllib.loads(path.read_bytes().decode("utf-8-sig"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return tomllib.loads(read_capped(path).decode("utf-8-sig"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, RecursionError):
         return None
 
 

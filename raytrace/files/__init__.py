@@ -56,7 +56,8 @@ def _sniff(path: str | Path) -> str | None:
     import re
 
     try:
-        raw = Path(path).read_bytes()[:4096]
+        with open(path, "rb") as fh:
+            raw = fh.read(4096)
     except OSError:
         return None
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or raw[1:2] == b"\x00":

@@ -514,6 +514,8 @@ def parse_toml_configurations(
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise _err(f"TOML syntax error: {e}", spath, None) from None
+    except RecursionError:
+        raise _err("the TOML nests too deeply to hold configurations", spath, None) from None
     scale = 1.0
     if "scale_to_efl" in data and data.get("configurations"):
         from .native import efl_scale
@@ -606,7 +608,8 @@ def read_configurations(path: str | Path) -> Configurations:
     path : str or Path
         A lens file path (bundled names: :func:`read_configured`): Zemax ``.zmx`` (``THIC``
         operands of the multi-configuration editor), CODE V ``.seq`` (``ZOO THI``), anything else
-        native TOML (``[[configurations]]``). Lengths in the file's unit, returned in mm (a
+        but an OSLO ``.len`` (refused: it holds none that are read) native TOML
+        (``[[configurations]]``). Lengths in the file's unit, returned in mm (a
         TOML file's ``scale_to_efl`` scales them with the lens).
 
     Returns
@@ -619,6 +622,14 @@ def read_configurations(path: str | Path) -> Configurations:
         Naming the file and line, for a missing or unreadable file and every problem in it.
     """
     suffix = Path(path).suffix.lower()
+    if suffix == ".len":
+        raise _err(
+            "an OSLO .len file holds no configurations orthoscope reads: they come from a .zmx "
+            "(THIC in the multi-configuration editor), a .seq (ZOO THI) or a TOML lens "
+            "([[configurations]])",
+            str(path),
+            None,
+        )
     kind = {".zmx": "zmx", ".seq": "seq"}.get(suffix, "toml")
     return parse_configurations(read_bytes(path), kind=kind, path=path)
 

@@ -5,6 +5,7 @@ and skipped-command warnings."""
 from __future__ import annotations
 
 import codecs
+import errno
 import math
 import re
 import warnings
@@ -95,23 +96,31 @@ def decode_text(raw: bytes, path: str | None, what: str, *, latin1: bool = True)
 MAX_FILE_BYTES = 64 * 1024 * 1024
 
 
+def read_capped(path: str | Path, limit: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of a file (or a pipe) that holds at most ``limit`` bytes (default
+    :data:`MAX_FILE_BYTES`). A larger one raises ``OSError(errno.EFBIG, ...)``, so that every
+    reader's ``OSError`` branch names it (``/dev/zero`` or a video given by mistake would
+    otherwise fill the memory)."""
+    with open(path, "rb") as fh:
+        data = fh.read(limit + 1)
+    if len(data) > limit:
+        raise OSError(errno.EFBIG, f"larger than {limit // (1024 * 1024)} MB, too large to read")
+    return data
+
+
 def read_bytes(path: str | Path) -> bytes:
-    """Read a file (or a pipe), turning OS errors into PrescriptionError; a file larger than
-    :data:`MAX_FILE_BYTES` is refused."""
+    """Read a lens file (or a pipe) with :func:`read_capped`, turning OS errors into
+    PrescriptionError."""
     p = Path(path)
     try:
-        with open(p, "rb") as fh:
-            data = fh.read(MAX_FILE_BYTES + 1)
-        if len(data) > MAX_FILE_BYTES:
-            raise PrescriptionError(
-                f"larger than {MAX_FILE_BYTES // (1024 * 1024)} MB: not a lens file", path=str(p)
-            )
-        return data
+        return read_capped(p)
     except FileNotFoundError:
         raise PrescriptionError("no such file", path=str(p)) from None
     except IsADirectoryError:
         raise PrescriptionError("is a directory, not a lens file", path=str(p)) from None
     except OSError as e:
+        if e.errno == errno.EFBIG:
+            raise PrescriptionError(f"{e.strerror}: not a lens file", path=str(p)) from None
         raise PrescriptionError(f"cannot read: {e.strerror}", path=str(p)) from None
 
 

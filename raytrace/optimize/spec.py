@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ..errors import OrthoscopeError, PrescriptionError
+from ..files.text import read_capped
 from ..lens import Lens
 from ..units import is_whole
 
@@ -695,7 +696,7 @@ def read_spec(path: str | Path) -> DesignSpec:
     """
     p = resolve_spec_path(path)
     try:
-        raw = p.read_bytes()
+        raw = read_capped(p)
         d = tomllib.loads(raw.decode("utf-8-sig"))  # a byte-order mark is no error
     except FileNotFoundError:
         raise SpecError(f"{p}: no such spec file") from None
@@ -707,6 +708,8 @@ def read_spec(path: str | Path) -> DesignSpec:
         raise SpecError(f"{p}: not a UTF-8 text file") from None
     except tomllib.TOMLDecodeError as e:
         raise SpecError(f"{p}: {e}") from None
+    except RecursionError:
+        raise SpecError(f"{p}: nested too deeply to be a spec") from None
     probs = _Problems(str(p))
     probs.unknown_keys(d, TOP_KEYS, "top level")
     if "start" not in d or not isinstance(d["start"], str):

@@ -59,6 +59,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import OrthoscopeError
+from ..files.text import read_capped
 
 #: the item types and the kind of target they take
 SURFACE_TYPES = ("TRAD", "TCUR", "TFRN", "TTHI", "TCON", "TASP", "TSDX", "TSDY", "TSTX", "TSTY",
@@ -528,7 +529,7 @@ def read_tolerance_spec(path: str | Path) -> ToleranceSpec:
 
         return read_zmx_tolerances(p)
     try:
-        raw = p.read_bytes()
+        raw = read_capped(p)
     except FileNotFoundError:
         raise ToleranceSpecError(f"{p}: no such tolerance spec; check the path") from None
     except IsADirectoryError:

@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..files.text import read_capped
 from .spec import (
     DEFAULT_SIGMA,
     DEFAULT_TEST_WAVELENGTH,
@@ -56,7 +57,7 @@ class ZemaxTolerances:
 
 def _text(path: Path) -> str:
     try:
-        raw = path.read_bytes()
+        raw = read_capped(path)
     except FileNotFoundError:
         raise ToleranceSpecError(f"{path}: no such file; check the path") from None
     except OSError as e:
