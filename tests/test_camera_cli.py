@@ -877,17 +877,20 @@ def test_camera_id_reaches_the_colmap_file_of_two(tmp_path, monkeypatch):
 
 
 def _count_reads(monkeypatch) -> list[str]:
-    """The names of the files ``Path.read_text`` reads from now on (in order, appended)."""
+    """The names of the files the data-file reader of distortion/ (``distortion.errors.read_text``,
+    through ``read_capped``) reads from now on (in order, appended)."""
     from pathlib import Path
 
+    import distortion.errors
+
     reads = []
-    read_text = Path.read_text
+    read_capped = distortion.errors.read_capped
 
-    def counted(self, *args, **kw):
-        reads.append(self.name)
-        return read_text(self, *args, **kw)
+    def counted(path, *args, **kw):
+        reads.append(Path(path).name)
+        return read_capped(path, *args, **kw)
 
-    monkeypatch.setattr(Path, "read_text", counted)
+    monkeypatch.setattr(distortion.errors, "read_capped", counted)
     return reads
 
 

@@ -54,9 +54,6 @@ def read_calibrations(args, *paths):
 
     read = [_input_format(p) for p in paths]
     fmts = [f for f, _ in read]
-    for p, f in zip(paths, fmts, strict=True):
-        if f is None:  # read_calibration says why it cannot be read
-            read_calibration(p)
     if "--camera-id" in given_flags(args) and "colmap" not in fmts:
         what = " and ".join(f"{p} is {f}" for p, f in zip(paths, fmts, strict=True))
         raise CliError(
@@ -68,14 +65,12 @@ def read_calibrations(args, *paths):
     ]
 
 
-def _input_format(path: str) -> tuple[str, str] | tuple[None, None]:
+def _input_format(path: str) -> tuple[str, str]:
     """The format of the calibration file ``path`` as read_calibration tells it (its name,
     and the text of a .txt / .xml), and its text; a CliError for a name that tells none (no
-    flag gives the format of an input); (None, None) for a file that cannot be read as text."""
-    from pathlib import Path
-
+    flag gives the format of an input), a DataError for a file that cannot be read as text."""
     from distortion.camera.files import detect_format
-    from distortion.errors import DataError
+    from distortion.errors import DataError, read_text
 
     try:
         detect_format(path)
@@ -84,12 +79,7 @@ def _input_format(path: str) -> tuple[str, str] | tuple[None, None]:
             f"{path}: the name does not tell the calibration format; a calibration file ends "
             f"in {CALIBRATION_NAMES}"
         ) from None
-    try:
-        text = Path(path).read_text(encoding="utf-8-sig")
-    except OSError:
-        return None, None
-    except UnicodeError:
-        raise CliError(f"{path}: not a text file; a calibration file is text") from None
+    text = read_text(path, "a calibration file")
     return detect_format(path, text), text
 
 
