@@ -267,3 +267,150 @@ def test_files_cv2_writes_in_other_forms_are_read(tmp_path, suffix, names):
     got = cam.as_dict()
     assert (got["fx"], got["fy"], got["cx"], got["cy"]) == (6000.0, 6000.0, 1499.5, 999.5)
     assert [got[n] for n in ("k1", "k2", "p1", "p2", "k3")] == [-0.1, 0.01, 0.001, -0.002, 0.0]
+
+
+# ---- bad input: one DataError naming the file (and the line where the format has lines) ----
+#: cv2.FileStorage's XML layout of an OpenCV calibration (``<opencv_storage>``)
+_CV_XML = (
+    '<?xml version="1.0"?>\n<opencv_storage>\n'
+    f"<image_width>{W}</image_width>\n<image_height>{H}</image_height>\n"
+    '<camera_matrix type_id="opencv-matrix"><rows>3</rows><cols>3</cols><dt>d</dt>'
+    "<data>3210.25 0 1523.4 0 3190.5 987.6 0 0 1</data></camera_matrix>\n"
+    '<distortion_coefficients type_id="opencv-matrix"><rows>1</rows><cols>5</cols><dt>d</dt>'
+    "<data>-0.1 0.01 0.001 -0.002 0</data></distortion_coefficients>\n</opencv_storage>\n"
+)
+
+
+def _bad_file(tmp_path, name, old, new):
+    """A good calibration file ``name`` (its format from the suffix; ``cv.xml``: cv2's XML)
+    with the text ``old`` replaced by ``new`` (``old`` must be in it)."""
+    path = tmp_path / name
+    if name == "cv.xml":
+        text = _CV_XML
+    else:
+        cam = {".aus": australis_camera(), ".xml": metashape_camera()}.get(path.suffix, _opencv(5))
+        text = format_calibration(cam, FORMATS_BY_SUFFIX[path.suffix])
+    assert old in text, (old, text)
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+FORMATS_BY_SUFFIX = {".yml": "opencv-yaml", ".json": "opencv-json", ".xml": "metashape"}
+FORMATS_BY_SUFFIX[".aus"] = "australis"
+
+
+def test_deeply_nested_json_is_a_data_error(tmp_path):
+    """json.loads raised a raw RecursionError on 100,000 '[' (an internal error at the CLI)."""
+    (tmp_path / "deep.json").write_text("[" * 100_000 + "\n")
+    with pytest.raises(DataError, match=r"deep.json: JSON nested too deeply"):
+        read_calibration(tmp_path / "deep.json")
+    (tmp_path / "deep.yml").write_text("[" * 100_000 + "\n")  # the echoed line is cut short
+    with pytest.raises(DataError, match=r"deep.yml:1: expected 'key: value'") as e:
+        read_calibration(tmp_path / "deep.yml")
+    assert len(str(e.value)) < 200
+
+
+@pytest.mark.parametrize(
+    "name,old,new,msg",
+    [
+        # 1e400 is an infinity: int() raised a raw OverflowError
+        (
+            "c.yml",
+            f"image_width: {W}",
+            "image_width: 1e400",
+            r"c.yml:3: image_width must be a whole",
+        ),
+        ("c.json", f'"image_width": {W}', '"image_width": 1e400', r"c.json: image_width must be"),
+        ("cv.xml", f"<image_width>{W}<", "<image_width>1e400<", r"cv.xml: image_width must be"),
+        # a fraction was cut to an int: 3000.5 read as 3000
+        ("c.yml", f"image_width: {W}", "image_width: 3000.5", r"whole number of pixels.*'3000.5'"),
+        ("c.json", f'"image_height": {H}', '"image_height": 1999.5', r"image_height must be a who"),
+        ("m.xml", f"<width>{W}<", "<width>3000.5<", r"m.xml: <width> must be a whole number"),
+        ("a.aus", f"image_width {W}", "image_width 3000.5", r"a.aus:8: image_width must be a who"),
+        ("c.json", f'"image_width": {W}', '"image_width": true', r"image_width must be a whole"),
+    ],
+)
+def test_whole_number_fields_refuse_infinities_and_fractions(tmp_path, name, old, new, msg):
+    with pytest.raises(DataError, match=msg):
+        read_calibration(_bad_file(tmp_path, name, old, new))
+
+
+@pytest.mark.parametrize(
+    "name,old,new,msg",
+    [
+        ("c.json", '"data": [\n            3210.25', '"data": "abc", "x": [3210.25', r"flat list"),
+        ("c.json", "3210.25,", "[3210.25, 1],", r"c.json: camera_matrix data must be a flat list"),
+        ("c.json", '"rows": 3', '"rows": 1e400', r"c.json: camera_matrix rows must be a whole"),
+        ("c.yml", "rows: 3", "rows: .inf", r"c.yml:5: camera_matrix rows must be a whole number"),
+        ("c.yml", "rows: 3\n   cols: 3", "rows: -3\n   cols: -3", r"c.yml:5: camera_matrix rows"),
+        ("c.yml", "data: [", "data: 1, 2 ]\n   x: [", r"c.yml:9: matrix data must be a list"),
+    ],
+)
+def test_malformed_opencv_matrices_are_data_errors(tmp_path, name, old, new, msg):
+    """np.asarray / int() on a matrix raised a raw ValueError / OverflowError."""
+    with pytest.raises(DataError, match=msg):
+        read_calibration(_bad_file(tmp_path, name, old, new))
+
+
+@pytest.mark.parametrize(
+    "name,old,new,msg",
+    [
+        ("c.yml", f"image_width: {W}", "image_width: -3000", r":3: image_width must be a whole"),
+        ("c.yml", "data: [ 3210.25", "data: [ 0.0", r":5: camera_matrix fx = \[0\]\[0\] and fy"),
+        ("c.json", "3210.25,", "1e999,", r"camera_matrix data must be a flat list of finite"),
+        ("m.xml", "<f>3200.0<", "<f>inf<", r"<f> is not a finite number: 'inf'"),
+        ("m.xml", "<f>3200.0<", "<f>-1<", r"camera model metashape: f must be positive"),
+        ("m.xml", f"<width>{W}<", "<width>-3000<", r"<width> must be a whole number"),
+        ("a.aus", "pixel_width_mm 0.0078", "pixel_width_mm 0", r":10: pixel_width_mm must be"),
+        ("a.aus", "c 25.0", "c 0", r":12: c \(the principal distance, mm\) must be positive"),
+        ("a.aus", "K1 8e-05", "K1 inf", r":15: K1 is not a finite number"),
+    ],
+)
+def test_camera_model_checks_name_the_file(tmp_path, name, old, new, msg):
+    """The model's own checks were raised as 'camera model opencv: fx must be positive' with
+    no file; now every message starts with the file (and its line where the format has lines)."""
+    path = _bad_file(tmp_path, name, old, new)
+    with pytest.raises(DataError, match=msg) as e:
+        read_calibration(path)
+    assert str(e.value).startswith(f"{path}")
+
+
+@pytest.mark.parametrize(
+    "name,old,new,msg",
+    [
+        (
+            "c.yml",
+            f"image_width: {W}\n",
+            f"image_width: {W}\nimage_width: 10\n",
+            r"c.yml:4: 'image_wid",
+        ),
+        ("c.yml", "   cols: 3\n", "   cols: 3\n   cols: 3\n", r"c.yml:8: 'cols' appears twice"),
+        ("c.json", f'"image_width": {W},', f'"image_width": {W}, "image_width": 10,', r"twice"),
+        ("cv.xml", "<image_height>", "<image_width>10</image_width><image_height>", r"<image_wid"),
+        ("a.aus", "c 25.0\n", "c 25.0\nC 26\n", r"a.aus:13: C appears twice \(first on line 12\)"),
+    ],
+)
+def test_a_key_given_twice_is_refused(tmp_path, name, old, new, msg):
+    """The last of two values was silently taken."""
+    with pytest.raises(DataError, match=msg):
+        read_calibration(_bad_file(tmp_path, name, old, new))
+
+
+def test_australis_format_version_is_checked(tmp_path):
+    for head, msg in (
+        (
+            "format orthoscope-australis 99",
+            r":7: .*version '99' is unknown; this reader reads vers",
+        ),
+        ("format orthoscope-australis", r":7: .* has no version; this reader reads version 1"),
+    ):
+        path = _bad_file(tmp_path, "a.aus", "format orthoscope-australis 1", head)
+        with pytest.raises(DataError, match=msg):
+            read_calibration(path)
+
+
+def test_a_file_not_utf8_is_named_so(tmp_path):
+    """Regression pin (distortion.errors.read_text gave this wording already)."""
+    (tmp_path / "latin.yml").write_bytes("%YAML:1.0\n# café\nimage_width: 3000\n".encode("latin-1"))
+    with pytest.raises(DataError, match=r"latin.yml: not UTF-8 text; a calibration file"):
+        read_calibration(tmp_path / "latin.yml")

@@ -14,6 +14,8 @@ Formats (``format=`` names; inferred from the file name when left out):
     a nonzero camera_matrix[0][1] is refused (``cv2.projectPoints`` ignores that element).
     Read also: the tutorials' key names ``cameraMatrix`` / ``distCoeffs`` (and ``K`` / ``D``),
     and the same layout in ``cv2.FileStorage``'s XML (``<opencv_storage>``, a ``.xml`` file).
+    A key given twice, and an image size or matrix rows/cols that is not a whole number, are
+    refused (not cut to an int, not the last value silently).
 ``colmap`` (``cameras.txt``)
     COLMAP's text format: ``CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]``, one camera a line, ``#``
     comments; parameters in COLMAP's order (pixel centres at +0.5).
@@ -30,15 +32,16 @@ Formats (``format=`` names; inferred from the file name when left out):
     are Metashape's. (That assumption is not checked against a PhotoScan installation.)
 ``australis`` (``.txt`` starting with ``format orthoscope-australis``, or ``.aus``)
     Defined here (Australis' own files are not documented publicly): ``#`` comments, then
-    ``name value`` lines: ``format orthoscope-australis 1``, ``image_width``,
-    ``image_height`` (px), ``pixel_width_mm``, ``pixel_height_mm``, and the model's parameters
-    ``c xp yp K1 K2 K3 P1 P2 b1 b2`` (mm and mm⁻²ⁱ; image coordinates x right, y up, origin at
-    the image centre; a correction measured → ideal, Fraser 1997).
+    ``name value`` lines: ``format orthoscope-australis 1`` (another version is refused),
+    ``image_width``, ``image_height`` (px), ``pixel_width_mm``, ``pixel_height_mm``, and the
+    model's parameters ``c xp yp K1 K2 K3 P1 P2 b1 b2`` (mm and mm⁻²ⁱ; image coordinates x
+    right, y up, origin at the image centre; a correction measured → ideal, Fraser 1997).
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import xml.etree.ElementTree as ET
@@ -54,6 +57,43 @@ from .models import OPENCV_ORDERS, CameraModel, NotRepresentable, model_spec
 
 FORMATS = ("opencv-yaml", "opencv-json", "colmap", "metashape", "photoscan", "australis")
 _AUS_MAGIC = "orthoscope-australis"
+_AUS_VERSIONS = ("1",)  # the versions of the Australis-style text this reader knows
+
+
+def _show(value, n: int = 40) -> str:
+    """``value`` quoted for a message, cut to ``n`` characters (a file's text may be huge)."""
+    t = str(value)
+    return repr(t) if len(t) <= n else repr(t[:n]) + "…"
+
+
+def _whole(value, what: str, where: str, unit: str = "", least: int = 1) -> int:
+    """``value`` (a number or its text, as a file holds it) as a whole number, ``least`` or
+    more; a DataError at ``where`` (the file, and its line where known) naming ``what``
+    otherwise: a fraction, an infinity, a NaN or a true/false is not silently cut to an int."""
+    v = value.strip() if isinstance(value, str) else value
+    if isinstance(v, str):
+        try:
+            v = int(v)
+        except ValueError:
+            try:
+                v = float(v)
+            except ValueError:
+                pass
+    if isinstance(v, float) and math.isfinite(v) and v.is_integer():
+        v = int(v)
+    if not isinstance(v, int) or isinstance(v, bool) or v < least:
+        raise DataError(
+            f"{where}: {what} must be a whole number{unit}, {least} or more; got {_show(value)}"
+        )
+    return v
+
+
+def _create(where: str, model: str, width: int, height: int, **kw) -> CameraModel:
+    """CameraModel.create, its DataError prefixed with ``where`` (the file, and a line)."""
+    try:
+        return CameraModel.create(model, width, height, **kw)
+    except DataError as e:
+        raise DataError(f"{where}: {e}") from None
 
 
 def _fmt(v: float) -> str:
@@ -145,13 +185,30 @@ def read_calibration(
             f"is {fmt}: leave out camera_id"
         )
     if fmt == "opencv-yaml":
-        return _opencv_from_nodes(_parse_opencv_yaml(text, p), p)
+        return _opencv_from_nodes(*_parse_opencv_yaml(text, p), p)
     if fmt == "opencv-json":
+
+        def no_twice(pairs):
+            out = {}
+            for k, v in pairs:
+                if k in out:
+                    raise DataError(f"{p}: key {_show(k)} appears twice; keep one")
+                out[k] = v
+            return out
+
         try:
-            nodes = json.loads(text)
+            nodes = json.loads(text, object_pairs_hook=no_twice)
         except json.JSONDecodeError as e:
             raise DataError(f"{p}:{e.lineno}: not valid JSON: {e.msg}") from None
-        return _opencv_from_nodes(nodes, p)
+        except RecursionError:
+            raise DataError(
+                f"{p}: JSON nested too deeply; an OpenCV calibration is one mapping of keys"
+            ) from None
+        except ValueError:  # an integer of more digits than Python converts to an int
+            raise DataError(
+                f"{p}: holds an integer thousands of digits long; no calibration value is that long"
+            ) from None
+        return _opencv_from_nodes(nodes, {}, p)
     if fmt == "colmap":
         cams = read_colmap_cameras(p, text=text)
         if camera_id is None:
@@ -183,11 +240,19 @@ def _scalar(text: str):
         return t
 
 
-def _parse_opencv_yaml(text: str, path: Path) -> dict:
+def _parse_opencv_yaml(text: str, path: Path) -> tuple[dict, dict]:
     """The subset of YAML that ``cv2.FileStorage`` writes: top-level scalars and
-    ``!!opencv-matrix`` blocks (rows, cols, dt, data: [ … ] over one or more lines)."""
+    ``!!opencv-matrix`` blocks (rows, cols, dt, data: [ … ] over one or more lines). Returns
+    the nodes and {top-level key: its line}; a key given twice is refused."""
     lines = text.splitlines()
     out: dict = {}
+    where: dict[str, int] = {}
+
+    def once(seen: dict, key: str, n: int, at: dict | None = None) -> None:
+        if key in seen:
+            first = f" (first on line {at[key]})" if at and key in at else ""
+            raise DataError(f"{path}:{n}: {_show(key)} appears twice{first}; keep one")
+
     i = 0
     while i < len(lines):
         raw = lines[i]
@@ -196,18 +261,24 @@ def _parse_opencv_yaml(text: str, path: Path) -> dict:
             i += 1
             continue
         if raw[0].isspace():
-            raise DataError(f"{path}:{i + 1}: unexpected indented line {s!r}")
+            raise DataError(f"{path}:{i + 1}: unexpected indented line {_show(s)}")
         key, sep, rest = s.partition(":")
         if not sep:
-            raise DataError(f"{path}:{i + 1}: expected 'key: value', got {s!r}")
-        rest = rest.strip()
+            raise DataError(f"{path}:{i + 1}: expected 'key: value', got {_show(s)}")
+        key, rest = key.strip(), rest.strip()
+        once(out, key, i + 1, where)
+        where[key] = i + 1
         if rest.startswith("!!opencv-matrix"):
-            node: dict = {"type_id": "opencv-matrix"}
+            node: dict = {}
             start = i + 1
             i += 1
             while i < len(lines) and (not lines[i].strip() or lines[i][0].isspace()):
                 k2, _, v2 = lines[i].strip().partition(":")
+                if k2:
+                    once(node, k2, i + 1)
                 if k2 == "data":
+                    if not v2.strip().startswith("["):
+                        raise DataError(f"{path}:{i + 1}: matrix data must be a list [ … ]")
                     buf = v2
                     while "]" not in buf:
                         i += 1
@@ -222,11 +293,12 @@ def _parse_opencv_yaml(text: str, path: Path) -> dict:
                 elif k2:
                     node[k2] = _scalar(v2)
                 i += 1
-            out[key.strip()] = node
+            node["type_id"] = "opencv-matrix"
+            out[key] = node
         else:
-            out[key.strip()] = _scalar(rest)
+            out[key] = _scalar(rest)
             i += 1
-    return out
+    return out, where
 
 
 #: other names of the two matrices in files written by OpenCV's samples and tutorials
@@ -236,61 +308,95 @@ _MATRIX_NAMES = {
 }
 
 
-def _matrix(nodes: dict, key: str, path: Path) -> np.ndarray:
-    node = next((nodes[k] for k in (key, *_MATRIX_NAMES.get(key, ())) if k in nodes), None)
-    if node is None:
+def _matrix(nodes: dict, key: str, path: Path, lines: dict) -> tuple[np.ndarray, str]:
+    """The matrix ``key`` (or an other name of it) as rows × cols, and where it is in the file
+    (the file, and its line where the format has lines)."""
+    name = next((k for k in (key, *_MATRIX_NAMES.get(key, ())) if k in nodes), None)
+    if name is None:
         raise DataError(
             f"{path}: no {key!r}; an OpenCV calibration has camera_matrix and "
             "distortion_coefficients"
         )
+    node, at = nodes[name], f"{path}:{lines[name]}" if name in lines else str(path)
     if not isinstance(node, dict) or "data" not in node:
-        raise DataError(f"{path}: {key} is not an opencv-matrix (rows, cols, dt, data)")
-    data = np.asarray(node["data"], dtype=float)
-    rows, cols = int(node.get("rows", 1)), int(node.get("cols", data.size))
+        raise DataError(f"{at}: {name} is not an opencv-matrix (rows, cols, dt, data)")
+    raw = node["data"]
+    try:
+        if not isinstance(raw, list) or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in raw
+        ):
+            raise TypeError
+        data = np.asarray(raw, dtype=float)
+        if not np.isfinite(data).all():
+            raise ValueError
+    except (TypeError, ValueError, OverflowError):
+        raise DataError(
+            f"{at}: {name} data must be a flat list of finite numbers [ a, b, … ]"
+        ) from None
+    rows = _whole(node.get("rows", 1), f"{name} rows", at, least=0)
+    cols = _whole(node.get("cols", data.size), f"{name} cols", at, least=0)
     if rows * cols != data.size:
-        raise DataError(f"{path}: {key} says {rows}x{cols} but holds {data.size} numbers")
-    return data.reshape(rows, cols)
+        raise DataError(f"{at}: {name} says {rows}x{cols} but holds {data.size} numbers")
+    return data.reshape(rows, cols), at
 
 
-def _opencv_from_nodes(nodes: dict, path: Path) -> CameraModel:
+def _opencv_from_nodes(nodes: dict, lines: dict, path: Path) -> CameraModel:
+    """A camera from the nodes of an OpenCV file; ``lines``: {key: its line} where the
+    format has lines (YAML), for the messages."""
     if not isinstance(nodes, dict):
         raise DataError(f"{path}: not an OpenCV calibration (expected a mapping of keys)")
-    k = _matrix(nodes, "camera_matrix", path)
-    d = _matrix(nodes, "distortion_coefficients", path).ravel()
+    k, at_k = _matrix(nodes, "camera_matrix", path, lines)
+    d, at_d = _matrix(nodes, "distortion_coefficients", path, lines)
+    d = d.ravel()
     if k.shape != (3, 3):
-        raise DataError(f"{path}: camera_matrix must be 3x3, got {k.shape[0]}x{k.shape[1]}")
-    try:
-        w, h = int(nodes["image_width"]), int(nodes["image_height"])
-    except (KeyError, TypeError, ValueError):
-        raise DataError(f"{path}: give image_width and image_height (pixels)") from None
+        raise DataError(f"{at_k}: camera_matrix must be 3x3, got {k.shape[0]}x{k.shape[1]}")
+    if "image_width" not in nodes or "image_height" not in nodes:
+        raise DataError(f"{path}: give image_width and image_height (pixels)")
+    w, h = (
+        _whole(nodes[n], n, f"{path}:{lines[n]}" if n in lines else str(path), " of pixels")
+        for n in ("image_width", "image_height")
+    )
+    if not (k[0, 0] > 0 and k[1, 1] > 0):
+        raise DataError(
+            f"{at_k}: camera_matrix fx = [0][0] and fy = [1][1] (the focal lengths, pixels) "
+            f"must be positive, got fx = {k[0, 0]:g}, fy = {k[1, 1]:g}"
+        )
     fx, skew = k[0, 0], k[0, 1]
     pinhole = {"fx": fx, "fy": k[1, 1], "cx": k[0, 2], "cy": k[1, 2]}
-    kind = str(nodes.get("distortion_model", "")).lower()
+    kind = nodes.get("distortion_model", "")
+    at_m = f"{path}:{lines['distortion_model']}" if "distortion_model" in lines else str(path)
+    if not isinstance(kind, str):
+        raise DataError(
+            f"{at_m}: distortion_model must be a name (opencv or fisheye), got a "
+            f"{type(kind).__name__}"
+        )
+    kind = kind.lower()
     if kind in ("fisheye", "equidistant", "kannala_brandt", "opencv_fisheye"):
         if d.size != 4:
-            raise DataError(f"{path}: a fisheye model has 4 coefficients k1..k4, got {d.size}")
-        return CameraModel.create(
+            raise DataError(f"{at_d}: a fisheye model has 4 coefficients k1..k4, got {d.size}")
+        return _create(
+            str(path),
             "opencv_fisheye",
             w,
             h,
             **pinhole,
-            alpha=skew / fx,
+            alpha=float(skew) / float(fx),  # a Python float: an overflow is inf, no warning
             k1=d[0],
             k2=d[1],
             k3=d[2],
             k4=d[3],
         )
     if kind not in ("", "opencv", "plumb_bob", "rational_polynomial", "standard"):
-        raise DataError(f"{path}: unknown distortion_model {kind!r} (opencv or fisheye)")
+        raise DataError(f"{at_m}: unknown distortion_model {_show(kind)} (opencv or fisheye)")
     if skew != 0:
         raise DataError(
-            f"{path}: camera_matrix[0][1] = {skew:g} (skew); cv2.projectPoints ignores it and the "
+            f"{at_k}: camera_matrix[0][1] = {skew:g} (skew); cv2.projectPoints ignores it and the "
             "OpenCV standard model has none — set it to 0 or use a Metashape model (b2)"
         )
     if d.size not in OPENCV_ORDERS:
-        raise DataError(f"{path}: {d.size} distortion coefficients; OpenCV takes 4, 5, 8, 12 or 14")
-    return CameraModel.create(
-        "opencv", w, h, **pinhole, **dict(zip(OPENCV_ORDERS[d.size], d, strict=True))
+        raise DataError(f"{at_d}: {d.size} distortion coefficients; OpenCV takes 4, 5, 8, 12 or 14")
+    return _create(
+        str(path), "opencv", w, h, **pinhole, **dict(zip(OPENCV_ORDERS[d.size], d, strict=True))
     )
 
 
@@ -341,9 +447,12 @@ def _xml_number(el: ET.Element, tag: str, path: Path, default: float | None = 0.
             raise DataError(f"{path}: <calibration> has no <{tag}>")
         return default
     try:
-        return float(child.text)
+        v = float(child.text)
     except ValueError:
-        raise DataError(f"{path}: <{tag}> is not a number: {child.text!r}") from None
+        raise DataError(f"{path}: <{tag}> is not a number: {_show(child.text)}") from None
+    if not math.isfinite(v):
+        raise DataError(f"{path}: <{tag}> is not a finite number: {_show(child.text.strip())}")
+    return v
 
 
 def _storage_nodes(root, path: Path) -> dict:
@@ -351,16 +460,19 @@ def _storage_nodes(root, path: Path) -> dict:
     ``<cols>``, ``<data>``) as a dict, a scalar as its value."""
     out: dict = {}
     for child in root:
+        if child.tag in out:
+            raise DataError(f"{path}: <{child.tag[:40]}> appears twice; keep one")
         if child.find("data") is not None:
             try:
                 data = [float(v) for v in (child.findtext("data") or "").split()]
-                out[child.tag] = {
-                    "rows": int(child.findtext("rows") or 1),
-                    "cols": int(child.findtext("cols") or len(data)),
-                    "data": data,
-                }
             except ValueError:
-                raise DataError(f"{path}: <{child.tag}> holds something not a number") from None
+                raise DataError(
+                    f"{path}: <{child.tag[:40]}> holds something not a number"
+                ) from None
+            out[child.tag] = {"data": data}
+            for n in ("rows", "cols"):  # as the file has them: _matrix reads them
+                if child.findtext(n) is not None:
+                    out[child.tag][n] = child.findtext(n)
         else:
             out[child.tag] = _scalar(child.text or "")
     return out
@@ -372,7 +484,7 @@ def _read_metashape(text: str, path: Path) -> CameraModel:
     except ET.ParseError as e:
         raise DataError(f"{path}:{e.position[0]}: not valid XML: {e}") from None
     if root.tag == "opencv_storage":  # cv2.FileStorage's XML: the nodes of its YAML
-        return _opencv_from_nodes(_storage_nodes(root, path), path)
+        return _opencv_from_nodes(_storage_nodes(root, path), {}, path)
     cals = [root] if root.tag == "calibration" else list(root.iter("calibration"))
     if not cals:
         raise DataError(f"{path}: no <calibration> element")
@@ -381,23 +493,23 @@ def _read_metashape(text: str, path: Path) -> CameraModel:
     proj = (cal.findtext("projection") or cal.get("type") or "frame").strip()
     if proj != "frame":
         raise DataError(
-            f"{path}: Metashape projection {proj!r} is not supported; only frame cameras"
+            f"{path}: Metashape projection {_show(proj)} is not supported; only frame cameras"
         )
-    w = cal.findtext("width")
-    h = cal.findtext("height")
+    w, h, tags = cal.findtext("width"), cal.findtext("height"), ("<width>", "<height>")
     if w is None or h is None:
         res = cal.find("resolution")
         if res is not None:
             w, h = res.get("width"), res.get("height")
-    try:
-        w, h = int(w), int(h)
-    except (TypeError, ValueError):
-        raise DataError(f"{path}: the calibration needs the image <width> and <height>") from None
+            tags = ("<resolution width>", "<resolution height>")
+    if w is None or h is None:
+        raise DataError(f"{path}: the calibration needs the image <width> and <height>")
+    w, h = (_whole(v, t, str(path), " of pixels") for v, t in zip((w, h), tags, strict=True))
     co = {t: _xml_number(cal, t, path) for t in ("k1", "k2", "k3", "k4", "p1", "p2", "p3", "p4")}
     if cal.find("fx") is not None and cal.find("f") is None:  # PhotoScan (older) layout
         fx = _xml_number(cal, "fx", path, None)
         fy = _xml_number(cal, "fy", path, None)
-        return CameraModel.create(
+        return _create(
+            str(path),
             "metashape",
             w,
             h,
@@ -408,7 +520,8 @@ def _read_metashape(text: str, path: Path) -> CameraModel:
             cy=_xml_number(cal, "cy", path, None) - h / 2.0,
             **co,
         )
-    return CameraModel.create(
+    return _create(
+        str(path),
         "metashape",
         w,
         h,
@@ -424,7 +537,8 @@ def _read_metashape(text: str, path: Path) -> CameraModel:
 def _read_australis(text: str, path: Path) -> CameraModel:
     spec = model_spec("australis")
     vals: dict[str, float] = {}
-    meta: dict[str, str] = {}
+    meta: dict[str, int | float] = {}
+    at: dict[str, int] = {}  # name: its line
     lower = {n.lower(): n for n in spec.params}
     for n, line in enumerate(text.splitlines(), start=1):
         s = line.split("#", 1)[0].strip()
@@ -435,22 +549,43 @@ def _read_australis(text: str, path: Path) -> CameraModel:
         if key == "format":
             if f[1:2] != [_AUS_MAGIC]:
                 raise DataError(f"{path}:{n}: not an orthoscope Australis-style file")
+            if len(f) != 3 or f[2] not in _AUS_VERSIONS:
+                got = f"version {_show(' '.join(f[2:]))} is unknown" if f[2:] else "has no version"
+                raise DataError(
+                    f"{path}:{n}: the format line's {_AUS_MAGIC} {got}; this reader reads version "
+                    f"{', '.join(_AUS_VERSIONS)} (a first line 'format {_AUS_MAGIC} "
+                    f"{_AUS_VERSIONS[-1]}')"
+                )
             continue
         if len(f) != 2:
-            raise DataError(f"{path}:{n}: expected 'name value', got {s!r}")
-        if key in spec.params or key.lower() in ("xp", "yp", "c"):
-            name = key if key in spec.params else lower[key.lower()]
+            raise DataError(f"{path}:{n}: expected 'name value', got {_show(s)}")
+        name = lower.get(key.lower(), key) if key.lower() in ("xp", "yp", "c") else key
+        if name in at:
+            raise DataError(f"{path}:{n}: {key} appears twice (first on line {at[name]}); keep one")
+        if name in spec.params:
             try:
                 vals[name] = float(f[1])
             except ValueError:
-                raise DataError(f"{path}:{n}: {key} is not a number: {f[1]!r}") from None
-        elif key in ("image_width", "image_height", "pixel_width_mm", "pixel_height_mm"):
-            meta[key] = f[1]
+                raise DataError(f"{path}:{n}: {key} is not a number: {_show(f[1])}") from None
+            if not math.isfinite(vals[name]):
+                raise DataError(f"{path}:{n}: {key} is not a finite number: {_show(f[1])}")
+        elif key in ("image_width", "image_height"):
+            meta[key] = _whole(f[1], key, f"{path}:{n}", " of pixels")
+        elif key in ("pixel_width_mm", "pixel_height_mm"):
+            try:
+                meta[key] = float(f[1])
+            except ValueError:
+                meta[key] = math.nan
+            if not (math.isfinite(meta[key]) and meta[key] > 0):
+                raise DataError(
+                    f"{path}:{n}: {key} must be a positive number (mm), got {_show(f[1])}"
+                )
         else:
             raise DataError(
-                f"{path}:{n}: unknown name {key!r} (parameters: {', '.join(spec.params)}; "
+                f"{path}:{n}: unknown name {_show(key)} (parameters: {', '.join(spec.params)}; "
                 "image_width, image_height, pixel_width_mm, pixel_height_mm)"
             )
+        at[name] = n
     missing = [
         k
         for k in ("image_width", "image_height", "pixel_width_mm", "pixel_height_mm")
@@ -458,14 +593,18 @@ def _read_australis(text: str, path: Path) -> CameraModel:
     ] + [k for k in ("c",) if k not in vals]
     if missing:
         raise DataError(f"{path}: missing {', '.join(missing)}")
-    try:
-        w, h = int(meta["image_width"]), int(meta["image_height"])
-        ps = (float(meta["pixel_width_mm"]), float(meta["pixel_height_mm"]))
-    except ValueError:
-        raise DataError(f"{path}: image size and pixel size must be numbers") from None
+    if not vals["c"] > 0:
+        raise DataError(f"{path}:{at['c']}: c (the principal distance, mm) must be positive")
     vals.setdefault("xp", 0.0)
     vals.setdefault("yp", 0.0)
-    return CameraModel.create("australis", w, h, pixel_size_mm=ps, **vals)
+    return _create(
+        str(path),
+        "australis",
+        meta["image_width"],
+        meta["image_height"],
+        pixel_size_mm=(meta["pixel_width_mm"], meta["pixel_height_mm"]),
+        **vals,
+    )
 
 
 # ---- writing ------------------------------------------------------------------------------------
