@@ -295,8 +295,12 @@ def _bad_file(tmp_path, name, old, new):
     return path
 
 
-FORMATS_BY_SUFFIX = {".yml": "opencv-yaml", ".json": "opencv-json", ".xml": "metashape"}
-FORMATS_BY_SUFFIX[".aus"] = "australis"
+FORMATS_BY_SUFFIX = {
+    ".yml": "opencv-yaml",
+    ".json": "opencv-json",
+    ".xml": "metashape",
+    ".aus": "australis",
+}
 
 
 def test_deeply_nested_json_is_a_data_error(tmp_path):
