@@ -275,8 +275,7 @@ def test_plots_keep_the_ax_convention(cooke, sensor):
 def test_convert_keeps_to_the_model_and_coefficient_count_asked_for(tmp_path, monkeypatch, cooke):
     # --model opencv on a fisheye calibration is the perspective model (a refit), not the
     # fisheye again; --coefficients N refits to N coefficients (the exact path ignored N)
-    import cv2
-
+    cv2 = pytest.importorskip("cv2")  # the referee (extra "camera")
     from distortion.camera import format_calibration
 
     setup = CameraSetup(sensor=Sensor.from_spec(size="24x16", pixels="1200x800"), grid=(9, 7))
