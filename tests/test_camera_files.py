@@ -418,3 +418,20 @@ def test_a_file_not_utf8_is_named_so(tmp_path):
     (tmp_path / "latin.yml").write_bytes("%YAML:1.0\n# café\nimage_width: 3000\n".encode("latin-1"))
     with pytest.raises(DataError, match=r"latin.yml: not UTF-8 text; a calibration file"):
         read_calibration(tmp_path / "latin.yml")
+
+
+@pytest.mark.parametrize(
+    "old,new,msg",
+    [
+        # a K whose last row is not 0 0 1 (or with [1][0] set) was read as if it were
+        ("0.0,\n            1.0\n", "0.0,\n            2.0\n",
+         r"c.json: camera_matrix must read .* last row 0 0 2"),
+        ("1523.4,\n            0.0,", "1523.4,\n            0.5,", r"\[1\]\[0\] = 0.5"),
+        # two names of one matrix: the first found was used, the other ignored
+        ('"camera_matrix": {', '"K": {"rows": 1, "cols": 1, "data": [1]}, "camera_matrix": {',
+         r"c.json: holds camera_matrix and K, two names of one matrix; keep one"),
+    ],
+)  # fmt: skip
+def test_a_camera_matrix_that_is_not_opencvs_k_is_refused(tmp_path, old, new, msg):
+    with pytest.raises(DataError, match=msg):
+        read_calibration(_bad_file(tmp_path, "c.json", old, new))

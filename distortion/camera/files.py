@@ -14,8 +14,9 @@ Formats (``format=`` names; inferred from the file name when left out):
     a nonzero camera_matrix[0][1] is refused (``cv2.projectPoints`` ignores that element).
     Read also: the tutorials' key names ``cameraMatrix`` / ``distCoeffs`` (and ``K`` / ``D``),
     and the same layout in ``cv2.FileStorage``'s XML (``<opencv_storage>``, a ``.xml`` file).
-    A key given twice, and an image size or matrix rows/cols that is not a whole number, are
-    refused (not cut to an int, not the last value silently).
+    A key given twice, an image size or matrix rows/cols that is not a whole number, a
+    camera_matrix that is not OpenCV's K ([fx s cx; 0 fy cy; 0 0 1]) and a matrix under two of
+    its names are refused (not cut to an int, not the last or first value silently).
 ``colmap`` (``cameras.txt``)
     COLMAP's text format: ``CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]``, one camera a line, ``#``
     comments; parameters in COLMAP's order (pixel centres at +0.5).
@@ -311,12 +312,15 @@ _MATRIX_NAMES = {
 def _matrix(nodes: dict, key: str, path: Path, lines: dict) -> tuple[np.ndarray, str]:
     """The matrix ``key`` (or an other name of it) as rows × cols, and where it is in the file
     (the file, and its line where the format has lines)."""
-    name = next((k for k in (key, *_MATRIX_NAMES.get(key, ())) if k in nodes), None)
-    if name is None:
+    names = [k for k in (key, *_MATRIX_NAMES.get(key, ())) if k in nodes]
+    if not names:
         raise DataError(
             f"{path}: no {key!r}; an OpenCV calibration has camera_matrix and "
             "distortion_coefficients"
         )
+    if len(names) > 1:
+        raise DataError(f"{path}: holds {' and '.join(names)}, two names of one matrix; keep one")
+    name = names[0]
     node, at = nodes[name], f"{path}:{lines[name]}" if name in lines else str(path)
     if not isinstance(node, dict) or "data" not in node:
         raise DataError(f"{at}: {name} is not an opencv-matrix (rows, cols, dt, data)")
@@ -350,6 +354,11 @@ def _opencv_from_nodes(nodes: dict, lines: dict, path: Path) -> CameraModel:
     d = d.ravel()
     if k.shape != (3, 3):
         raise DataError(f"{at_k}: camera_matrix must be 3x3, got {k.shape[0]}x{k.shape[1]}")
+    if k[1, 0] != 0 or list(k[2]) != [0, 0, 1]:
+        raise DataError(
+            f"{at_k}: camera_matrix must read [fx s cx; 0 fy cy; 0 0 1] (OpenCV's K), got "
+            f"[1][0] = {k[1, 0]:g} and last row {' '.join(f'{v:g}' for v in k[2])}"
+        )
     if "image_width" not in nodes or "image_height" not in nodes:
         raise DataError(f"{path}: give image_width and image_height (pixels)")
     w, h = (
