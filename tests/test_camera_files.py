@@ -435,3 +435,10 @@ def test_a_file_not_utf8_is_named_so(tmp_path):
 def test_a_camera_matrix_that_is_not_opencvs_k_is_refused(tmp_path, old, new, msg):
     with pytest.raises(DataError, match=msg):
         read_calibration(_bad_file(tmp_path, "c.json", old, new))
+
+
+def test_a_metashape_tag_given_twice_is_refused(tmp_path):
+    # the first <f> was used and the second ignored
+    path = _bad_file(tmp_path, "m.xml", "<f>3200.0</f>", "<f>3200.0</f><f>3300.0</f>")
+    with pytest.raises(DataError, match=r"m.xml: <f> appears twice in <calibration>; keep one"):
+        read_calibration(path)

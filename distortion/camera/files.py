@@ -499,6 +499,10 @@ def _read_metashape(text: str, path: Path) -> CameraModel:
         raise DataError(f"{path}: no <calibration> element")
     adjusted = [c for c in cals if c.get("class") == "adjusted"]
     cal = (adjusted or cals)[0]
+    tags = [c.tag for c in cal]
+    twice = next((t for t in tags if tags.count(t) > 1), None)
+    if twice is not None:
+        raise DataError(f"{path}: <{twice[:40]}> appears twice in <calibration>; keep one")
     proj = (cal.findtext("projection") or cal.get("type") or "frame").strip()
     if proj != "frame":
         raise DataError(
