@@ -24,8 +24,9 @@ Formats (``format=`` names; inferred from the file name when left out):
     Agisoft Metashape calibration XML: ``<calibration>`` with ``projection`` = frame,
     ``width``, ``height``, ``f``, ``cx``, ``cy`` (offsets from the image centre), ``b1``, ``b2``,
     ``k1``..``k4``, ``p1``..``p4`` (Metashape's P1, P2: P1 = OpenCV p2). Missing coefficients
-    are zero. A ``<calibration>`` inside a Metashape cameras/chunk XML is found too
-    (``class="adjusted"`` preferred; image size from ``<resolution width= height=>``).
+    are zero; a tag given twice is refused. A ``<calibration>`` inside a Metashape cameras/chunk
+    XML is found too (``class="adjusted"`` preferred; image size from ``<resolution width=
+    height=>``).
 ``photoscan`` (``.xml``, the older PhotoScan layout; detected by its ``<fx>``)
     ``fx``, ``fy``, absolute ``cx``, ``cy`` (pixels from the image's top-left corner), ``skew``,
     ``k1``..``k4``, ``p1``, ``p2``. Read as Metashape with f = fy, b1 = fx − fy, b2 = skew,
