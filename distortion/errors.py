@@ -7,7 +7,6 @@ import os
 from pathlib import Path
 
 from raytrace.errors import OrthoscopeError
-from raytrace.files.text import read_capped
 
 
 class DataError(OrthoscopeError):
@@ -35,6 +34,8 @@ def read_text(path: str | os.PathLike, what: str) -> str:
         :data:`raytrace.files.text.MAX_FILE_BYTES`), or it is not UTF-8 text (``what`` names what
         it should hold, e.g. ``"a calibration file"``).
     """
+    from raytrace.files.text import read_capped  # not at import: every module imports this one
+
     p = Path(path)
     try:
         return read_capped(p).decode("utf-8-sig")

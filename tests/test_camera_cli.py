@@ -876,20 +876,20 @@ def test_camera_id_reaches_the_colmap_file_of_two(tmp_path, monkeypatch):
 
 
 def _count_reads(monkeypatch) -> list[str]:
-    """The names of the files the data-file reader of distortion/ (``distortion.errors.read_text``,
-    through ``read_capped``) reads from now on (in order, appended)."""
+    """The names of the files ``raytrace.files.text.read_capped`` (the one reader of every file a
+    person names) reads from now on (in order, appended)."""
     from pathlib import Path
 
-    import distortion.errors
+    import raytrace.files.text
 
     reads = []
-    read_capped = distortion.errors.read_capped
+    read_capped = raytrace.files.text.read_capped
 
     def counted(path, *args, **kw):
         reads.append(Path(path).name)
         return read_capped(path, *args, **kw)
 
-    monkeypatch.setattr(distortion.errors, "read_capped", counted)
+    monkeypatch.setattr(raytrace.files.text, "read_capped", counted)
     return reads
 
 

@@ -52,6 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from raytrace.files.output import write_atomic
+from raytrace.units import is_whole
 
 from ..errors import DataError, read_text
 from .convert import smallest_exact
@@ -83,7 +84,7 @@ def _whole(value, what: str, where: str, unit: str = "", least: int = 1) -> int:
                 pass
     if isinstance(v, float) and math.isfinite(v) and v.is_integer():
         v = int(v)
-    if not isinstance(v, int) or isinstance(v, bool) or v < least:
+    if not is_whole(v) or v < least:
         raise DataError(
             f"{where}: {what} must be a whole number{unit}, {least} or more; got {_show(value)}"
         )
