@@ -188,13 +188,19 @@ def dask_setup(worker) -> None:
     ignore_worker_warnings()
 
 
+#: the loggers a Dask run writes to: its own, and those of the event loop it runs on (an
+#: exception in one of its callbacks, e.g. a Ctrl-C that lands inside ``distributed.utils.sync``,
+#: is logged with its traceback on ``tornado.application``, which Dask's own config sets to ERROR)
+DASK_LOGGERS = ("distributed", "tornado", "asyncio")
+
+
 def quiet_dask_logs(level: int) -> None:
-    """Raise Dask's loggers (``distributed`` and below, as its import configured them) to at
-    least ``level`` (a :mod:`logging` level)."""
+    """Raise the loggers of a Dask run (:data:`DASK_LOGGERS` and below, as the import of
+    ``distributed`` configured them) to at least ``level`` (a :mod:`logging` level)."""
     import logging
 
-    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
-    for name in {"distributed", *names}:
+    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] in DASK_LOGGERS]
+    for name in {*DASK_LOGGERS, *names}:
         log = logging.getLogger(name)
         log.setLevel(max(log.level, level))
 

@@ -175,3 +175,23 @@ def test_remote_cluster_workers_leave_the_warnings_to_the_parent_while_connected
     assert "control (connected)" in err and "control (late worker)" in err, err
     assert "no cache (connected)" not in err and "no cache (late worker)" not in err, err
     assert "OutOfRangeWarning" not in err, err
+
+
+def test_a_dask_run_quiets_the_event_loop_it_runs_on_too():
+    # a Ctrl-C inside distributed.utils.sync once printed "tornado.application - ERROR - Exception
+    # in callback ..." and its traceback beside the command's one line: Dask's own config sets
+    # tornado.application to ERROR, and only the distributed loggers were raised
+    pytest.importorskip("distributed")
+    code = """
+import logging
+import distributed
+from raytrace.executors import quiet_dask_logs
+quiet_dask_logs(logging.CRITICAL)
+logging.getLogger("tornado.application").error("Exception in callback")
+logging.getLogger("asyncio").error("Task exception was never retrieved")
+logging.getLogger("distributed.utils").error("distributed")
+print("done")
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and r.stdout == "done\n", r.stderr
+    assert r.stderr == ""
