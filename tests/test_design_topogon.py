@@ -233,10 +233,22 @@ def test_spherical_spec_operands_match_an_independent_trace(spherical, spherical
         assert violation <= 1e-9 and abs(v.residual) <= 1e-9, (v.operand, v.value)
 
 
+#: How close a design re-run lands to the shipped lens, per curvature and thickness (relative).
+#: The minimax optimum is flat, and where the run ends on it depends on the machine's floating
+#: point (numba's code for the host CPU, the BLAS/LAPACK kernels scipy picks for it) and on the
+#: numpy/scipy versions. Observed: within 1e-6 in the earlier sessions' runs and CI; on an AMD
+#: EPYC VM (2026-11-28) 3.0e-5 in one thickness of the heights design (1.30934 against 1.30938
+#: mm: 39 nm) with numpy 2.4 / scipy 1.17, and 1.0e-6 (one curvature) with Python 3.13, numpy
+#: 2.5, scipy 1.18; on the oldest declared stack (numpy 1.24, scipy 1.10) 4e-6 and 1e-5.
+#: 1e-4 keeps a margin over these: the same lens to four significant digits (far below any
+#: shop tolerance), with the same max error (checked to 0.01 µm and 0.001 µm).
+REPRODUCE_REL = 1e-4
+
+
 def test_spherical_design_is_reproducible_from_its_spec(spherical):
     """The design run itself (about 3 s on one core, 773 evaluations): the spec's minimax from its
     start lens (the 2026-11-23 design, rounded) converges to the shipped lens, to 0.01 µm in its
-    max error and 1e-6 (relative) in every curvature and thickness."""
+    max error and REPRODUCE_REL (relative) in every curvature and thickness."""
     from raytrace.optimize.solver import get_value
 
     spec = read_spec(SPHERICAL_SPEC)
@@ -250,10 +262,10 @@ def test_spherical_design_is_reproducible_from_its_spec(spherical):
     assert res.merit == pytest.approx(shipped, abs=0.01)
     for v in spec.variables:
         got, want = get_value(res.lens, v.kind, v.surface), get_value(spherical, v.kind, v.surface)
-        assert got == pytest.approx(want, rel=1e-6), (v.kind, v.surface)
+        assert got == pytest.approx(want, rel=REPRODUCE_REL), (v.kind, v.surface)
     for a, b in zip(res.lens.surfaces, spherical.surfaces, strict=True):
-        assert a.curvature == pytest.approx(b.curvature, rel=1e-6)
-        assert a.thickness == pytest.approx(b.thickness, rel=1e-6)
+        assert a.curvature == pytest.approx(b.curvature, rel=REPRODUCE_REL)
+        assert a.thickness == pytest.approx(b.thickness, rel=REPRODUCE_REL)
 
 
 def _minimax_odd_fit(table1, lowest: int, top: int) -> tuple[float, np.ndarray]:
@@ -401,8 +413,8 @@ def test_heights_design_is_reproducible_from_its_spec(heights):
     assert res.violation <= 1e-9
     assert res.merit == pytest.approx(HEIGHTS_MAX_ERR_UM, abs=1e-3)
     for a, b in zip(res.lens.surfaces, heights.surfaces, strict=True):
-        assert a.curvature == pytest.approx(b.curvature, rel=1e-6)
-        assert a.thickness == pytest.approx(b.thickness, rel=1e-6)
+        assert a.curvature == pytest.approx(b.curvature, rel=REPRODUCE_REL)
+        assert a.thickness == pytest.approx(b.thickness, rel=REPRODUCE_REL)
 
 
 def test_table1_scale_term_quoted_in_the_notes(heights, table1):
