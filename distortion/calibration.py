@@ -38,7 +38,7 @@ import numpy as np
 
 from raytrace.units import is_whole
 
-from .curve import DistortionCurve, require_choice
+from .curve import HEIGHT, DistortionCurve, check_field_angles, require_choice
 from .errors import CalibrationError
 
 if TYPE_CHECKING:
@@ -55,16 +55,40 @@ def axis_spread(values: np.ndarray, on_axis: float) -> float:
     return float(np.max(v) - np.min(v))
 
 
-def match_fields(fields: np.ndarray, at, what: str) -> list[int]:
-    """Indices of the ``at`` field values among ``fields`` (CalibrationError naming ``what``)."""
+def looks_like_radians(angle_deg: float, span_deg: float) -> bool:
+    """Whether a field angle given in degrees looks like radians: 0 < |a| <= π/2 and, read as
+    radians, within 1.1 × ``span_deg`` (the largest field of the curve, degrees) — 0.65 for
+    37.5° on a lens of 45°. Used where such a value is no field of the curve (a field of 0.65°
+    that the curve holds is taken as it is)."""
+    a = abs(float(angle_deg))
+    return 0.0 < a <= math.pi / 2 and math.degrees(a) <= 1.1 * span_deg
+
+
+def match_fields(fields: np.ndarray, at, what: str, *, angles: bool = False) -> list[int]:
+    """Indices of the ``at`` field values among ``fields`` (CalibrationError naming ``what``).
+
+    ``angles``: the fields are angles in degrees; an ``at`` value not strictly between −90° and
+    90° is refused with the tracer's message (:func:`~distortion.curve.check_field_angles`), and
+    one that is no field point but, read as radians, lies within the curve's angles says that it
+    looks like radians (``0.65`` for 37.5°).
+    """
     lo, hi = float(np.min(fields)), float(np.max(fields))
     span = max(abs(lo), abs(hi), 1.0)
     idx = []
     listing = ", ".join(f"{v:g}" for v in fields)
     for a in at:
+        if not math.isfinite(float(a)):
+            raise CalibrationError(f"{what}: field {float(a)!r} is not a finite number")
+    if angles:
+        check_field_angles(at, f"{what}: field", CalibrationError, index=False)
+    for a in at:
         a = float(a)
-        if not math.isfinite(a):
-            raise CalibrationError(f"{what}: field {a!r} is not a finite number")
+        unit = ""
+        if angles and looks_like_radians(a, span):
+            unit = (
+                f"; {a:g} looks like radians ({a:g} rad = {math.degrees(a):.4g}°): the fields are "
+                "in degrees"
+            )
         hit = np.nonzero(np.abs(fields - a) <= 1e-9 * span)[0]
         if not hit.size:  # a value copied from the listing below (6 significant digits)
             hit = np.nonzero([f"{v:g}" == f"{a:g}" for v in fields])[0]
@@ -74,13 +98,91 @@ def match_fields(fields: np.ndarray, at, what: str) -> list[int]:
             continue
         if a < lo - 1e-9 * span or a > hi + 1e-9 * span:
             raise CalibrationError(
-                f"{what}: field {a:g} is outside the curve's fields ({lo:g} … {hi:g})"
+                f"{what}: field {a:g} is outside the curve's fields ({lo:g} … {hi:g}){unit}"
             )
         raise CalibrationError(
             f"{what}: field {a:g} is not one of the curve's field points ({listing}); "
-            "choose one of them (or trace the curve with that field included)"
+            f"choose one of them (or trace the curve with that field included){unit}"
         )
     return idx
+
+
+def calibration_fields(
+    fields: np.ndarray, method: str, at: Sequence[float], *, angles: bool = False
+) -> list[int] | None:
+    """The indices among ``fields`` of the ``at`` fields of a calibration ``method``: two for
+    ``two-point``, one for ``zero-at``, None (and no ``at``) for the others.
+
+    The one check of ``at`` (:func:`calibrate`, and the ``distortion`` command before it traces):
+    CalibrationError for the wrong number of fields or a field that is not among ``fields``
+    (:func:`match_fields`; ``angles``: the fields are degrees).
+    """
+    what = f"calibration ({method})"
+    require_choice(method, METHODS, "calibration method", CalibrationError)
+    need = {"two-point": 2, "zero-at": 1}.get(method, 0)
+    if need and len(at) != need:
+        raise CalibrationError(f"{what} needs exactly {need} field(s) in at=, got {len(at)}")
+    if not need and at:
+        raise CalibrationError(f"{what} takes no at= fields")
+    return match_fields(np.asarray(fields, dtype=float), at, what, angles=angles) if need else None
+
+
+#: A given calibrated constant is refused outside this factor of the curve's own scales (K0 and
+#: y'/x at every off-axis field point). Least squares and minimax (weighted means of y'/x, and a
+#: line through the origin that misses them all fits no point better), zero-at and two-point at
+#: fields on one side of the axis give a K_c inside those scales; for a real lens they lie
+#: within its distortion of K0 (Table I: 0.3 %; a fisheye y' = F0·θ to 85° reaches down to
+#: 0.13·F0 and its minimax F_c ≈ 0.19·F0 lies inside), so a factor of 2 beyond them refuses no
+#: such calibration, while a unit slip (metres or µm for mm: a factor of 1000) is far outside.
+#: (Two-point at fields on both sides of the axis gives a chord slope of the curve instead,
+#: which a strongly distorting lens can put outside them.)
+GIVEN_FACTOR = 2.0
+
+
+def check_given_constant(value: object, curve: DistortionCurve, what: str) -> float:
+    """The calibrated constant ``value`` of method ``given`` as a float, checked against the
+    curve (:data:`GIVEN_FACTOR`).
+
+    Raises
+    ------
+    CalibrationError
+        Naming ``value=``: not a finite nonzero number, of the other sign than K0, or outside a
+        factor of :data:`GIVEN_FACTOR` of the curve's scales; for F (mm) a value that would fit in
+        metres or micrometres says so.
+    """
+    s = curve.symbol
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
+    v = float(value) if ok else math.nan  # type: ignore[arg-type]
+    if not (math.isfinite(v) and v != 0.0):
+        raise CalibrationError(
+            f"{what}: value= must be a finite nonzero number, the calibrated constant {s}_c"
+            f"{'' if curve.finite else ' in mm'}, got {value!r}"
+        )
+    K0 = curve.constant
+    if v * K0 < 0:
+        raise CalibrationError(
+            f"{what}: {s}_c = {value!r} must have the sign of {s}0 = {K0:.6g} (a calibration "
+            "rescales the image; it does not flip it)"
+        )
+    off = (curve.x != 0.0) & np.isfinite(curve.yp)
+    scales = np.append(curve.yp[off] / curve.x[off] / K0, 1.0)
+    lo, hi = float(np.min(scales)) / GIVEN_FACTOR, float(np.max(scales)) * GIVEN_FACTOR
+    q = v / K0
+    if lo <= q <= hi:
+        return v
+    unit = "" if curve.finite else " mm"
+    head = f"{what}: value={v:g} is {q:.4g} times {s}0 = {K0:.6g}{unit}"
+    if not curve.finite:
+        for factor, name in ((1000.0, "metres"), (1e-3, "micrometres")):
+            if lo <= q * factor <= hi:
+                raise CalibrationError(
+                    f"{head}: it looks like {name}; {s}_c is in mm (value={v * factor:g})"
+                )
+    raise CalibrationError(
+        f"{head}, beyond a factor of {GIVEN_FACTOR:g} of the curve's scales y'/x "
+        f"({K0 * lo * GIVEN_FACTOR:.6g} … {K0 * hi / GIVEN_FACTOR:.6g}{unit}): no calibration of "
+        "this curve gives it"
+    )
 
 
 def _minimax(x: np.ndarray, r: np.ndarray) -> float:
@@ -293,7 +395,10 @@ def calibrate(
         Field values (same kind and unit as the curve's fields: degrees or mm) for
         ``two-point`` (two) and ``zero-at`` (one); they must be field points of the curve.
     value : float, optional
-        F_c (mm) or M_c for ``given``.
+        F_c (mm) or M_c for ``given``: finite, of the sign of K0 and within a factor of
+        :data:`GIVEN_FACTOR` (2) of the curve's own scales (K0 and y'/x at its field points,
+        where every criterion puts K_c); beyond that it is refused, and an F_c that would fit in
+        metres or micrometres is refused as looking like them (0.154 for 154 mm).
     k : float
         Plot exaggeration for ρ_k (Eq. 14; the paper's Fig. 2 uses 200).
     plane : int
@@ -324,28 +429,15 @@ def calibrate(
         raise CalibrationError(f"k={k!r}: the plot exaggeration of Eq. 14 is a positive number")
     if curve.fields.size < 2:
         raise CalibrationError(f"{what}: a curve needs at least two field points")
-    need = {"two-point": 2, "zero-at": 1}.get(method, 0)
-    if need and len(at_t) != need:
-        raise CalibrationError(f"{what} needs exactly {need} field(s) in at=, got {len(at_t)}")
-    if not need and at_t:
-        raise CalibrationError(f"{what} takes no at= fields")
-    idx = match_fields(curve.fields, at_t, what) if need else None
+    idx = calibration_fields(curve.fields, method, at_t, angles=curve.field_kind != HEIGHT)
     if method == "given" and value is None:
         raise CalibrationError(f"{what} needs the calibrated constant {curve.symbol}_c (value=)")
     if method != "given" and value is not None:
         raise CalibrationError(
             f"{what} chooses {curve.symbol}_c itself: value= goes with method 'given'"
         )
-    if (
-        method == "given"
-        and isinstance(value, (int, float, np.number))
-        and value * curve.constant < 0
-    ):
-        raise CalibrationError(
-            f"{what}: {curve.symbol}_c = {value!r} must have the sign of {curve.symbol}0 = "
-            f"{curve.constant:.6g} (a calibration rescales the image; it does not flip it)"
-        )
-    Kc = fit_scale(curve.x, curve.yp, method, idx=idx, given=value)
+    given = check_given_constant(value, curve, what) if method == "given" else None
+    Kc = fit_scale(curve.x, curve.yp, method, idx=idx, given=given)
     if not math.isfinite(Kc) or Kc == 0.0:
         raise CalibrationError(f"{what} gave a degenerate constant {Kc!r}")
     ycp = Kc * curve.x

@@ -351,6 +351,63 @@ def _check_corners(lens, par, clip, ok, az, th_max, dense, nt, fmt, c0, is_senso
     )
 
 
+def _check_rows(lens, par, clip, c0, sensor, max_field_deg, fmt, theta_max, step) -> None:
+    """Refuse a format too small for any tabulated field: its corner ``theta_max`` (deg) within
+    5 % of ``step`` (:func:`_table_steps`) leaves the certificate's table empty. The message names
+    what set the format (``sensor``, ``max_field_deg`` or the lens's field) and the fix: a sensor
+    whose size read as metres gives a format that traces (its four corner chief rays) "looks
+    like metres"; otherwise a larger format or the largest ``field_step_deg`` that gives a row
+    (the corner itself, tabulated when it lies more than 5 % of a step out)."""
+    if _table_count(theta_max, step) > 0:
+        return
+    # a row needs theta_max > 0.05 step: the largest step that gives one, rounded down to two
+    # significant digits (and strictly below the bound)
+    bound = theta_max / 0.05
+    e = math.floor(math.log10(bound)) - 1
+    best = math.floor(bound / 10.0**e) * 10.0**e
+    if best >= bound:
+        best -= 10.0**e
+    smaller = f"field_step_deg={best:.{max(-e, 0)}f} or less"
+    why = (
+        f"reaches only {theta_max:.3g} deg off the lens axis, not more than 5 % of "
+        f"field_step_deg={step:g} ({0.05 * step:.3g} deg), so the certificate would have no "
+        "tabulated field"
+    )
+    if sensor is None:
+        if max_field_deg is not None:
+            raise DataError(
+                f"max_field_deg={float(max_field_deg):g}: the format {why}; give a larger "
+                f"max_field_deg= or {smaller}"
+            )
+        raise DataError(
+            f"the lens's field ({fmt}) {why}; give a larger max_field_deg= or a sensor, or "
+            f"{smaller}"
+        )
+    from raytrace.trace.chief2d import aim_2d
+
+    from .camera.sensor import Sensor
+    from .grid.field import sensor_size
+
+    s = sensor_size(sensor)
+    w, h = (s.width_mm, s.height_mm) if isinstance(s, Sensor) else s
+    # the same size in metres: does the certificate's format trace (its four corners)?
+    T = 1000.0 * math.hypot(w, h) / 2.0 / c0
+    metres = False
+    if math.degrees(math.atan(T)) < 89.0:
+        a = np.arctan2([h, h, -h, -h], [w, -w, -w, w])
+        FX = np.degrees(np.arctan(T * np.cos(a)))
+        FY = np.degrees(np.arctan(T * np.sin(a)))
+        cr = aim_2d(lens, FX, FY, "angle", par.object_distance, par.wavelength, clip)
+        metres = bool(np.all(np.asarray(cr.ok)))
+    label = f"sensor {w:g}x{h:g} (mm)"
+    if metres:
+        raise DataError(
+            f"{label}: the format {why}; it looks like metres: give the size in mm, "
+            f"'{1000 * w:g}x{1000 * h:g}' (or write '{w:g}x{h:g}m')"
+        )
+    raise DataError(f"{label}: the format {why}; give a larger sensor (mm) or {smaller}")
+
+
 def _traceable_limit(lens, par, clip, azimuth, ok_dense, dense, theta_corner) -> float:
     """The largest field (deg) along ``azimuth`` out to which every chief ray traces: the first
     dense field that fails (or the corner) bracketed, then traced on 64 steps between."""
@@ -543,6 +600,7 @@ def calibration_certificate(
     th_max = np.degrees(np.arctan(T_max))
     if np.any(th_max >= 89.0):
         raise DataError("the format reaches 89 degrees or more; the certificate needs less")
+    _check_rows(lens, par, clip, c0, sensor, max_field_deg, fmt, float(np.max(th_max)), step)
     _check_work(float(np.max(th_max)), step, int(az.size), allow_large)
 
     # 1. the semi-diagonals: tabulated and dense fields and the four corners in one trace (a

@@ -8,7 +8,8 @@ planes: the final segment is moved analytically to each plane. Image planes may 
 - ``defocus``: distance from the Gaussian image plane of the object (+ = away from the lens),
 - or ``plane=`` :class:`~raytrace.paraxial.ImagePlane` objects (docs/design.md, "Vocabulary");
 
-none of them = the Gaussian plane. Distances in mm; planes before the last vertex are refused.
+none of them = the Gaussian plane. Distances in mm (or strings with a length unit, ``"50.5mm"``,
+as the command line takes them); planes before the last vertex are refused.
 
 Fields: angles α in degrees (object at infinity), object heights y in mm (finite conjugates) or,
 for a finite object, nominal angles α standing for ``y = p0·tan α`` (``field_kind="angle"`` with a
@@ -216,8 +217,8 @@ def characteristic_distortion(
     plane : ImagePlane, list of ImagePlane, "gaussian" or "file", optional
         The image plane(s); or give ONE of ``s_prime`` (mm from H'), ``from_last_vertex`` (mm
         from the last vertex), ``defocus`` (mm from the Gaussian plane, + away from the lens),
-        each a number or a sequence. Default: the Gaussian image plane of the object. All
-        planes come from one trace.
+        each a number or a sequence (numbers in mm or strings with a length unit, ``"50.5mm"``).
+        Default: the Gaussian image plane of the object. All planes come from one trace.
     object_distance, object_s, object_scale
         The object plane (at most one): mm from the first vertex (or ``inf`` / ``"12x"``),
         Pestrecov's signed s from H (mm, negative), or an image scale N ("N×", magnification

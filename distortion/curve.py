@@ -10,6 +10,7 @@ in the paper. Curves come from a trace (:mod:`distortion.characteristic`) or fro
 
 from __future__ import annotations
 
+import math
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -36,6 +37,37 @@ def require_choice(
     expected one of <choices>``, unless ``value`` is one of ``choices`` (names, in order)."""
     if value not in choices:
         raise error(f"unknown {what} {value!r}; expected one of {', '.join(choices)}")
+
+
+def check_field_angles(
+    values: npt.ArrayLike, what: str, error: type[Exception] = TraceError, *, index: bool = True
+) -> None:
+    """Raise ``error`` naming the first of ``values`` (field angles in degrees) that is not
+    strictly between −90° and 90°, ``<what>[i] = <value>: <the tracer's message>`` (without
+    ``index``: ``<what> <value>: …``): the check the tracer applies to every field
+    (:func:`raytrace.trace.chief.checked_aim_request`). ``values`` must be finite."""
+    from raytrace.trace.chief import checked_aim_request
+
+    a = np.atleast_1d(np.asarray(values, dtype=float)).ravel()
+    try:
+        checked_aim_request("angle", math.inf, a)
+    except TraceError as e:
+        i = int(np.argmax(~(np.abs(a) < 90.0)))
+        raise error(f"{what}[{i}] = {a[i]:g}: {e}" if index else f"{what} {a[i]:g}: {e}") from None
+
+
+def _require_finite(values: np.ndarray, name: str, unit: str, fields=None) -> None:
+    """ValueError naming ``make_curve``'s input ``name`` and the index of its first value that
+    is not finite (and that point's field, when ``fields`` are given)."""
+    bad = np.nonzero(~np.isfinite(values))[0]
+    if bad.size:
+        i = int(bad[0])
+        at = f" (field {fields[i]:g})" if fields is not None else ""
+        unit = f" ({unit})" if unit else ""
+        raise ValueError(
+            f"make_curve: {name}[{i}] = {values[i]:g}{at} is not a finite number; {name} holds "
+            f"one finite value{unit} per field point"
+        )
 
 
 def relative_distortion(
@@ -304,13 +336,30 @@ def make_curve(
     Raises
     ------
     ValueError
-        An unknown ``field_kind``, a nominal-angle curve without ``x``, or arrays of different
-        lengths.
+        An unknown ``field_kind``, a nominal-angle curve without ``x``, arrays of different
+        lengths, a value of ``fields``, ``D0``, ``x`` or ``y0p`` that is not finite, a field angle
+        not strictly between −90° and 90° (the tracer's check,
+        :func:`raytrace.trace.chief.checked_aim_request`), or a ``constant`` that is zero or not
+        finite; each message names the input (and the index). Negative fields and a constant of
+        either sign are curves (an erecting system with an intermediate image has F0 < 0).
     """
     if field_kind not in FIELD_KINDS:
         raise ValueError(f"unknown field kind {field_kind!r}; expected one of {FIELD_KINDS}")
     f = np.asarray(fields, dtype=float).ravel()
     d = np.asarray(D0, dtype=float).ravel()
+    _require_finite(f, "fields", "degrees" if field_kind != HEIGHT else "mm")
+    if field_kind != HEIGHT:
+        check_field_angles(f, "make_curve: fields", ValueError)
+    try:
+        k = math.nan if isinstance(constant, (bool, str)) else float(constant)
+        shown = repr(constant) if isinstance(constant, (bool, str)) else f"{k:g}"
+    except (TypeError, ValueError):
+        k, shown = math.nan, repr(constant)
+    if not (math.isfinite(k) and k != 0.0):
+        raise ValueError(
+            f"make_curve: constant = {shown} is not a finite nonzero number: K0 is F0 in mm "
+            "(object at infinity) or M0 (finite conjugates)"
+        )
     if x is None:
         if field_kind == ANGLE:
             x = np.tan(np.radians(f))
@@ -319,7 +368,9 @@ def make_curve(
         else:
             raise ValueError("a nominal-angle curve needs x (object heights y = p0 tan α)")
     xa = np.asarray(x, dtype=float).ravel()
-    ya = constant * xa if y0p is None else np.asarray(y0p, dtype=float).ravel()
+    ya = k * xa if y0p is None else np.asarray(y0p, dtype=float).ravel()
     if not (f.size == d.size == xa.size == ya.size):
         raise ValueError("fields, x, y0p and D0 must have the same length")
-    return DistortionCurve(f, field_kind, xa, ya, d, float(constant), name, plane, source, decimals)
+    for values, what in ((xa, "x"), (ya, "y0p"), (d, "D0")):
+        _require_finite(values, what, "mm" if what != "x" or field_kind == HEIGHT else "", f)
+    return DistortionCurve(f, field_kind, xa, ya, d, k, name, plane, source, decimals)

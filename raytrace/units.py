@@ -92,11 +92,56 @@ def length_mm(
             )
         v *= LENGTH_UNITS[unit]
     else:
-        v = float(value)
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise UnitError(
+                f"{what}: expected a length in mm (a number, or a string with its unit such as "
+                f"50.5mm or 0.05m), got {value!r}"
+            ) from None
     if math.isnan(v) or (math.isinf(v) and not allow_inf):
         raise UnitError(f"{what}: expected a finite length, got {value!r}")
     if positive and not v > 0:
         raise UnitError(f"{what}: expected a positive length, got {value!r}")
+    return v
+
+
+#: The largest distance of an image plane (mm, exclusive): Zemax, CODE V and OSLO read a
+#: distance of 1e10 (lens units) or more as infinity (``raytrace/files``: zemax.py, codev.py,
+#: oslo.py), so a plane that far is no finite plane (1e10 mm is 10,000 km: no image plane of a
+#: lens lies near it, and 1e300 was traced to distortions of 1e296 mm).
+PLANE_LIMIT_MM = 1e10
+
+
+def plane_distance_mm(value: float | str, what: str) -> float:
+    """The signed distance of an image plane in mm (``s_prime``, ``from_last_vertex``,
+    ``defocus``) from a number (mm) or a string with a length unit (``"50.5mm"``, ``"5cm"``):
+    :func:`length_mm`, then finite and below :data:`PLANE_LIMIT_MM` in magnitude.
+
+    Parameters
+    ----------
+    value : float or str
+        The distance as given.
+    what : str
+        The keyword's name, for the message.
+
+    Returns
+    -------
+    float
+        mm.
+
+    Raises
+    ------
+    UnitError
+        Not a length, not finite, or 1e10 mm or more away (a distance lens files read as
+        infinity).
+    """
+    v = length_mm(value, what)
+    if abs(v) >= PLANE_LIMIT_MM:
+        raise UnitError(
+            f"{what}={v:g} mm is not a plane position: lens-design programs read 1e10 mm or more "
+            "as infinity; give a distance within ±1e10 mm (mm, or a length with its unit: 50.5mm)"
+        )
     return v
 
 
@@ -114,7 +159,7 @@ def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
     if isinstance(value, str) and value.strip() in SPECTRAL_LINES:
         return SPECTRAL_LINES[value.strip()]
     if isinstance(value, str):
-        v, unit = split_unit(value)
+        v, unit = _split(value, what)
         bare = not unit
         unit = unit or "nm"
         if unit not in WAVELENGTH_UNITS:

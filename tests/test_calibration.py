@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -435,3 +436,152 @@ def test_bundled_table1_is_the_test_table_and_calibrate_takes_its_name(tmp_path,
     rc, local, err = run_cli(cal(f"{PESTRECOV_TABLE_I}.csv"))
     assert rc == 0, err
     assert len(json.loads(local)["Dc_mm"]) == len(json.loads(by_path)["Dc_mm"]) - 1
+
+
+# ------------------------------------------------- input checks of make_curve and calibrate
+
+
+@pytest.mark.parametrize(
+    "kw, needle",
+    [
+        ({"D0": [0.0, math.nan, 0.001, 0.002]}, r"D0\[1\] = nan \(field 10\)"),
+        ({"fields": [0.0, math.nan, 20.0, 30.0]}, r"fields\[1\] = nan"),
+        ({"constant": math.nan}, r"constant = nan"),
+        ({"constant": math.inf}, r"constant = inf"),
+        ({"x": [0.0, 0.1, math.inf, 0.3]}, r"x\[2\] = inf"),
+        ({"y0p": [0.0, 1.0, -math.inf, 3.0]}, r"y0p\[2\] = -inf"),
+    ],
+)
+def test_make_curve_refuses_non_finite_inputs_naming_them(kw, needle):
+    # a NaN field, D0 or constant reached scipy's linprog ("b_ub must not contain values inf,
+    # nan") or a curve of NaN; now make_curve names the input (defect #3 of the units sweep)
+    args = {"fields": [0.0, 10.0, 20.0, 30.0], "D0": [0.0, 0.0005, 0.001, 0.002]}
+    args.update({k: v for k, v in kw.items() if k in args})
+    rest = {k: v for k, v in kw.items() if k not in args}
+    with pytest.raises(ValueError, match=needle) as e:
+        calibrate(make_curve(args["fields"], args["D0"], **{"constant": 154.0, **rest}))
+    assert "linprog" not in str(e.value) and "\n" not in str(e.value)
+
+
+def test_make_curve_refuses_field_angles_beyond_90_and_a_zero_constant():
+    # tan(100°) made y0' = −873 mm and calibrate completed; constant=0 printed "F0 = 0 …
+    # D_rc = -100 %" (defect #4). The tracer's own check refuses the same angles.
+    with pytest.raises(ValueError, match=r"fields\[2\] = 100: field angles must lie strictly "):
+        make_curve([0, 10, 100], [0, 0.001, 0.002], constant=154)
+    with pytest.raises(ValueError, match=r"fields\[1\] = -90: field angles"):
+        make_curve([0, -90], [0, 0.001], constant=154)
+    with pytest.raises(ValueError, match=r"fields\[1\] = 95: field angles"):  # α of y = p0 tan α
+        make_curve([0, 95], [0, 1e-3], field_kind="nominal-angle", x=[0, 1], constant=-2.0)
+    for kind in ("angle", "height"):
+        with pytest.raises(ValueError, match="constant = 0 is not a finite nonzero number"):
+            make_curve([0, 10, 20], [0, 0.001, 0.002], field_kind=kind, constant=0)
+    # what the curve allows stays allowed: negative and large fields, heights of any size, an
+    # M0 of either sign, and a negative F0 (an erecting system with an intermediate image traces
+    # to one: two f = 100 mm lenses 300 mm apart give F0 = −99.3 mm)
+    assert len(make_curve([-30, 0, 30, 89.9], [-0.1, 0, 0.1, 1.0], constant=154)) == 4
+    assert make_curve([0, 10, 20], [0, 1e-3, 2e-3], constant=-99.3).y0p[1] < 0
+    for M0 in (-9.5, 0.25):
+        c = make_curve([-500.0, 0.0, 1e4], [0.0, 0.0, 0.5], field_kind="height", constant=M0)
+        assert c.constant == M0
+
+
+def test_given_constant_that_looks_like_another_unit_is_refused(table1):
+    # F0 = 153.706 mm and value=0.154 (metres) gave max |D_c| = 153.8 mm, D_rc = +99 709 %
+    # (defect #5); every criterion gives a constant within the curve's own scales y'/x
+    with pytest.raises(CalibrationError, match=r"value=0\.154 .*looks like metres.*value=154\)"):
+        calibrate(table1, "given", value=0.154)
+    with pytest.raises(CalibrationError, match=r"value=154000 .*looks like micrometres"):
+        calibrate(table1, "given", value=154e3)
+    with pytest.raises(CalibrationError, match=r"value=40 is 0\.26.* times F0"):
+        calibrate(table1, "given", value=40.0)
+    for bad in (0.0, math.nan, math.inf):
+        with pytest.raises(CalibrationError, match=r"^calibration \(given\): value= must be a "):
+            calibrate(table1, "given", value=bad)
+    with pytest.raises(CalibrationError, match=r"value= must be a finite nonzero number.*'154'"):
+        calibrate(table1, "given", value="154")
+    # real calibrated constants pass: the paper's F_c, and a fisheye's minimax constant, which is
+    # far from F0 (y' = F0·θ against x = tan θ to 85°: K_c ≈ 0.19 F0) but within the curve's scales
+    assert calibrate(table1, "given", value=154.059).Kc == 154.059
+    th = np.radians(np.arange(0.0, 86.0, 5.0))
+    fisheye = make_curve(np.degrees(th), 100.0 * (th - np.tan(th)), constant=100.0)
+    kc = calibrate(fisheye, "minimax").Kc
+    assert 15.0 < kc < 25.0
+    assert calibrate(fisheye, "given", value=kc).Kc == kc
+    m = make_curve([0.0, -2.0, -4.0], [0.0, 1e-4, 3e-4], field_kind="height", constant=-9.5)
+    assert calibrate(m, "given", value=-9.49).Kc == -9.49
+    with pytest.raises(CalibrationError, match=r"value=-0\.0095 is 0\.001 times M0 = -9\.5"):
+        calibrate(m, "given", value=-0.0095)
+
+
+def _one_line_error(argv, *needles):
+    from support import run_cli
+
+    rc, out, err = run_cli(argv)
+    assert rc == 2, (out, err)
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    for n in needles:
+        assert n in err, err
+    return err
+
+
+def test_given_constant_in_metres_is_refused_by_both_commands():
+    # `calibrate TABLE --method given --value 0.154` and `distortion LENS --calibrate given
+    # --value 0.154` ran (D_rc = +99 709 %); both now refuse it in one line naming --value
+    table = str(DATA / "pestrecov_table1.csv")
+    _one_line_error(
+        ["calibrate", table, "--method", "given", "--value", "0.154"],
+        "calibration (given): --value 0.154 is 0.001002 times F0 = 153.706 mm: it looks like "
+        "metres; F_c is in mm (--value 154)",
+    )
+    cooke = ["distortion", "cooke-triplet-f4", "--fields", "0,10,20", "--calibrate", "given"]
+    _one_line_error([*cooke, "--value", "0.05"], "--value 0.05 is 0.001", "looks like metres")
+    _one_line_error(["calibrate", table, "--method", "given", "--value", "nan"], "--value must")
+
+
+def test_distortion_at_fields_are_the_calibrate_commands_check():
+    # --at 0.65,0.79 (radians for 37.5°, 45°) was added to the traced fields and calibrated at
+    # 0.65° and 0.79°, while `calibrate` and osc.calibrate refused them (defect #15): --at
+    # values are still traced with the run's fields, except one that looks like radians, which
+    # the one check (distortion.calibration.match_fields) then refuses, saying so
+    table = str(DATA / "pestrecov_table1.csv")
+    listing = "(0, 10, 20, 25, 30, 35, 37.5, 40, 42.5, 45)"
+    common = (
+        "field 0.65 is not one of the curve's field points",
+        "0.65 looks like radians (0.65 rad = 37.24°): the fields are in degrees",
+    )
+    e1 = _one_line_error(
+        ["calibrate", table, "--method", "two-point", "--at", "0.65,0.79"], *common
+    )
+    fields = "0,10,20,25,30,35,37.5,40,42.5,45"
+    e2 = _one_line_error(
+        ["distortion", "topogon-like-pestrecov", "--fields", fields, "--calibrate", "two-point",
+         "--at", "0.65,0.79"], *common, listing)  # fmt: skip
+    assert e1.split("error: ", 1)[1] == e2.split("error: ", 1)[1]  # the same message
+    # the same without --fields: the default fields (0, 4.5, … 45) do not hold 0.65
+    _one_line_error(
+        ["distortion", "topogon-like-pestrecov", "--calibrate", "two-point", "--at", "0.65,0.79"],
+        "field 0.65 is not one of the curve's field points (0, 4.5, 9,",
+        common[1],
+    )
+    # fields in degrees are traced too (37.5 is no default field), and 0.65 in --fields is taken
+    # as degrees: the user said so
+    for argv in (
+        ["--at", "37.5,45"],
+        ["--fields", "0,0.65,20,45", "--at", "0.65,45"],
+    ):
+        from support import run_cli
+
+        rc, out, err = run_cli(
+            ["distortion", "topogon-like-pestrecov", "--calibrate", "two-point", *argv, "--json"]
+        )
+        assert rc == 0, err
+        at = [float(a) for a in argv[-1].split(",")]
+        fields = json.loads(out)["distortion"]["fields"]
+        assert all(a in fields for a in at), (at, fields)
+    with pytest.raises(CalibrationError, match=re.escape(common[1])):
+        calibrate(read_distortion_table(table), "zero-at", at=0.65)
+    # --wavelengths takes no calibration: its --at was traced as one more field, now refused
+    _one_line_error(
+        ["distortion", "cooke-triplet-f4", "--wavelengths", "F,d,C", "--at", "5"],
+        "--wavelengths does not combine with --at",
+    )

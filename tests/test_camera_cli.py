@@ -208,7 +208,13 @@ def test_picture_and_maps(tmp_path, monkeypatch):
         ([*BASE[:-1], "2x2"], "the grid gives 4 points (a larger grid)"),
         ([*BASE, "--object-distances", "10m,1m,,1m"], "an empty entry"),
         ([*BASE, "--object-distances", "10m,1m,1m"], "1m is listed twice"),
-        ([*BASE, "--principal-point", "50,0", "--no-clip"], "only 0 of 63 chief rays reached"),
+        # a 1 m sensor: its corners lie far beyond the field the lens images
+        (
+            ["camera", "cooke-triplet-f4", "--sensor", "1000x800", "--pixels", "10000x8000"]
+            + ["--grid", "8x6", "--no-clip"],
+            "only 0 of 48 chief rays reached",
+        ),
+        ([*BASE, "--principal-point", "50,0"], "lies outside the 24x16 mm sensor"),
         (
             ["camera", "cooke-triplet-f4", "--sensor", "200x150", "--pixels", "800x600"],
             "makes pixels of 250 x 250 µm",

@@ -507,3 +507,24 @@ def test_points_beyond_the_fold_get_a_status_not_a_number():
     assert np.all(np.isnan(m.points[3:]))
     r = m.points[:3, 0]
     np.testing.assert_allclose(r * (1 - 0.5 * r**2), rd[:3], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize(
+    "ps, match",
+    [
+        ((3.9, 3.9), r"camera model opencv: pixel_size_mm=\(3.9, 3.9\): a pixel pitch of 3.9 mm is "
+         r"above 0.1 mm; micrometres\? give \(0.0039, 0.0039\) mm"),
+        ((6e-6, 6e-6), r"pixel_size_mm=\(6e-06, 6e-06\): a pixel pitch of 6e-06 mm is below "
+         r"0.0003 mm; metres\? give \(0.006, 0.006\) mm"),
+        ((0.0, 0.006), r"pixel_size_mm=\(0, 0.006\): give \(pitch_x, pitch_y\) in mm"),
+        (0.006, r"pixel_size_mm=0.006: give \(pitch_x, pitch_y\) in mm"),
+    ],
+)  # fmt: skip
+def test_a_pixel_size_in_the_wrong_unit_is_refused_by_the_camera(ps, match):
+    """The pitch range of Sensor.from_spec (0.3..100 µm), said in mm where the keyword is mm."""
+    with pytest.raises(Exception, match=match) as e:
+        CameraModel.create("opencv", 6000, 4000, pixel_size_mm=ps, fx=8333.0, fy=8333.0,
+                           cx=2999.5, cy=1999.5)  # fmt: skip
+    from distortion.errors import DataError
+
+    assert e.type is DataError

@@ -8,6 +8,8 @@ arithmetic of a 36 × 24 mm, 6000 × 4000 px sensor (6 µm pitch).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -108,3 +110,78 @@ def test_a_size_and_pixel_count_that_make_no_pixel_say_so():
 
     with pytest.warns(UnitWarning, match=r"5.333 x 12 µm, far from square: .* swapped"):
         Sensor.from_spec(size="16x24", pixels="3000x2000")
+
+
+# ---- values in the wrong unit, refused where they enter (review 2026-12: camera units sweep) ----
+@pytest.mark.parametrize(
+    "size, match",
+    [
+        ("0.036x0.024", r"sensor size '0.036x0.024': the width 0.036 mm is outside 0.5\.\.1000 mm;"
+         r" metres\? 0.036 m = 36 mm"),
+        ((0.036, 0.024), r"the width 0.036 mm is outside .* metres\? 0.036 m = 36 mm"),
+        ("36000x24000", r"the width 36000 mm is outside .* micrometres\? 36000 µm = 36 mm"),
+    ],
+)  # fmt: skip
+def test_a_sensor_size_in_metres_or_micrometres_is_refused_where_it_is_parsed(size, match):
+    from distortion.camera.sensor import parse_size_mm
+    from distortion.grid.field import sensor_size
+
+    with pytest.raises(DataError, match=match):
+        parse_size_mm(size)
+    with pytest.raises(DataError, match=match):  # distortion_grid(sensor=...) reads it here
+        sensor_size(size)
+
+
+def test_a_sensor_size_in_metres_is_refused_by_distortion_and_its_command(cooke):
+    from support import run_cli
+
+    from distortion.grid import distortion_grid
+
+    with pytest.raises(DataError, match=r"0.036 mm is outside 0.5\.\.1000 mm; metres\?"):
+        distortion_grid(cooke, sensor="0.036x0.024", grid=(5, 5))
+    rc, out, err = run_cli(
+        ["distortion", "cooke-triplet-f4", "--sensor", "0.036x0.024", "--grid", "5x5"]
+    )
+    assert rc == 2 and not out
+    assert "0.036 mm is outside 0.5..1000 mm; metres? 0.036 m = 36 mm" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "offset, match",
+    [
+        ((100, 0), r"principal-point offset 100,0: \(100, 0\) mm lies outside the 36x24 mm "
+         r"sensor \(\|dx\| ≤ 18, \|dy\| ≤ 12 mm\); micrometres\? give \(0.1, 0\) mm"),
+        ((0, -13), r"principal-point offset 0,-13: \(0, -13\) mm lies outside the 36x24 mm"),
+        ("3000,0", r"lies outside the 36x24 mm sensor .*; micrometres\? give \(3, 0\) mm$"),
+        ((0, 30000), r"lies outside .*; give the offset from the sensor centre in mm \(x right"),
+    ],
+)  # fmt: skip
+def test_a_principal_point_offset_outside_the_sensor_is_refused(offset, match):
+    with pytest.raises(DataError, match=match):
+        Sensor.from_spec(size="36x24", pixels="6000x4000", principal_point_offset_mm=offset)
+    # on the edge is on the sensor (a shift lens at its limit)
+    s = Sensor.from_spec(size="36x24", pixels="6000x4000", principal_point_offset_mm=(18, -12))
+    assert s.principal_point_offset_mm == (18.0, -12.0)
+
+
+@pytest.mark.parametrize(
+    "c, match",
+    [
+        (0.05, r"principal_distance_mm=0.05: 0.05 mm is 433 times smaller than the sensor's "
+         r"largest radius 21.6 mm \(a field angle of 89.87°\): metres\? 0.05 m = 50 mm; give c in "
+         r"mm$"),
+        (50000, r"principal_distance_mm=50000: 50000 mm is 2311 times the sensor's largest "
+         r"radius 21.6 mm \(a field angle of 0.02479°\); more than 1000 times is refused: "
+         r"micrometres\? 50000 µm = 50 mm; give c in mm$"),
+        (math.nan, r"principal_distance_mm=nan: give the principal distance c in mm, a positive"),
+        (-50, r"principal_distance_mm=-50: give the principal distance c in mm, a positive"),
+    ],
+)  # fmt: skip
+def test_camera_from_sensor_refuses_a_principal_distance_in_the_wrong_unit(c, match):
+    from distortion.camera import camera_from_sensor
+
+    s = Sensor.from_spec(size="36x24", pixels="6000x4000")
+    with pytest.raises(DataError, match=match):
+        camera_from_sensor("opencv", s, c)
+    assert camera_from_sensor("opencv", s, 50.0)["fx"] == pytest.approx(50.0 / 0.006)

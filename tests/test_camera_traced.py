@@ -92,6 +92,17 @@ def test_setup_refuses_two_ways_and_bad_grids():
     assert a.focus is None and a.from_last_vertex == 40.0
 
 
+@pytest.mark.parametrize("kind", ["s_prime", "from_last_vertex", "defocus"])
+def test_a_sensor_plane_at_the_distance_lens_files_call_infinity_is_refused(kind, cooke):
+    # camera_model(s_prime=1e300) was traced; the camera's plane keywords take the image-plane
+    # check of the rest of the API (raytrace.units.plane_distance_mm: 1e10 mm or more)
+    s = Sensor.from_spec(size="24x16", pixels="1200x800")
+    with pytest.raises(DataError, match=f"^{kind}=1e\\+300 mm is not a plane position"):
+        CameraSetup(s, grid=(3, 3), **{kind: 1e300}).resolve(cooke)
+    near = CameraSetup(s, grid=(3, 3), **{kind: "50.5mm" if kind == "s_prime" else "1mm"})
+    assert near.resolve(cooke).z_image > 0
+
+
 @pytest.mark.parametrize(
     "kw,key",
     [
@@ -740,3 +751,101 @@ def test_distortion_at_a_corner_of_a_nearly_degenerate_rational_model():
 
     back = project(cam, ideal_of(cam, corners), pixels="opencv").points
     assert np.abs(back - corners).max() < 1e-8
+
+
+# ---------------------------------------------------------- values in the wrong unit, refused where
+# they enter (review 2026-12, camera units sweep): the pitch range of Sensor.from_spec
+# (0.3..100 µm) said in mm, the grid limit of distortion_grid (raytrace.limits.MAX_FIELDS)
+def _bare_cam(**kw) -> CameraModel:
+    base = dict(fx=8333.0, fy=8333.0, cx=2999.5, cy=1999.5, k1=-0.05)
+    base.update(kw)
+    return CameraModel.create("opencv", 6000, 4000, **base)
+
+
+@pytest.mark.parametrize(
+    "ps, match",
+    [
+        ((6, 6), r"^pixel_size_mm=\(6, 6\): a pixel pitch of 6 mm is above 0.1 mm; micrometres\? "
+         r"give \(0.006, 0.006\) mm$"),
+        ((0, 0), r"^pixel_size_mm=\(0, 0\): give \(pitch_x, pitch_y\) in mm, two positive numbers"),
+        ((math.nan, math.nan), r"^pixel_size_mm=\(nan, nan\): give \(pitch_x, pitch_y\) in mm"),
+        ((-0.006, 0.006), r"^pixel_size_mm=\(-0.006, 0.006\): give \(pitch_x, pitch_y\) in mm"),
+        ((0.006, 0.006, 0.006), r"^pixel_size_mm=\(0.006, 0.006, 0.006\): give \(pitch_x, "),
+    ],
+)  # fmt: skip
+def test_compare_and_convert_refuse_a_pixel_size_in_the_wrong_unit(ps, match):
+    a, b = _bare_cam(), _bare_cam(fx=8300.0, fy=8300.0, k1=-0.04)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no NaN profile with numpy RuntimeWarnings
+        with pytest.raises(DataError, match=match):
+            compare_cameras(a, b, pixel_size_mm=ps)
+        with pytest.raises(DataError, match=match):
+            convert_camera_model(a, "opencv_fisheye", pixel_size_mm=ps)
+        with pytest.raises(DataError, match=match):
+            calibrated_models_by_distance(a, 1000, b, 3000, focal_length_mm=50.0, focus=2000,
+                                          object_distances=[1500], pixel_size_mm=ps)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "grid, match",
+    [
+        ((10**6, 10**6), r"^grid=\(1000000, 1000000\): 1000000000000 fields, more than 100000 "
+         r".*give allow_large=True to run it anyway$"),
+        ((2.5, 3), r"^grid=\(2.5, 3\): give n or \(nx, ny\) as whole numbers of points"),
+        ((math.nan, 3), r"^grid=\(nan, 3\): give n or \(nx, ny\) as whole numbers of points"),
+        ((0, 0), r"^grid=\(0, 0\): at least 2 points along each axis"),
+    ],
+)  # fmt: skip
+def test_compare_and_convert_refuse_a_grid_beyond_the_limit_or_not_whole(grid, match):
+    a, b = _bare_cam(), _bare_cam(fx=8300.0, fy=8300.0, k1=-0.04)
+    with pytest.raises(DataError, match=match):
+        compare_cameras(a, b, grid=grid)
+    with pytest.raises(DataError, match=match):
+        convert_camera_model(a, "opencv_fisheye", grid=grid)
+
+
+def test_compare_cameras_takes_allow_large_as_distortion_grid_does():
+    a, b = _bare_cam(), _bare_cam(fx=8300.0, fy=8300.0, k1=-0.04)
+    grid = (317, 316)  # 100172 points, just over the limit
+    with pytest.raises(DataError, match="100172 fields, more than 100000"):
+        compare_cameras(a, b, grid=grid)
+    c = compare_cameras(a, b, grid=grid, allow_large=True)
+    assert c.difference_px.shape == (316, 317, 2)
+    small = compare_cameras(a, b, grid=9)  # n: n x n, as distortion_grid reads it
+    assert small.difference_px.shape == (9, 9, 2)
+
+
+def _two_calibrations():
+    c1 = _opencv_cam(fx=6400.0, fy=6400.0, k1=0.015, k2=0.09, k3=0.0, p1=3e-5)  # c = 51.2 mm
+    c2 = _opencv_cam(fx=6330.0, fy=6330.0, k1=0.021, k2=0.11, k3=0.0, p1=1e-5)  # c = 50.64 mm
+    return c1, c2
+
+
+@pytest.mark.parametrize("n", [0, 2, -5, 2.5, math.nan, True, 10**9])
+def test_calibrated_models_refuse_a_number_of_radii_that_makes_no_profile(n):
+    c1, c2 = _two_calibrations()
+    with pytest.raises(DataError, match=r"^n_radii=.*: give a whole number of radii, 3\.\.100000 "
+                       r"\(k1, k2, k3 are fitted to the profiles\)$"):  # fmt: skip
+        calibrated_models_by_distance(c1, 1000, c2, 3000, focal_length_mm=50.0, focus=2000,
+                                      object_distances=[1500], n_radii=n)  # fmt: skip
+    t = calibrated_models_by_distance(c1, 1000, c2, 3000, focal_length_mm=50.0, focus=2000,
+                                      object_distances=[1500], n_radii=3)  # fmt: skip
+    assert len(t.cameras) == 1
+
+
+@pytest.mark.parametrize(
+    "f, match",
+    [
+        (0.05, r"^focal_length_mm=0.05 mm is far from the calibrations' principal distances 51.2 "
+         r"and 50.64 mm \(c/f = 1024 and 1013; c = f \(1 \+ magnification\), so c/f lies within "
+         r"0.5\.\.5\): metres\? 0.05 m = 50 mm; give f in mm$"),
+        (50000, r"^focal_length_mm=50000 mm is far from .* micrometres\? 50000 µm = 50 mm; give f "
+         r"in mm$"),
+        (5.0, r"^focal_length_mm=5 mm is far from .* centimetres\? 5 cm = 50 mm; give f in mm$"),
+    ],
+)  # fmt: skip
+def test_calibrated_models_refuse_a_focal_length_far_from_the_calibrations(f, match):
+    c1, c2 = _two_calibrations()
+    with pytest.raises(DataError, match=match):
+        calibrated_models_by_distance(c1, 1000, c2, 3000, focal_length_mm=f, focus=2000,
+                                      object_distances=[1500])  # fmt: skip

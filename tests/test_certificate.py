@@ -359,3 +359,83 @@ def test_number_text_never_prints_minus_zero():
     assert number_text(-1e-9, "um", signed=True) == "0.0"
     assert number_text(float("nan"), "um") == "\u2014"
     assert number_text(None, "mm") == "\u2014"
+
+
+# ------------------------------------------------ a format too small for any tabulated field
+@pytest.mark.parametrize(
+    "sensor,scale,metres",
+    [
+        ("1x1", 1.0, None),
+        ((1.0, 1.0), 1.0, None),
+        ("0.5x0.5", 400.0 / 153.7056, "'500x500'"),
+        ((0.5, 0.5), 400.0 / 153.7056, "'500x500'"),
+    ],
+    ids=["1x1", "(1,1)", "0.5x0.5@400mm", "(0.5,0.5)@400mm"],
+)
+def test_a_sensor_with_no_tabulated_field_is_refused_naming_it(topogon, sensor, scale, metres):
+    # sensor="1x1" (1 m meant) gave a certificate with no field rows and no message (and the
+    # command line an internal error). 1000 x 1000 mm does not trace on the Topogon (its chief
+    # rays reach 48.6 deg, the 1000 mm corners 77.7 deg): no metres hint there, but the largest
+    # field step that gives a row. The Topogon scaled to f = 400 mm takes 500 x 500 mm (corners
+    # 41.5 deg, traced): 0.5 x 0.5 "looks like metres"
+    lens = topogon if scale == 1.0 else topogon.scaled(scale)
+    with pytest.raises(DataError) as e:
+        calibration_certificate(lens, sensor=sensor, date=DATE)
+    msg = str(e.value)
+    assert msg.startswith("sensor ") and "\n" not in msg
+    assert "no tabulated field" in msg and "field_step_deg=" in msg
+    if metres:
+        assert "looks like metres" in msg and metres in msg and "'0.5x0.5m'" in msg
+        c = calibration_certificate(lens, sensor="0.5x0.5m", date=DATE)  # the fix it offers
+        assert c.fields_deg.size > 1
+    else:
+        assert "metres" not in msg and "larger sensor" in msg
+        # the step it offers gives a row
+        step = float(re.search(r"field_step_deg=([0-9.]+) or less", msg).group(1))
+        c = calibration_certificate(lens, sensor=sensor, date=DATE, field_step_deg=step)
+        assert c.fields_deg.size == 1
+
+
+@pytest.mark.parametrize("sensor", ["0.23x0.23", (0.23, 0.23)], ids=str)
+def test_a_sensor_in_metres_is_refused_saying_so(topogon, sensor):
+    # 0.23 x 0.23 m is the Topogon's 230 x 230 mm (9 in) aerial format: it gave a certificate
+    # with no field rows and no message
+    with pytest.raises(DataError) as e:
+        calibration_certificate(topogon, sensor=sensor, date=DATE)
+    msg = str(e.value)
+    assert msg.startswith("sensor") and "metres" in msg and "230" in msg and "\n" not in msg
+
+
+def test_a_max_field_with_no_tabulated_field_is_refused_naming_it(topogon):
+    with pytest.raises(DataError, match=r"^max_field_deg=0\.1: .*no tabulated field"):
+        calibration_certificate(topogon, max_field_deg=0.1, date=DATE)
+
+
+@pytest.mark.parametrize(
+    "sensor,words", [("1x1", "--field-step 5.2 or less"), ("0.23x0.23", "metres")]
+)
+def test_report_with_a_sensor_with_no_tabulated_field_is_exit_2(sensor, words):
+    # exit 1, "internal error: TypeError: 'int' object is not iterable" (format_certificate)
+    from support import run_cli
+
+    rc, out, err = run_cli(["report", "topogon-like-pestrecov", "--sensor", sensor])
+    assert rc == 2, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "internal error" not in err and "sensor" in err and words in err
+
+
+def test_format_certificate_prints_a_certificate_without_fields(topogon_cert):
+    # defensive: max(8, *()) crashed on a table with no field (TypeError)
+    empty = dataclasses.replace(
+        topogon_cert,
+        fields_deg=np.empty(0),
+        radius_mm=np.empty(0),
+        radial_um=np.empty((4, 0)),
+        tangential_um=np.empty((4, 0)),
+        mean_radial_um=np.empty(0),
+        decentering_profile_um=np.empty(0),
+    )
+    text = format_certificate(empty)
+    assert "no tabulated field" in text and "the last column of the table above" not in text
+    assert all(ln == ln.rstrip() for ln in text.splitlines())  # no rows of empty cells
+    assert "Calibrated focal length (minimax)" in text

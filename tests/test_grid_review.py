@@ -38,6 +38,7 @@ from distortion.grid import (
 )
 from distortion.grid.decompose import UndeterminedFit, distinct_radii
 from distortion.grid.field import MAX_GRID_FIELDS
+from raytrace.errors import TraceError
 from raytrace.files.library import load_lens
 
 
@@ -269,3 +270,53 @@ def test_an_output_under_a_file_says_it_is_a_file(tmp_path):
     (tmp_path / "c.toml").write_text("")
     rc, out, err = run_cli(["report", "cooke-triplet-f4", "-o", str(tmp_path / "c.toml" / "x.pdf")])
     assert (rc, out) == (2, "") and f"{tmp_path / 'c.toml'} is a file, not a folder" in err
+
+
+# ------------------------------------------- radial_by_azimuth / distortion_grid: empty, range
+@pytest.mark.parametrize("az", [[0, math.nan], [math.inf], [0, -math.inf], [1j]])
+def test_azimuths_that_are_no_angles_are_named(cooke, az):
+    # [0, nan] said "fields must be finite numbers" (the wrong keyword); [1j] a TypeError
+    with pytest.raises(TraceError) as e:
+        radial_by_azimuth(cooke, az, fields_deg=[0, 10])
+    assert str(e.value).startswith("azimuths_deg must be finite angles in degrees"), str(e.value)
+
+
+@pytest.mark.parametrize(
+    ("call", "says"),
+    [
+        (lambda c: radial_by_azimuth(c, fields_deg=[]), "no fields given: fields_deg is empty"),
+        (
+            lambda c: radial_by_azimuth(c, object_radii_mm=[], object_distance=1000),
+            "no fields given: object_radii_mm is empty",
+        ),
+        (
+            lambda c: radial_by_azimuth(c, azimuths_deg=[], fields_deg=[0, 10]),
+            "no azimuths given: azimuths_deg is empty",
+        ),
+        (
+            lambda c: distortion_grid(c, fields_x_deg=[], fields_y_deg=[0, 5]),
+            "no fields given: fields_x_deg is empty",
+        ),
+        (
+            lambda c: distortion_grid(c, fields_x_deg=[0, 5], fields_y_deg=[]),
+            "no fields given: fields_y_deg is empty",
+        ),
+        (
+            lambda c: distortion_grid(c, object_x_mm=[], object_y_mm=[0], object_distance=1000),
+            "no fields given: object_x_mm is empty",
+        ),
+    ],
+)
+def test_empty_fields_and_azimuths_are_refused(cooke, call, says):
+    # were accepted: the radial result's repr raised "zero-size array ...", the grid said
+    # "max |D| = nan mm"; characteristic_distortion refuses "no fields given"
+    with pytest.raises(TraceError) as e:
+        call(cooke)
+    assert str(e.value) == says
+
+
+@pytest.mark.parametrize("fields", [[0, 90], [0, 100], [0, 1e300], [0, 179]])
+def test_radial_fields_at_or_beyond_90_degrees_are_refused(cooke, fields):
+    # 100 and 1e300 were traced (tan of the total angle wraps) with 8 failed status flags
+    with pytest.raises(TraceError, match="field angles must lie strictly between -90 and 90"):
+        radial_by_azimuth(cooke, fields_deg=fields)

@@ -151,3 +151,33 @@ def test_object_space_na_follows_optiland():
     assert ours.epd == pytest.approx(
         2 * abs(ours.z_E0 - ours.z_object) * math.tan(math.asin(0.2)), rel=1e-14
     )
+
+
+@pytest.mark.parametrize("text", ["587.5618nm", "0.5875618um", "d"])
+def test_element_power_takes_the_wavelength_strings_of_every_keyword(text):
+    # was numpy's "could not convert string to float: '587.6nm'", no keyword named
+    from raytrace.files.library import load_lens
+    from raytrace.paraxial import element_power
+
+    cooke = load_lens("cooke-triplet-f4")
+    assert element_power(cooke, 1, 2, wavelength=text) == element_power(
+        cooke, 1, 2, wavelength=587.5618
+    )
+
+
+@pytest.mark.parametrize(
+    ("value", "says"),
+    [
+        ("abc", "wavelength: 'abc' is not a number"),
+        ("5mm", "wavelength: 5e+06 nm is outside 100-30000 nm"),
+        (0.5876, "wavelength 0.5876 nm looks like micrometres: write 0.5876um or 587.6nm"),
+    ],
+)
+def test_element_power_refuses_a_wavelength_naming_it(value, says):
+    from raytrace.errors import TraceError
+    from raytrace.files.library import load_lens
+    from raytrace.paraxial import element_power
+
+    with pytest.raises(TraceError) as e:
+        element_power(load_lens("cooke-triplet-f4"), 1, 2, wavelength=value)
+    assert str(e.value).startswith(says), str(e.value)

@@ -203,3 +203,15 @@ def test_csv_and_json_name_the_geometric_radius_alike(capsys):
         if key != "status":
             assert float(row[key]) == pytest.approx(spot[key], rel=1e-15)
     assert row["status"] == spot["status"] == "ok"
+
+
+# ---------------------------------------------------------------- image planes with units
+@pytest.mark.parametrize(
+    ("kw", "text", "mm"), [("s_prime", "50.5mm", 50.5), ("defocus", "20um", 0.02)]
+)
+def test_fans_and_spots_take_image_planes_with_a_unit(cooke, kw, text, mm):
+    # were float()ed: "could not convert string to float: '50.5mm'"; --s-prime 50.5mm worked
+    for call, ys in ((osc.ray_fan, "ey"), (osc.spot_diagram, "y")):
+        with_unit, bare = call(cooke, 10, **{kw: text}), call(cooke, 10, **{kw: mm})
+        assert with_unit.z_plane == bare.z_plane
+        assert np.array_equal(getattr(with_unit, ys), getattr(bare, ys), equal_nan=True)

@@ -9,10 +9,14 @@ explicit unit is taken as meant, and out of range the message gives the range.
 from __future__ import annotations
 
 import math
+import warnings
 
 import pytest
 
+import orthoscope as osc
 from orthoscope.cli import main
+from raytrace.errors import TraceError
+from raytrace.paraxial import ImagePlane, pestrecov_constants
 from raytrace.units import UnitError, length_mm, wavelength_nm
 
 #: a unit glued to a value that already has one ("0.55nmum", "5mmm", "5mmmm", "0.55nmnm")
@@ -131,3 +135,89 @@ def test_cli_object_distance_with_a_wavelength_unit_is_refused_once(capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "unknown length unit 'nm' in '5nm'" in err
     assert not doubled(err), err
+
+
+# ------------------------------------------------------------------------------- image planes
+# The API's image-plane keywords take the lengths the command line's --s-prime,
+# --from-last-vertex and --defocus take, through the one parser (raytrace.units.length_mm): they
+# were read with float() ("could not convert string to float: '50.5mm'", no keyword named).
+PLANE_STRINGS = [
+    ("s_prime", "50.5mm", 50.5),
+    ("s_prime", "5.05cm", 50.5),
+    ("from_last_vertex", "0.043m", 43.0),
+    ("defocus", "100um", 0.1),
+    ("defocus", " -0.1 mm ", -0.1),
+]
+
+
+@pytest.mark.parametrize(("kw", "text", "mm"), PLANE_STRINGS)
+def test_api_image_planes_take_the_cli_length_strings(cooke, kw, text, mm):
+    assert ImagePlane(kw, text) == ImagePlane(kw, mm)
+    assert ImagePlane(kw, text).value == length_mm(text, kw)
+    with_unit = osc.characteristic_distortion(cooke, [0, 10], **{kw: text})
+    bare = osc.characteristic_distortion(cooke, [0, 10], **{kw: mm})
+    assert with_unit.z_planes.tolist() == bare.z_planes.tolist()
+    assert with_unit.D0.tolist() == bare.D0.tolist()
+    if kw == "s_prime":  # Eq. (8)'s constants in that plane take it too
+        par = osc.paraxial(cooke)
+        assert pestrecov_constants(par, text) == pestrecov_constants(par, mm)
+
+
+def test_api_image_plane_lists_may_mix_numbers_and_lengths(cooke):
+    r = osc.characteristic_distortion(cooke, [0, 10], s_prime=["50.5mm", 50.6, "5.07cm"])
+    assert r.s_prime == pytest.approx([50.5, 50.6, 50.7], rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("value", "says"),
+    [
+        ("50.5nm", "s_prime: unknown length unit 'nm' in '50.5nm'; use mm, cm, m, um or in"),
+        ("x", "s_prime: 'x' is not a number (with an optional unit such as mm, m, nm, um)"),
+        (1j, "s_prime: expected a length in mm"),
+        ("inf", "s_prime: expected a finite length, got 'inf'"),
+        (math.nan, "s_prime: expected a finite length, got nan"),
+    ],
+)
+def test_an_image_plane_that_is_no_length_names_the_keyword(cooke, value, says):
+    for call in (
+        lambda: ImagePlane("s_prime", value),
+        lambda: osc.characteristic_distortion(cooke, [0, 10], s_prime=value),
+        lambda: osc.spot_diagram(cooke, 10, s_prime=value),
+        lambda: pestrecov_constants(osc.paraxial(cooke), value),
+    ):
+        with pytest.raises(TraceError) as e:
+            call()
+        assert str(e.value).startswith(says), str(e.value)
+        assert "\n" not in str(e.value) and not doubled(str(e.value))
+
+
+@pytest.mark.parametrize("kw", ["s_prime", "from_last_vertex", "defocus"])
+@pytest.mark.parametrize("value", [1e300, -1e300, 1e10, "1e7m"])
+def test_an_image_plane_at_the_distance_lens_files_call_infinity_is_refused(cooke, kw, value):
+    # 1e300 was traced (max |D0| = 5e296 mm) while inf was refused; Zemax, CODE V and OSLO read
+    # a distance of 1e10 mm or more as infinity (raytrace/files: zemax.py, codev.py, oslo.py)
+    mm = length_mm(value, kw)
+    says = f"{kw}={mm:g} mm is not a plane position: lens-design programs read 1e10 mm or more"
+    for call in (
+        lambda: ImagePlane(kw, value),
+        lambda: osc.characteristic_distortion(cooke, [0, 10], **{kw: value}),
+        lambda: osc.ray_fan(cooke, 10, **{kw: value}),
+    ):
+        with pytest.raises(TraceError) as e:
+            call()
+        assert str(e.value).startswith(says), str(e.value)
+
+
+def test_image_planes_below_the_bound_are_taken_without_a_warning(cooke):
+    assert ImagePlane("from_last_vertex", 9.99e9).value == 9.99e9
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = osc.characteristic_distortion(cooke, [0, 10], defocus=500)
+    assert r.defocus[0] == pytest.approx(500.0, rel=1e-12)
+
+
+def test_cli_s_prime_at_infinity_distance_is_refused_in_one_line(capsys):
+    rc = main(["distortion", "cooke-triplet-f4", "--s-prime", "1e300"])
+    out, err = capsys.readouterr()
+    assert rc == 2 and out == ""
+    assert err.count("\n") == 1 and "--s-prime 1e+300 mm is not a plane position" in err, err

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError
-from .convert import sensor_grid
+from .convert import grid_size, sensor_grid
 from .models import (
     NOT_CONVERGED,
     OK,
@@ -42,6 +42,7 @@ from .models import (
     project_jacobian,
     unproject,
 )
+from .sensor import check_pixel_size_mm
 
 #: azimuths of a radial profile
 N_AZIMUTHS = 72
@@ -123,10 +124,13 @@ def radial_profile(
         Radii in mm when a pixel size is known (the camera's or ``pixel_size_mm``), else in
         pixels. Default: 40 radii from 0 to the half-diagonal of the image.
     pixel_size_mm : (float, float), optional
-        Pixel pitch (mm) when the camera does not carry one.
+        Pixel pitch (mm) when the camera does not carry one (checked as
+        :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it).
     n_azimuths : int
         Points per circle.
     """
+    if pixel_size_mm is not None:
+        pixel_size_mm = check_pixel_size_mm(pixel_size_mm)
     ps = camera.pixel_size_mm or pixel_size_mm
     u0, _ = pinhole_part(camera)
     px, py = ps if ps is not None else (1.0, 1.0)
@@ -246,6 +250,7 @@ def compare_cameras(
     label_measured: str = "measured",
     label_predicted: str = "predicted",
     notes: tuple[str, ...] = (),
+    allow_large: bool = False,
 ) -> CameraComparison:
     """Compare two models of the same sensor (module docstring): the map of the distortion
     difference, the radial profiles, the projection difference and the principal-point and
@@ -256,9 +261,13 @@ def compare_cameras(
     measured, predicted : CameraModel
         Same image size (pixels).
     pixel_size_mm : (float, float), optional
-        Pixel pitch (mm) for profiles in mm and µm (default: the cameras' own).
-    grid : (int, int)
-        Columns × rows of the map over the sensor.
+        Pixel pitch (mm) for profiles in mm and µm (default: the cameras' own); two positive
+        numbers within 0.0003..0.1 mm (the pitch range of :meth:`Sensor.from_spec
+        <distortion.camera.Sensor.from_spec>`: a larger one reads as µm and is refused).
+    grid : (int, int) or int
+        Columns × rows of the map over the sensor (n: n × n), whole numbers of at least 2; at
+        most :data:`raytrace.limits.MAX_FIELDS` points without ``allow_large`` (the limit of
+        :func:`~distortion.grid.field.distortion_grid`).
     radii : array_like, optional
         Radii of the profiles (mm with a pixel size, else px); default 40 up to the
         half-diagonal.
@@ -266,6 +275,8 @@ def compare_cameras(
         Names of the two models in listings and plots.
     notes : tuple of str
         Carried into the result.
+    allow_large : bool
+        Lift the limit on the map's points.
 
     Returns
     -------
@@ -278,10 +289,13 @@ def compare_cameras(
             f"the cameras differ in image size: {measured.width}x{measured.height} (measured) vs "
             f"{predicted.width}x{predicted.height} px; compare calibrations of the same sensor"
         )
+    if pixel_size_mm is not None:
+        pixel_size_mm = check_pixel_size_mm(pixel_size_mm)
+    grid = grid_size(grid, allow_large)
     ps = pixel_size_mm or measured.pixel_size_mm or predicted.pixel_size_mm
     u0m, jm = pinhole_part(measured)
     u0p, jp = pinhole_part(predicted)
-    g = sensor_grid(predicted.width, predicted.height, grid)  # predicted image points
+    g = sensor_grid(predicted.width, predicted.height, grid, allow_large=allow_large)
     q = g - u0p
     dp = distortion_at(predicted, g)
     dm = distortion_at(measured, u0m + q)

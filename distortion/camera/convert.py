@@ -36,6 +36,7 @@ from .models import (
     project,
     unproject,
 )
+from .sensor import check_pixel_size_mm
 
 DEFAULT_GRID = (41, 31)
 
@@ -150,12 +151,28 @@ def smallest_exact(camera: CameraModel, target: str) -> CameraModel:
     raise last
 
 
-def sensor_grid(width: int, height: int, grid: tuple[int, int] = DEFAULT_GRID) -> np.ndarray:
+def grid_size(grid, allow_large: bool = False) -> tuple[int, int]:
+    """(columns, rows) of a grid over the image, checked as
+    :func:`~distortion.grid.field.distortion_grid` checks its ``grid`` (the same functions):
+    ``n`` or ``(nx, ny)``, whole numbers of at least 2, and at most
+    :data:`raytrace.limits.MAX_FIELDS` points unless ``allow_large``. DataError naming
+    ``grid=`` and the fix, before anything is allocated."""
+    from ..grid.field import check_field_count, grid_points
+
+    if grid is None:
+        grid = DEFAULT_GRID
+    gx, gy = grid_points(grid)
+    check_field_count(gx, gy, allow_large, f"grid={grid!r}")
+    return gx, gy
+
+
+def sensor_grid(
+    width: int, height: int, grid: tuple[int, int] = DEFAULT_GRID, *, allow_large: bool = False
+) -> np.ndarray:
     """(gx·gy, 2) OpenCV pixel coordinates of a regular grid over the whole image, from the
-    centre of the first pixel to the centre of the last (corners included)."""
-    gx, gy = (int(v) for v in grid)
-    if gx < 2 or gy < 2:
-        raise DataError(f"grid {grid!r}: at least 2 x 2 points")
+    centre of the first pixel to the centre of the last (corners included); ``grid`` and
+    ``allow_large`` as :func:`grid_size` checks them."""
+    gx, gy = grid_size(grid, allow_large)
     u, v = np.meshgrid(np.linspace(0.0, width - 1.0, gx), np.linspace(0.0, height - 1.0, gy))
     return np.column_stack([u.ravel(), v.ravel()])
 
@@ -183,6 +200,7 @@ def convert_camera_model(
     free: Sequence[str] | int | None = None,
     pixel_size_mm: tuple[float, float] | None = None,
     exact: bool = True,
+    allow_large: bool = False,
 ) -> Conversion:
     """Convert ``camera`` to the model ``target`` over its image.
 
@@ -193,15 +211,19 @@ def convert_camera_model(
     target:
         A model name (:data:`~distortion.camera.models.MODEL_NAMES`).
     grid:
-        Columns × rows of the comparison (and refit) grid over the image.
+        Columns × rows of the comparison (and refit) grid over the image (or n: n × n); at
+        most :data:`raytrace.limits.MAX_FIELDS` points without ``allow_large``.
     free:
         Parameters a refit may change (default: all of the target's; for ``opencv`` fx fy cx cy
         and the 8 coefficients k1..k6 p1 p2 — give 12 or 14 to add prism and tilt).
     pixel_size_mm:
-        Pixel size for a target in mm (``australis``) when the source has none.
+        Pixel size (mm) for a target in mm (``australis``) when the source has none; checked
+        as :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it (0.0003..0.1 mm).
     exact:
         Try exact algebra first (default; not when ``free`` is given: naming what a refit may
         change asks for a refit). ``False`` forces a refit.
+    allow_large:
+        Lift the limit on the grid's points.
 
     Returns
     -------
@@ -209,6 +231,9 @@ def convert_camera_model(
         With ``method``, the residual over the grid and the terms the target could not hold.
     """
     spec = model_spec(target)
+    if pixel_size_mm is not None:
+        pixel_size_mm = check_pixel_size_mm(pixel_size_mm)
+    grid = grid_size(grid, allow_large)
     ps = camera.pixel_size_mm or pixel_size_mm
     if spec.frame == "photo_mm" and ps is None:
         raise DataError(

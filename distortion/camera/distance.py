@@ -45,8 +45,19 @@ import numpy as np
 
 from ..errors import DataError
 from .models import OPENCV_ORDERS, CameraModel
+from .sensor import check_pixel_size_mm
 
 METHODS = ("brown", "fraser-shortis")
+#: the fewest radii of a calibrated profile: opencv_model fits k1, k2, k3 to it
+MIN_RADII = 3
+#: the range of c / f accepted between the calibrations' principal distance c and the focal
+#: length f of Brown's formulas: c = f (1 + m) for a thin lens at magnification m, so c/f is 1
+#: at infinity and 2 at 1:1; 0.5..5 leaves room for a nominal f and macro up to 4:1, while f in
+#: metres or µm (c/f near 1000 or 0.001), centimetres (10) or inches (25) falls outside
+FOCAL_RATIO_RANGE = (0.5, 5.0)
+#: unit slips tried for a refused focal length: (name, symbol, mm per unit)
+_SLIPS = (("metres", "m", 1000.0), ("centimetres", "cm", 10.0), ("inches", "in", 25.4),
+          ("micrometres", "µm", 1e-3))  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -233,6 +244,45 @@ def _distance(v, what: str) -> float:
     return d
 
 
+def _check_focal_length(f: float, cals: Sequence[CameraModel], ps) -> None:
+    """Refuse an f of Brown's formulas whose ratio to the calibrations' principal distances c
+    (mm, from each model's Jacobian on the axis) lies outside :data:`FOCAL_RATIO_RANGE`,
+    naming the unit that would bring it inside."""
+    from .compare import pinhole_part
+
+    cs = []
+    for cal in cals:
+        _, j = pinhole_part(cal)
+        cs.append(0.5 * (abs(j[0, 0]) * ps[0] + abs(j[1, 1]) * ps[1]))
+    lo, hi = FOCAL_RATIO_RANGE
+    if all(lo <= c / f <= hi for c in cs):
+        return
+    fix = "give f in mm"
+    for name, sym, mm in _SLIPS:
+        if all(lo <= c / (f * mm) <= hi for c in cs):
+            fix = f"{name}? {f:g} {sym} = {f * mm:g} mm; {fix}"
+            break
+    raise DataError(
+        f"focal_length_mm={f:g} mm is far from the calibrations' principal distances "
+        f"{' and '.join(f'{c:.4g}' for c in cs)} mm (c/f = "
+        f"{' and '.join(f'{c / f:.4g}' for c in cs)}; c = f (1 + magnification), so c/f lies "
+        f"within {lo:g}..{hi:g}): {fix}"
+    )
+
+
+def _check_n_radii(n_radii) -> int:
+    """n_radii as a whole number of radii, MIN_RADII..MAX_FIELDS; DataError naming it."""
+    from raytrace.limits import MAX_FIELDS
+    from raytrace.units import is_whole
+
+    if not (is_whole(n_radii) and MIN_RADII <= int(n_radii) <= MAX_FIELDS):
+        raise DataError(
+            f"n_radii={n_radii!r}: give a whole number of radii, {MIN_RADII}..{MAX_FIELDS} "
+            "(k1, k2, k3 are fitted to the profiles)"
+        )
+    return int(n_radii)
+
+
 def _opencv_of(cal: CameraModel, what: str):
     """(camera in OpenCV's 5-term form, note) — exact when it can be, else a refit."""
     from .convert import convert_camera_model
@@ -275,15 +325,20 @@ def calibrated_models_by_distance(
     s1, s2, focus : float or str
         Distances from the lens (mm, or with a unit: ``"2m"``; ``"inf"``), beyond f.
     focal_length_mm : float
-        f of Brown's formulas (mm).
+        f of Brown's formulas (mm). Refused when the calibrations' principal distance c is not
+        within 0.5..5 × f (:data:`FOCAL_RATIO_RANGE`; c = f (1 + magnification)): f in metres,
+        centimetres, inches or µm.
     object_distances : sequence
         s' of each row (distances from the lens).
     method : {"brown", "fraser-shortis"}
         Eq. (1), or Eq. (6) with ``g``.
     pixel_size_mm : (float, float), optional
-        Pixel pitch (mm) when the calibrations carry none.
+        Pixel pitch (mm) when the calibrations carry none (checked as
+        :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it: 0.0003..0.1 mm).
     n_radii : int
-        Radii of the profiles, from 0 to the half-diagonal.
+        Radii of the profiles, from half-diagonal / n_radii to the half-diagonal: a whole
+        number, at least 3 (:data:`MIN_RADII`: k1, k2, k3 are fitted to them), at most
+        :data:`raytrace.limits.MAX_FIELDS`.
 
     Returns
     -------
@@ -309,12 +364,16 @@ def calibrated_models_by_distance(
     c1, c2 = calibration_1, calibration_2
     if (c1.width, c1.height) != (c2.width, c2.height):
         raise DataError("the two calibrations are of different image sizes")
+    if pixel_size_mm is not None:
+        pixel_size_mm = check_pixel_size_mm(pixel_size_mm)
     ps = pixel_size_mm or c1.pixel_size_mm or c2.pixel_size_mm
     if ps is None:
         raise DataError("give pixel_size_mm=(pitch_x, pitch_y) in mm: the profiles are in mm")
+    n_radii = _check_n_radii(n_radii)
     f = float(focal_length_mm)
-    if not f > 0:
+    if not (f > 0 and math.isfinite(f)):
         raise DataError(f"focal_length_mm must be positive, got {focal_length_mm!r}")
+    _check_focal_length(f, (c1, c2), ps)
     s1v, s2v, sv = (_distance(v, w) for v, w in ((s1, "s1"), (s2, "s2"), (focus, "focus")))
     objs = [_distance(v, "object distance") for v in object_distances]
     if not objs:

@@ -74,7 +74,7 @@ from .conventions import (
     photo_mm_to_opencv_pixels,
     pixel_centre_offset,
 )
-from .sensor import Sensor
+from .sensor import Sensor, check_pixel_size_mm, check_principal_distance_mm
 
 # ---- status codes ---------------------------------------------------------------------------
 OK = 0
@@ -970,9 +970,7 @@ class CameraModel:
                 raise DataError(f"camera model {name}: image {n} must be a positive integer")
             object.__setattr__(self, n, int(v))
         if self.pixel_size_mm is not None:
-            ps = tuple(float(v) for v in self.pixel_size_mm)
-            if len(ps) != 2 or not all(math.isfinite(v) and v > 0 for v in ps):
-                raise DataError(f"camera model {name}: pixel_size_mm must be two positive mm")
+            ps = check_pixel_size_mm(self.pixel_size_mm, f"camera model {name}: ")
             object.__setattr__(self, "pixel_size_mm", ps)
         elif spec.frame == "photo_mm":
             raise DataError(
@@ -1142,12 +1140,16 @@ def camera_from_sensor(
     Raises
     ------
     DataError
-        A principal distance that is not positive and finite, an unknown model, a parameter the
-        model does not have.
+        A principal distance that is not positive and finite, or in the wrong unit (a field
+        angle at the sensor's farthest corner above 87° or below 0.057°:
+        :func:`~distortion.camera.sensor.check_principal_distance_mm`), an unknown model, a
+        parameter the model does not have.
     """
-    c = float(principal_distance_mm)
-    if not (math.isfinite(c) and c > 0):
-        raise DataError(f"principal distance must be positive (mm), got {principal_distance_mm!r}")
+    dx, dy = sensor.principal_point_offset_mm
+    largest = math.hypot(sensor.width_mm / 2.0 + abs(dx), sensor.height_mm / 2.0 + abs(dy))
+    c = check_principal_distance_mm(
+        principal_distance_mm, largest, f"principal_distance_mm={principal_distance_mm!r}:"
+    )
     px, py = sensor.pixel_size_mm
     cu, cv = sensor.principal_point("opencv")
     cam = pinhole_camera(

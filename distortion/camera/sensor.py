@@ -29,6 +29,12 @@ from .conventions import (
 PITCH_RANGE_UM = (0.3, 100.0)
 SIZE_RANGE_MM = (0.5, 1000.0)
 MAX_PIXELS = 1_000_000
+#: the largest principal distance accepted, as a multiple of the sensor's largest radius from the
+#: principal point: 1000 is a field half-angle of 0.057°. A 50 mm lens given in µm (50000) on a
+#: full-frame sensor (half-diagonal 21.6 mm) is 2311, a 4.3 mm phone lens given in µm on a
+#: 7.7 mm-diagonal sensor 1117; long lenses stay far below (2000 mm on APS-C, half-diagonal
+#: 14.2 mm: 141). A telescope of more than 1000 × the sensor's half-diagonal is refused too.
+MAX_PRINCIPAL_DISTANCE_RATIO = 1000.0
 
 _PAIR = re.compile(r"^\s*([^x×*,]+?)\s*(?:[x×*,]\s*([^x×*,]+?))?\s*$", re.IGNORECASE)
 _NUM_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zA-Zµμ]*)\s*$")
@@ -43,6 +49,139 @@ _UM = {
     "nm": 1e-3,
 }
 _MM = {"": 1.0, "mm": 1.0, "cm": 10.0, "m": 1000.0, "um": 1e-3, "µm": 1e-3, "μm": 1e-3}
+
+
+def unit_slip(value: float, lo: float, hi: float, factor: float = 1000.0) -> float | None:
+    """The value a slip of one unit step would have meant, when ``value`` lies outside
+    [lo, hi]: ``value * factor`` when it lies below (metres for mm, mm for µm), ``value /
+    factor`` when above (µm for mm, nm for µm) — if that lies inside; None otherwise (and for a
+    value inside the range). The one rule behind the "looks like the wrong unit" refusals of
+    this module: the pitch (:func:`parse_pitch_um`, :func:`check_pixel_size_mm`), the size
+    (:func:`parse_size_mm`) and the principal distance (:func:`check_principal_distance_mm`)."""
+    if value < lo:
+        alt = value * factor
+    elif value > hi:
+        alt = value / factor
+    else:
+        return None
+    return alt if lo <= alt <= hi else None
+
+
+def size_problem(value_mm: float) -> str | None:
+    """Why a sensor side of ``value_mm`` is refused (outside :data:`SIZE_RANGE_MM`, with the unit
+    it looks like: metres below, µm above), or None."""
+    lo, hi = SIZE_RANGE_MM
+    if lo <= value_mm <= hi:
+        return None
+    why = f"{value_mm:g} mm is outside {lo:g}..{hi:g} mm"
+    alt = unit_slip(value_mm, lo, hi)
+    if alt is not None:
+        unit = "metres" if value_mm < lo else "micrometres"
+        sym = "m" if value_mm < lo else "µm"
+        why += f"; {unit}? {value_mm:g} {sym} = {alt:g} mm"
+    return why + "; sizes are in mm (a full-frame sensor is 36x24)"
+
+
+def _pair_text(value) -> str:
+    """``(6, 6)`` of a sequence of numbers, else its repr (for the messages)."""
+    if isinstance(value, str | bytes):
+        return repr(value)
+    try:
+        vals = [float(v) for v in value]
+    except (TypeError, ValueError):
+        return repr(value)
+    return "(" + ", ".join(f"{v:g}" for v in vals) + ")"
+
+
+def check_pixel_size_mm(pixel_size_mm, head: str = "") -> tuple[float, float]:
+    """``(pitch_x, pitch_y)`` in mm, checked as :meth:`Sensor.from_spec` checks a pixel pitch:
+    two positive finite numbers within :data:`PITCH_RANGE_UM` (0.0003..0.1 mm); one above that
+    reads as micrometres given for mm, one below as metres (the message says which and gives
+    the pair in mm). ``head`` is put before the message (e.g. ``"camera model opencv: "``).
+
+    Raises
+    ------
+    DataError
+        ``pixel_size_mm=(6, 6): a pixel pitch of 6 mm is above 0.1 mm; micrometres? give
+        (0.006, 0.006) mm``.
+    """
+    label = f"{head}pixel_size_mm={_pair_text(pixel_size_mm)}"
+    try:
+        vals = tuple(float(v) for v in pixel_size_mm)
+    except (TypeError, ValueError):
+        vals = ()
+    if (
+        isinstance(pixel_size_mm, str)
+        or len(vals) != 2
+        or not all(math.isfinite(v) and v > 0 for v in vals)
+    ):
+        raise DataError(
+            f"{label}: give (pitch_x, pitch_y) in mm, two positive numbers, e.g. (0.006, 0.006)"
+        )
+    lo, hi = (v / 1000.0 for v in PITCH_RANGE_UM)
+    for v in vals:
+        if lo <= v <= hi:
+            continue
+        side = f"above {hi:g} mm" if v > hi else f"below {lo:g} mm"
+        # the pair as meant: each value out of range moved by the same unit step
+        fixed = [w if lo <= w <= hi else unit_slip(w, lo, hi) for w in vals]
+        if None not in fixed and all((w > hi) == (v > hi) for w in vals if not lo <= w <= hi):
+            unit = "micrometres" if v > hi else "metres"
+            fix = f"{unit}? give ({fixed[0]:g}, {fixed[1]:g}) mm"
+        else:
+            fix = "give the pitch in mm, e.g. (0.006, 0.006)"
+        raise DataError(f"{label}: a pixel pitch of {v:g} mm is {side}; {fix}")
+    return vals[0], vals[1]
+
+
+def check_principal_distance_mm(
+    principal_distance_mm, largest_radius_mm: float, what: str = "principal distance:"
+) -> float:
+    """The principal distance c (mm), checked against the largest image radius it serves: a
+    positive finite number, and a field angle atan(r / c) that a camera has — at most
+    atan(:data:`distortion.coefficients.MAX_RADIUS_RATIO`) = 87° (the bound of
+    :func:`distortion.coefficients.opencv_model`: c in metres, or a pitch in mm for µm, gives
+    more) and at least atan(1 / :data:`MAX_PRINCIPAL_DISTANCE_RATIO`) = 0.057° (c in µm gives
+    less). ``what`` names the value (``"principal_distance_mm=0.05:"`` names the keyword).
+
+    Raises
+    ------
+    DataError
+        Naming ``what``, the ratio and field angle, and the unit the value looks like.
+    """
+    from ..coefficients import MAX_RADIUS_RATIO  # not at import: coefficients imports models
+
+    try:
+        c = float(principal_distance_mm)
+    except (TypeError, ValueError):
+        c = math.nan
+    if isinstance(principal_distance_mm, bool) or not (math.isfinite(c) and c > 0):
+        raise DataError(f"{what} give the principal distance c in mm, a positive number (e.g. 50)")
+    r = float(largest_radius_mm)
+    lo, hi = r / MAX_RADIUS_RATIO, r * MAX_PRINCIPAL_DISTANCE_RATIO  # c in mm
+    angle = f"(a field angle of {math.degrees(math.atan(r / c)):.4g}°)"
+    alt = unit_slip(c, lo, hi)
+    if c < lo:
+        fix = (
+            f"metres? {c:g} m = {alt:g} mm; give c in mm"
+            if alt is not None
+            else "is it in the wrong unit (metres for mm, or a pixel pitch in mm for µm)?"
+        )
+        raise DataError(
+            f"{what} {c:g} mm is {r / c:.3g} times smaller than the sensor's largest radius "
+            f"{r:.3g} mm {angle}: {fix}"
+        )
+    if c > hi:
+        fix = (
+            f"micrometres? {c:g} µm = {alt:g} mm; give c in mm"
+            if alt is not None
+            else "is it in the wrong unit?"
+        )
+        raise DataError(
+            f"{what} {c:g} mm is {c / r:.4g} times the sensor's largest radius {r:.3g} mm "
+            f"{angle}; more than {MAX_PRINCIPAL_DISTANCE_RATIO:g} times is refused: {fix}"
+        )
+    return c
 
 
 def _split_pair(text: str, what: str, example: str) -> tuple[str, str | None]:
@@ -86,6 +225,11 @@ def parse_size_mm(size: str | Sequence[float]) -> tuple[float, float]:
     if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
         label = size.strip() if isinstance(size, str) else f"{w:g}x{h:g}"
         raise DataError(f"sensor {label}: width and height must be positive (mm)")
+    for side, v in (("width", w), ("height", h)):
+        why = size_problem(v)
+        if why is not None:
+            label = repr(size.strip()) if isinstance(size, str) else f"({w:g}, {h:g})"
+            raise DataError(f"sensor size {label}: the {side} {why}")
     return w, h
 
 
@@ -132,7 +276,7 @@ def parse_pitch_um(pitch: str | float | Sequence[float]) -> tuple[float, float]:
         if not (math.isfinite(v) and v > 0):
             raise DataError(f"pixel pitch {pitch!r}: must be positive (µm)")
         if v < lo:
-            if not explicit and lo <= v * 1000.0 <= hi:
+            if not explicit and unit_slip(v, lo, hi) is not None:
                 raise DataError(
                     f"pixel pitch {v:g} µm looks like millimetres ({v * 1000:g} µm = {v:g} mm);"
                     f" give the pitch in micrometres ({v * 1000:g}) or write '{v:g}mm'"
@@ -173,7 +317,8 @@ class Sensor:
     principal_point_offset_mm:
         (dx, dy) of the principal point (where the optical axis meets the sensor) from the sensor
         centre, in mm, photogrammetric axes: **x right, y up** (Australis' xp, yp of a camera
-        whose image centre is the sensor centre).
+        whose image centre is the sensor centre); on the sensor (|dx| ≤ width/2, |dy| ≤
+        height/2): an offset beyond it is refused (as µm when it would fit read so).
 
     Build it from strings or numbers with :meth:`from_spec`; the constructor checks
     consistency and ranges and raises :class:`~distortion.errors.DataError` naming the fix.
@@ -191,20 +336,18 @@ class Sensor:
             if isinstance(v, bool) or not float(v) == int(v) or not 0 < int(v) <= MAX_PIXELS:
                 raise DataError(f"Sensor {name}={v!r}: a whole number of pixels, 1..{MAX_PIXELS}")
             object.__setattr__(self, name, int(v))
-        lo, hi = SIZE_RANGE_MM
         for name in ("width_mm", "height_mm"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v > 0):
                 raise DataError(f"Sensor {name}={v!r}: must be positive (mm)")
-            if not lo <= v <= hi:
-                raise DataError(
-                    f"Sensor {name}={v:g} mm is outside {lo:g}..{hi:g} mm; sizes are in mm "
-                    "(a full-frame sensor is 36x24)"
-                )
+            why = size_problem(v)
+            if why is not None:
+                raise DataError(f"Sensor {name}={why}")
             object.__setattr__(self, name, v)
         object.__setattr__(
             self, "principal_point_offset_mm", _parse_offset(self.principal_point_offset_mm)
         )
+        self._check_offset()
         px, py = self.pixel_pitch_um
         lo, hi = PITCH_RANGE_UM
         if not all(lo <= v <= hi for v in (px, py)):
@@ -222,6 +365,22 @@ class Sensor:
                 ),
                 stacklevel=3,
             )
+
+    def _check_offset(self) -> None:
+        """Refuse a principal point off the sensor (|dx| > width/2 or |dy| > height/2; on the
+        edge is on it); when it would lie on it read as µm, say so."""
+        dx, dy = self.principal_point_offset_mm
+        hw, hh = self.width_mm / 2.0, self.height_mm / 2.0
+        if abs(dx) <= hw and abs(dy) <= hh:
+            return
+        fix = "give the offset from the sensor centre in mm (x right, y up)"
+        if abs(dx) / 1000.0 <= hw and abs(dy) / 1000.0 <= hh:
+            fix = f"micrometres? give ({dx / 1000.0:g}, {dy / 1000.0:g}) mm"
+        raise DataError(
+            f"principal-point offset {dx:g},{dy:g}: ({dx:g}, {dy:g}) mm lies outside the "
+            f"{self.width_mm:g}x{self.height_mm:g} mm sensor (|dx| ≤ {hw:g}, |dy| ≤ {hh:g} mm); "
+            f"{fix}"
+        )
 
     # ---- construction -----------------------------------------------------------------------
     @classmethod
@@ -245,7 +404,7 @@ class Sensor:
             pixel count the count is size / pitch rounded to whole pixels and the size becomes
             count × pitch.
         principal_point_offset_mm:
-            (dx, dy) from the sensor centre in mm, x right, y up (or ``"dx,dy"``).
+            (dx, dy) from the sensor centre in mm, x right, y up (or ``"dx,dy"``); on the sensor.
         """
         given = [
             n

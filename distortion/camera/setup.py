@@ -65,7 +65,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from raytrace.trace.results import object_words
-from raytrace.units import UnitError, image_scale, length_mm, wavelength_nm
+from raytrace.units import UnitError, image_scale, length_mm, plane_distance_mm, wavelength_nm
 
 from ..errors import DataError, read_text
 from .sensor import Sensor
@@ -267,8 +267,9 @@ def _in_units(
     Parameters
     ----------
     convert : callable
-        :func:`~raytrace.units.length_mm` (→ mm), :func:`~raytrace.units.image_scale` (→ N,
-        dimensionless) or :func:`~raytrace.units.wavelength_nm` (→ nm).
+        :func:`~raytrace.units.length_mm` or :func:`~raytrace.units.plane_distance_mm` (→ mm),
+        :func:`~raytrace.units.image_scale` (→ N, dimensionless) or
+        :func:`~raytrace.units.wavelength_nm` (→ nm).
     value : float, str or None
         The value as given: a number in the parser's default unit, or a string with a unit
         (``"2m"``, ``"12x"``, ``"0.5876um"``). None: not given.
@@ -353,7 +354,7 @@ def resolve_setup(lens, setup: CameraSetup) -> CameraGeometry:
         what = f"focused at {setup.describe_focus()}"
     elif any(getattr(setup, k) is not None for k in _PLANE_KEYS):
         kind = next(k for k in _PLANE_KEYS if getattr(setup, k) is not None)
-        v = _in_units(length_mm, getattr(setup, kind), kind)
+        v = _in_units(plane_distance_mm, getattr(setup, kind), kind)
         z = {
             "s_prime": par_ref.z_from_s_prime,
             "from_last_vertex": par_ref.z_from_last_vertex,

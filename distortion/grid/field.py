@@ -284,7 +284,8 @@ def distortion_grid(
         positive, finite mm.
     plane, s_prime, from_last_vertex, defocus
         The image plane(s) (docs/design.md, "Vocabulary"); default the Gaussian plane. All planes
-        come from one trace.
+        come from one trace. Distances in mm, or strings with a length unit as the command line
+        takes them (``"50.5mm"``).
     object_distance, object_s, object_scale
         The object plane (at most one); default the lens's.
     reference_point : {"axial", "ppa", "ppbs"}
@@ -309,7 +310,7 @@ def distortion_grid(
         raise TraceError(
             f"reference_point={reference_point!r}; use one of {', '.join(REFERENCE_POINTS)}"
         )
-    nx, ny = _grid_size(grid)
+    nx, ny = grid_points(grid)
     s = sensor_size(sensor) if sensor is not None else None
     given = requested_fields_2d(fields_x_deg, fields_y_deg, object_x_mm, object_y_mm)
     if given is not None and sensor is not None:
@@ -317,9 +318,15 @@ def distortion_grid(
     if given is not None:
         kind, ax, ay = given
         ax, ay = np.atleast_1d(ax).ravel(), np.atleast_1d(ay).ravel()
-        _check_count(ax.size, ay.size, allow_large, "the fields")
+        names = (
+            ("fields_x_deg", "fields_y_deg") if kind == "angle" else ("object_x_mm", "object_y_mm")
+        )
+        for name, a in zip(names, (ax, ay), strict=True):
+            if a.size == 0:  # as characteristic_distortion: an empty grid has no distortion
+                raise TraceError(f"no fields given: {name} is empty")
+        check_field_count(ax.size, ay.size, allow_large, "the fields")
     else:
-        _check_count(nx, ny, allow_large, f"grid={grid!r}" if grid is not None else "the grid")
+        check_field_count(nx, ny, allow_large, f"grid={grid!r}" if grid is not None else "the grid")
     # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
     # centred lens (raytrace.paraxial refuses a lens that is not centred)
     par = resolve_paraxial(lens, object_distance, object_s, object_scale, wavelength, nominal=True)
@@ -343,7 +350,7 @@ def distortion_grid(
     )
 
 
-def _grid_size(grid) -> tuple[int, int]:
+def grid_points(grid) -> tuple[int, int]:
     """(nx, ny) of ``grid`` (n or (nx, ny), whole numbers >= 2); DataError naming the fix."""
     if grid is None:
         return DEFAULT_GRID
@@ -361,7 +368,7 @@ def _grid_size(grid) -> tuple[int, int]:
     return int(vals[0]), int(vals[1])
 
 
-def _check_count(nx: int, ny: int, allow_large: bool, what: str) -> None:
+def check_field_count(nx: int, ny: int, allow_large: bool, what: str) -> None:
     """Refuse more than ``MAX_GRID_FIELDS`` fields without ``allow_large``, before any work."""
     n = int(nx) * int(ny)
     if n > MAX_GRID_FIELDS and not allow_large:
@@ -632,6 +639,7 @@ def radial_by_azimuth(
     """
     require_lens(lens)
     from raytrace.paraxial import resolve_paraxial
+    from raytrace.trace.chief import checked_aim_request
 
     # a decentered or tilted lens: the first-order data (ideal image, camera constant) of its
     # centred lens (raytrace.paraxial refuses a lens that is not centred)
@@ -639,10 +647,24 @@ def radial_by_azimuth(
     kind, r = requested_fields(
         lens, par.infinite, fields_deg, object_radii_mm, heights_name="object_radii_mm"
     )
+    if r.size == 0:  # as characteristic_distortion
+        name = "object_radii_mm" if object_radii_mm is not None else "fields_deg"
+        raise TraceError(f"no fields given: {name} is empty")
     if np.any(r < 0):
         raise TraceError("radial fields are total field angles or radii: give values >= 0")
-    az = np.atleast_1d(np.asarray(azimuths_deg, dtype=float)).ravel()
-    _check_count(az.size, r.size, allow_large, "azimuths x fields")
+    # the range check of every aim (finite; angles strictly within ±90°) on the total field: a
+    # field of 100° would otherwise wrap through tan into one within ±90° and be traced
+    checked_aim_request(kind, par.object_distance, r, heights="object radii")
+    what = "azimuths_deg must be finite angles in degrees (from +x toward +y)"
+    try:
+        az = np.atleast_1d(np.asarray(azimuths_deg, dtype=float)).ravel()
+    except (TypeError, ValueError):
+        raise TraceError(f"{what}, got {azimuths_deg!r}") from None
+    if az.size == 0:
+        raise TraceError("no azimuths given: azimuths_deg is empty")
+    if not np.all(np.isfinite(az)):
+        raise TraceError(f"{what}, got {az[~np.isfinite(az)][0]:g}")
+    check_field_count(az.size, r.size, allow_large, "azimuths x fields")
     phi = np.radians(az)[:, None]
     if kind == "angle":
         T = np.tan(np.radians(r))[None, :]

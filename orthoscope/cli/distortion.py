@@ -40,7 +40,11 @@ METHOD_HELP = (
     "at the two --at fields, the paper's example), 'minimax' (smallest max |Dc| over the fields, "
     "exact), 'least-squares', 'zero-at' (Dc = 0 at the --at field), 'given' (--value Fc or Mc)."
 )
-AT_HELP = "Field(s) for two-point (two) or zero-at (one): degrees or object heights, A,B."
+AT_HELP = (
+    "Field(s) for two-point (two) or zero-at (one): degrees or object heights, A,B; traced with "
+    "the run's fields (a value up to pi/2 that is no field of the run is refused as looking like "
+    "radians; list it in --fields to calibrate there)."
+)
 EXAGGERATION_HELP = (
     "Plot exaggeration k of the distortion scale (Eq. 14: tan rho_k = k (Fc/F0 - 1)). Default: 200."
 )
@@ -94,7 +98,7 @@ def add_calibration_args(q: argparse.ArgumentParser, *, required: bool) -> None:
 def cmd_distortion(args) -> int:
     import numpy as np
 
-    from distortion.calibration import calibrate
+    from distortion.calibration import calibrate, calibration_fields, looks_like_radians
 
     from ..report.distortion import (
         calibration_to_dict,
@@ -109,9 +113,6 @@ def cmd_distortion(args) -> int:
         return _grid(args, lens)
     od = resolve_object(lens, args)
     fields, kind = resolve_fields(lens, args)
-    at = at_fields(args.at)
-    if at:
-        fields = np.union1d(fields, np.array(at))
     check_plot_paths(args, "plot", "plot_rotation", "layout")
     planes = resolve_planes(lens, args)
     check_finite_object(kind, od)
@@ -123,9 +124,18 @@ def cmd_distortion(args) -> int:
         raise CliError("--focal needs --definition NAME")
     if args.wavelengths is not None:
         return _by_wavelength(lens, fields, kind, od, planes, args)
-    res = _characteristic(lens, fields, kind, od, planes, args, wavelength=args.wavelength)
     if args.calibrate is None and (args.at is not None or args.value is not None):
         raise CliError("--at and --value need --calibrate METHOD")
+    at = at_fields(args.at) or ()
+    if args.calibrate:  # --at names fields of the run: calibrate's own check, before the trace
+        span = max(float(np.max(np.abs(fields))), 1.0)
+        # the --at fields are traced too, except one that looks like radians (0.65 for 37.5°):
+        # unless the run's fields hold it, calibrate's check refuses it, saying so
+        fields = np.union1d(
+            fields, [a for a in at if kind != "angle" or not looks_like_radians(a, span)]
+        )
+        calibration_fields(fields, args.calibrate, at, angles=kind == "angle")
+    res = _characteristic(lens, fields, kind, od, planes, args, wavelength=args.wavelength)
     cals = (
         [
             calibrate(res, args.calibrate, at=at, value=args.value, k=args.exaggeration, plane=i)
@@ -179,6 +189,8 @@ def _by_wavelength(lens, fields, kind, od, planes, args) -> int:
         (
             ("--wavelength", args.wavelength is not None),
             ("--calibrate", args.calibrate is not None),
+            ("--at", args.at is not None),
+            ("--value", args.value is not None),
             ("--csv", args.csv),
             ("--plot-rotation", args.plot_rotation),
             ("--layout", args.layout),

@@ -378,19 +378,24 @@ def format_certificate(cert_or_dict) -> str:
     lw = max(len(r[0]) for r in rows)
     across = len(head) <= ACROSS_MAX_FIELDS
     if across:
-        cw = max(8, *(len(c.text) for _, cs in rows for c in cs), *(len(c.text) for c in head))
+        # a list, not max(8, *cells): an empty table (no field) is 8 wide, not a TypeError
+        cw = max([8, *(len(c.text) for _, cs in rows for c in cs), *(len(c.text) for c in head)])
         cw += 1
         out += ["", "Radial distortion (um) along the semi-diagonals"]
-        out.append(f"  {'field angle (deg)':<{lw}}" + "".join(c.text.rjust(cw) for c in head))
-        for lab, cs in rows:
-            out.append(f"  {lab:<{lw}}" + "".join(c.text.rjust(cw) for c in cs))
+        if not head:  # the API refuses such a format; a certificate made otherwise still prints
+            out.append("  no tabulated field: the format lies within 5 % of the field step")
+        else:
+            out.append(f"  {'field angle (deg)':<{lw}}" + "".join(c.text.rjust(cw) for c in head))
+            for lab, cs in rows:
+                out.append(f"  {lab:<{lw}}" + "".join(c.text.rjust(cw) for c in cs))
     else:
         out += ["", *_rows_table(d, head, rows, prof)]
     out += ["", "Decentering distortion"]
     for lab, c, unit in params:
         out.append(f"  {lab:<{kw}}{c.text:>18} {unit}")
     if across:
-        out.append(f"  {'profile J r^2 (um)':<{lw}}" + "".join(c.text.rjust(cw) for c in prof))
+        if prof:  # (none without a tabulated field)
+            out.append(f"  {'profile J r^2 (um)':<{lw}}" + "".join(c.text.rjust(cw) for c in prof))
     else:
         out.append(f"  {'profile J r^2 (um)':<{kw}}the last column of the table above")
     out += ["", "Radial distortion coefficients (mean curve): " + d["radial_coefficients"]["form"]]

@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import TraceError
+from ..units import UnitError, plane_distance_mm
 from .orthoscopy import object_distance_for_magnification
 
 if TYPE_CHECKING:
@@ -56,19 +57,25 @@ class ImagePlane:
 
     kind:  ``"s_prime"`` | ``"from_last_vertex"`` | ``"defocus"`` | ``"gaussian"`` | ``"file"``
            | ``"gaussian_reference"``.
-    value: the distance in mm for the first three kinds (ignored for the others).
+    value: the distance for the first three kinds (ignored for the others): a number in mm or a
+           string with a length unit as the command line takes it (``"50.5mm"``, ``"5cm"``,
+           :func:`raytrace.units.plane_distance_mm`); stored as a float in mm. TraceError,
+           naming the kind, for a value that is not a length, not finite, or 1e10 mm or more
+           (:data:`raytrace.units.PLANE_LIMIT_MM`).
     """
 
     kind: str
-    value: float = 0.0
+    value: float | str = 0.0
 
     def __post_init__(self) -> None:
         if self.kind not in PLANE_KINDS:
             raise TraceError(
                 f"unknown image-plane kind {self.kind!r}; expected one of {', '.join(PLANE_KINDS)}"
             )
-        if not math.isfinite(self.value):
-            raise TraceError(f"image plane {self.kind}: expected a finite distance in mm")
+        try:  # the one parser of the command line's --s-prime / --from-last-vertex / --defocus
+            object.__setattr__(self, "value", plane_distance_mm(self.value, self.kind))
+        except UnitError as e:
+            raise TraceError(str(e)) from None
 
     def z(self, par: ParaxialResult) -> float:
         """Absolute z (mm from the first vertex) of this plane for the paraxial data ``par``."""
@@ -103,7 +110,8 @@ def image_planes(
 ) -> list[ImagePlane]:
     """The image planes a call asks for: ``plane`` (an :class:`ImagePlane`, a list of them, or
     ``"gaussian"`` / ``"file"``) or ONE of the keywords ``s_prime`` / ``from_last_vertex`` /
-    ``defocus`` (a number or a sequence of numbers, mm). Nothing → the Gaussian plane."""
+    ``defocus`` (a distance or a sequence of them: numbers in mm or strings with a length unit,
+    ``"50.5mm"``, as :class:`ImagePlane` takes them). Nothing → the Gaussian plane."""
     kw = {
         k: v
         for k, v in (
@@ -119,10 +127,12 @@ def image_planes(
         )
     if kw:
         ((kind, v),) = kw.items()
-        arr = np.atleast_1d(np.asarray(v, dtype=float)).ravel()
-        if arr.size == 0:
+        # objects, not floats: a distance may be a string with its unit ("50.5mm"), read by
+        # ImagePlane with the command line's parser
+        items = np.asarray(v, dtype=object).ravel().tolist()
+        if not items:
             raise TraceError(f"{kind}: no image plane given")
-        return [ImagePlane(kind, float(x)) for x in arr]
+        return [ImagePlane(kind, x) for x in items]
     if plane is None:
         return [ImagePlane("gaussian")]
     if isinstance(plane, str):

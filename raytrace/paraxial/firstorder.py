@@ -329,7 +329,24 @@ def gaussian_solved(lens: Lens) -> Lens:
     return replace(lens.with_image_distance(d), image_solve="gaussian")
 
 
-def element_power(lens: Lens, first: int, last: int, wavelength: float | None = None) -> float:
+def _checked_wavelength(wavelength: float | str | None) -> float | None:
+    """``wavelength`` through the one check of every wavelength keyword
+    (:func:`raytrace.paraxial.conjugates.checked_wavelength`: nm, a string with a unit, a line
+    letter; TraceError naming it), except a float in range (the optimizers' calls), which needs
+    no more checking."""
+    if wavelength is None or (
+        isinstance(wavelength, float)
+        and WAVELENGTH_RANGE_NM[0] <= wavelength <= WAVELENGTH_RANGE_NM[1]
+    ):
+        return wavelength
+    from .conjugates import checked_wavelength
+
+    return checked_wavelength(wavelength)
+
+
+def element_power(
+    lens: Lens, first: int, last: int, wavelength: float | str | None = None
+) -> float:
     """Paraxial power of the surfaces ``first`` .. ``last`` (1-based, inclusive): an element, a
     cemented group or any run of surfaces, in the media around it.
 
@@ -338,8 +355,8 @@ def element_power(lens: Lens, first: int, last: int, wavelength: float | None = 
     lens : Lens
     first, last : int
         1-based surface numbers, ``first <= last`` (an element in air: its two surfaces).
-    wavelength : float, optional
-        nm; default the lens's.
+    wavelength : float or str, optional
+        nm (or ``"0.5876um"``, a line letter ``"d"``); default the lens's reference wavelength.
 
     Returns
     -------
@@ -348,12 +365,20 @@ def element_power(lens: Lens, first: int, last: int, wavelength: float | None = 
         height 1 mm parallel to the axis (:func:`ynu_trace`); + converging. For a lens in air,
         φ = (n − 1)(c1 − c2) + (n − 1)² t c1 c2 / n (the thick-lens formula); 1/φ is its
         focal length.
+
+    Raises
+    ------
+    LensError
+        Surfaces out of range, or a lens that is not centred.
+    TraceError
+        A wavelength the unit check refuses (``"abc"``, a bare 0.5876, which looks like µm).
     """
     require_centred(lens)
     n = lens.n_surfaces
     if not 1 <= first <= last <= n:
         raise LensError(f"{lens.name}: surfaces {first}..{last}: need 1 <= first <= last <= {n}")
-    c, t, n_in, n_out = _system(lens, lens.wavelength if wavelength is None else wavelength)
+    wl = _checked_wavelength(wavelength)
+    c, t, n_in, n_out = _system(lens, lens.wavelength if wl is None else wl)
     _, nu = ynu_trace(c, t, n_in, n_out, 1.0, 0.0, last, start=first - 1)
     return float(-nu)
 
@@ -400,13 +425,7 @@ def paraxial(
     a value the unit checks refuse.
     """
     require_lens(lens)
-    if wavelength is not None and not (
-        isinstance(wavelength, float)
-        and WAVELENGTH_RANGE_NM[0] <= wavelength <= WAVELENGTH_RANGE_NM[1]
-    ):  # a float in range (the optimizers' calls) needs no more checking
-        from .conjugates import checked_wavelength
-
-        wavelength = checked_wavelength(wavelength)
+    wavelength = _checked_wavelength(wavelength)
     if isinstance(object_distance, str) or object_s is not None or object_scale is not None:
         from .conjugates import resolve_object_distance
 

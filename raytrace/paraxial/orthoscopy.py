@@ -192,7 +192,7 @@ class PestrecovConstants:
     infinite: bool
 
 
-def pestrecov_constants(par: ParaxialResult, s_prime: float) -> PestrecovConstants:
+def pestrecov_constants(par: ParaxialResult, s_prime: float | str) -> PestrecovConstants:
     """Pestrecov Eq. (8) in the image plane at ``s_prime`` (mm from H') of a traced lens.
 
     ``p0 = s − HE0``, ``p0' = s' − H'E0'``; ``M0 = p0' / (m_e p0)`` (finite conjugates) or
@@ -208,8 +208,10 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float) -> PestrecovConstan
     par : ParaxialResult
         :func:`raytrace.paraxial.paraxial` of the lens and its object (m_e of Eq. 6, the pupils
         E0, E0', p0 in mm, negative for a finite object).
-    s_prime : float
-        The image plane, mm from the second principal point H' (positive toward the image).
+    s_prime : float or str
+        The image plane, mm from the second principal point H' (positive toward the image), or a
+        string with a length unit as the command line takes it (``"50.5mm"``;
+        :func:`raytrace.units.plane_distance_mm`; TraceError naming ``s_prime``).
 
     Returns
     -------
@@ -218,7 +220,13 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float) -> PestrecovConstan
         ``scale`` = M0 (finite conjugates, dimensionless, signed) or F0 (object at infinity, mm)
         and ``infinite``.
     """
-    sp = float(s_prime)
+    from ..errors import TraceError
+    from ..units import UnitError, plane_distance_mm
+
+    try:
+        sp = plane_distance_mm(s_prime, "s_prime")
+    except UnitError as e:  # the error every image-plane keyword raises (ImagePlane)
+        raise TraceError(str(e)) from None
     return PestrecovConstants(sp, par.p0, sp - par.HpE0p, float(_scale(par, sp)), par.infinite)
 
 

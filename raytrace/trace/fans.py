@@ -173,9 +173,9 @@ def ray_fan(
     n: int = 21,
     axis: str = "y",
     plane: ImagePlane | str | None = None,
-    s_prime: float | None = None,
-    from_last_vertex: float | None = None,
-    defocus: float | None = None,
+    s_prime: float | str | None = None,
+    from_last_vertex: float | str | None = None,
+    defocus: float | str | None = None,
     object_distance: float | str | None = None,
     object_s: float | None = None,
     object_scale: float | None = None,
@@ -195,7 +195,8 @@ def ray_fan(
     axis : {"y", "x"}
         "y": tangential fan (pupil coordinate py, aberration ε_y); "x": sagittal (px, ε_x).
     plane, s_prime, from_last_vertex, defocus
-        The image plane (docs/design.md, "Vocabulary"); default the Gaussian plane.
+        The image plane (docs/design.md, "Vocabulary"); default the Gaussian plane. Distances
+        in mm, or strings with a length unit as the command line takes them (``"50.5mm"``).
     object_distance, object_s, object_scale
         The object plane; default the lens's.
     wavelength : float, optional
@@ -275,9 +276,9 @@ def spot_diagram(
     pattern: str = "hexapolar",
     n: int = 8,
     plane: ImagePlane | str | None = None,
-    s_prime: float | None = None,
-    from_last_vertex: float | None = None,
-    defocus: float | None = None,
+    s_prime: float | str | None = None,
+    from_last_vertex: float | str | None = None,
+    defocus: float | str | None = None,
     object_distance: float | str | None = None,
     object_s: float | None = None,
     object_scale: float | None = None,
@@ -296,7 +297,8 @@ def spot_diagram(
         Pupil sampling (:mod:`raytrace.trace.pupil`); ``n`` rings (or points across: at least
         3 for ``"square"``), a whole number.
     plane, s_prime, from_last_vertex, defocus
-        The image plane; default the Gaussian plane.
+        The image plane; default the Gaussian plane. Distances in mm, or strings with a length
+        unit (``"50.5mm"``).
     object_distance, object_s, object_scale
         The object plane; default the lens's.
     wavelength : float, optional
