@@ -205,6 +205,18 @@ def quiet_dask_logs(level: int) -> None:
         log.setLevel(max(log.level, level))
 
 
+def require_dask():
+    """The ``distributed`` module; OrthoscopeError (one line, how to install it) when Dask is not
+    installed. Cheap: a command checks it before any long work."""
+    try:
+        import distributed
+    except ImportError:
+        raise OrthoscopeError(
+            "Dask is not installed; install the extra: pip install 'orthoscope[dask]'"
+        ) from None
+    return distributed
+
+
 def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
     """``(client, close)`` for an executor spec.
 
@@ -229,12 +241,7 @@ def dask_client(executor) -> tuple[object, Callable[[], None] | None]:
     OrthoscopeError
         Dask is not installed, the spec is malformed, or the scheduler cannot be reached.
     """
-    try:
-        import distributed
-    except ImportError:
-        raise OrthoscopeError(
-            "Dask is not installed; install the extra: pip install 'orthoscope[dask]'"
-        ) from None
+    distributed = require_dask()
     if isinstance(executor, distributed.Client):
         return executor, None
     if not isinstance(executor, str):

@@ -188,3 +188,114 @@ def test_a_spot_bundle_with_failing_rays_is_an_error_not_a_smaller_spot():
     assert operand_problems("rms_spot", {"drop_failed": "yes"}, 0.0, 1.0) == [
         "'drop_failed' must be true or false, got 'yes'"
     ]
+
+
+@pytest.fixture(scope="module")
+def split_start():
+    """The twinplex spec's start lens with its first element split (``--split 1``): each half is
+    half as thick, so the first half's surfaces meet about 8 mm from the axis, below the height
+    the 45 deg chief ray needs there (probed by tracing rays from the 45 deg object point: those
+    that pass reach the stop only 1.1 to 3.3 mm off its centre)."""
+    from raytrace.optimize import read_spec, split_design, start_lens
+
+    spec = read_spec("twinplex-like-55-525")
+    return split_design(start_lens(spec), spec, 1)
+
+
+def test_a_failing_chief_ray_is_named_by_its_status_word_with_a_fix(split_start):
+    # "distortion(field=45.0): the chief ray fails (status 4)": the code, not its word
+    # (raytrace.kernels.codes.STATUS_NAMES), and no fix (docs/design.md: WHERE: WHAT; FIX)
+    from raytrace.errors import TraceError
+    from raytrace.optimize.solver import apply, start_values
+
+    lens, spec = split_start
+    design = apply(lens, spec, start_values(lens, spec))
+    with pytest.raises(TraceError) as e:
+        evaluate(design, spec.operands)
+    msg = str(e.value)
+    assert msg.startswith("distortion(field=45.0): the chief ray fails (aim_failed: ")
+    assert "status 4" not in msg
+    assert msg.endswith(
+        "; lower the operand's field, or change the lens so that it passes that field"
+    )
+    assert e.value.problem == msg.split("; lower")[0] and e.value.status == 4
+
+
+def test_a_start_lens_that_fails_is_named_and_trial_failures_use_the_word(split_start):
+    # the optimizers say which lens failed (the start, before any step); a run's summary of its
+    # failed trial lenses ("N of M evaluations failed (... the first: ...)") quotes the word
+    from raytrace.errors import TraceError
+    from raytrace.optimize import optimize
+    from raytrace.optimize.minimax import minimax
+    from raytrace.optimize.solver import EvaluationLog, checked_evaluate, start_values
+
+    lens, spec = split_start
+    for run in (optimize, minimax):
+        with pytest.raises(TraceError) as e:
+            run(lens, spec)
+        assert str(e.value).startswith(
+            f"the start lens ({spec.start}): distortion(field=45.0): the chief ray fails "
+            "(aim_failed: "
+        )
+    # a global search that gave no design (its time ran out before the first start) keeps the
+    # start lens, which fails: said as such, not as a bare operand error after the search
+    from raytrace.optimize import global_optimize
+
+    with pytest.raises(TraceError) as e:
+        global_optimize(lens, spec, starts=1, workers=1, time_budget_s=1e-9)
+    assert str(e.value).startswith(
+        f"the start lens ({spec.start}), kept: no start of the search gave a design: "
+        "distortion(field=45.0): the chief ray fails (aim_failed: "
+    )
+    log = EvaluationLog()
+    with pytest.raises(TraceError):
+        checked_evaluate(lens, spec, start_values(lens, spec), None, log)
+    note = log.note()
+    assert "the first: distortion(field=45.0): the chief ray fails (aim_failed: " in note
+    assert "status 4" not in note
+
+
+def test_a_spec_plane_is_read_by_image_plane_as_given(twinplex, tmp_path):
+    # spec_plane built ImagePlane(k, float(v)): a length with its unit ("525mm"), which
+    # ImagePlane reads (raytrace.paraxial.conjugates: the command line's --s-prime parser), was
+    # refused as "must be a number (mm)"; a number ImagePlane refuses (1e11 mm: "not a plane
+    # position") passed the spec's check and failed in evaluate without naming the operand
+    from support import read_spec_text
+
+    from raytrace.optimize import SpecError
+
+    def op(v):
+        return Operand("distortion", 0.0, 1.0,
+                       {"field": 25.0, "object_s": S_PROJ, "plane": {"s_prime": v}})  # fmt: skip
+
+    (ref,) = evaluate(twinplex, (op(525.0),))
+    (mm,) = evaluate(twinplex, (op("525mm"),))
+    (cm,) = evaluate(twinplex, (op("52.5 cm"),))
+    assert mm.value == ref.value and cm.value == pytest.approx(ref.value, rel=1e-12, abs=1e-15)
+    from raytrace.errors import TraceError
+    from raytrace.paraxial import ImagePlane
+
+    def own(kind, v):  # ImagePlane's message for v, its kind said as the spec's key
+        with pytest.raises(TraceError) as e:
+            ImagePlane(kind, v)
+        msg = str(e.value)
+        assert msg.startswith(kind)
+        return msg[len(kind) :]
+
+    for v in ("525 parsec", 1e11):
+        with pytest.raises(SpecError) as e:
+            evaluate(twinplex, (op(v),))
+        assert str(e.value) == f"operands[0] ({op(v).label()}): plane s_prime{own('s_prime', v)}"
+    with pytest.raises(SpecError, match=r"^operands\[0\] .*: plane s_prime: True is not a length"):
+        evaluate(twinplex, (op(True),))  # (ImagePlane reads True as 1 mm)
+    # in a spec file: the same value works, and a refused one names the operand
+    head = 'start = "twinplex-like-55-525"\nvariables = [ { kind = "curvature", surface = 1 } ]\n'
+    ops = ('operands = [ { type = "efl", target = 50 }, { type = "distortion", field = 25, '
+           'plane = { from_vertex = %s }, target = 0 } ]\n')  # fmt: skip
+    spec = read_spec_text(tmp_path, head + ops % '"475.5mm"')
+    assert spec.operands[1].params["plane"] == {"from_vertex": "475.5mm"}
+    with pytest.raises(SpecError) as e:
+        read_spec_text(tmp_path, head + ops % '"4x"')
+    assert f"operands[2] (distortion): plane from_vertex{own('from_last_vertex', '4x')}" in str(
+        e.value
+    )

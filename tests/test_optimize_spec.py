@@ -322,3 +322,38 @@ def test_cli_a_lens_given_as_spec_says_so_in_one_line(tmp_path, monkeypatch, cap
     assert line.startswith(f"orthoscope optimize: error: {spec}: no such spec file; ")
     assert line.endswith("give a spec, e.g. `orthoscope optimize twinplex-like-55-525`")
     assert not (tmp_path / "out.toml").exists()
+
+
+GLOBAL_AT_ONCE = ["--global", "--starts", "1", "--workers", "1", "--time", "0.001"]
+
+
+@pytest.mark.parametrize(
+    "edit,search",
+    [(["--split", "1"], []), (["--insert", "4:N-BK7"], []), (["--split", "1"], GLOBAL_AT_ONCE)],
+    ids=["split", "insert", "split-global"],
+)
+def test_cli_an_edited_start_lens_whose_chief_ray_fails_says_the_word_and_the_fix(
+    tmp_path, capsys, edit, search
+):
+    # `optimize twinplex-like-55-525 --split 1` (or --insert 4:N-BK7) ended "error:
+    # distortion(field=45.0): the chief ray fails (status 4)": the code, not its word, and no
+    # fix. The edit makes the start lens: a split element's halves are half as thick and an
+    # inserted plate's flat face cuts the concave surface 4, so the 45 deg chief ray meets
+    # overlapping surfaces (another element, e.g. --split 6, passes it). A global search that
+    # gave no design (its time ran out at once here) keeps that start lens and says so
+    from orthoscope.cli import main
+
+    out = tmp_path / "out.toml"
+    assert main(["optimize", "twinplex-like-55-525", *edit, *search, "-o", str(out)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(
+        f"orthoscope optimize: error: {' '.join(edit)}: on the start lens this makes, "
+        "distortion(field=45.0): the chief ray fails (aim_failed: "
+    )
+    assert "status 4" not in line
+    fix = "; split another element or insert elsewhere"
+    if search:
+        assert f", and no start of the search gave a design{fix}, or lower" in line
+    else:
+        assert f"{fix} (--split auto tries every element), or lower" in line
+    assert not out.exists()

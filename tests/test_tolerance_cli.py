@@ -189,3 +189,106 @@ def test_ctrl_c_on_a_dask_run_stops_once_and_keeps_the_chunks(tmp_path):
     ]
     assert len(rest) == 1 and "interrupted; the finished chunks are kept" in rest[0], err
     assert sorted(out.glob("chunk-*.npz")), "no finished chunk kept"
+
+
+@pytest.mark.parametrize("run", [["--sensitivity"], ["--samples", "4", "--quiet"]])
+def test_a_lens_file_object_inside_the_front_focal_length_is_exit_2(tmp_path, run):
+    # the lens file's object 2 mm from the first vertex (inside the front focal length: a
+    # virtual image) ran to exit 0 with numbers measured on no real image
+    src = (ROOT / "lenses" / "cooke-triplet-f4.toml").read_text()
+    near = src.replace('distance = "inf"', "distance = 2").replace('t = "gaussian"', "t = 43.08")
+    assert near != src
+    lens = tmp_path / "near.toml"
+    lens.write_text(near)
+    rc, out, err = run_cli(["tolerance", str(lens), str(SPEC), "--fields", FIELDS, *run])
+    assert rc == 2, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "internal error" not in err
+    assert "inside the front focal length" in err and "before the last surface" in err
+
+
+def _entries(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` and its bytes (what a refused run must leave as it was)."""
+    return {str(p.relative_to(folder)): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+
+def test_a_run_refused_for_missing_dask_writes_nothing(tmp_path, monkeypatch):
+    # `--dask local:2 -o run2` without Dask was refused ("Dask is not installed") after
+    # run2/manifest.json was written; the next run there with another --samples was then
+    # refused as "holds another run" (docs/tolerance.md: the checks run before any long work)
+    import sys
+
+    from distortion.tolerance import monte_carlo
+    from raytrace.errors import OrthoscopeError
+    from raytrace.files.library import load_lens
+    from raytrace.tolerance import read_tolerance_spec
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # `import distributed` fails
+    run = tmp_path / "run2"
+    rc, out, err = run_cli(BASE + ["--samples", "32", "--dask", "local:2", "-o", str(run)])
+    assert rc == 2 and "Dask is not installed" in err, err
+    assert not run.exists()
+    # the API (the command checks Dask before its run; the run itself writes nothing either)
+    lens, spec = load_lens(LENS), read_tolerance_spec(SPEC)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for folder in (run, empty):
+        with pytest.raises(OrthoscopeError, match="Dask is not installed"):
+            monte_carlo(lens, spec, 32, fields_deg=[0.0, 10.0, 20.0], chunk_size=16,
+                        executor="local:2", out_dir=folder)  # fmt: skip
+    assert not run.exists() and list(empty.iterdir()) == []
+    # so the next run there is not refused as "another run"
+    rc, out, err = run_cli(BASE + ["--samples", "16", "--chunk", "16", "-o", str(run)])
+    assert rc == 0, err
+    assert json.loads((run / "manifest.json").read_text())["n"] == 16
+
+
+def test_a_run_refused_for_an_unreachable_scheduler_leaves_the_folder_as_it_was(
+    tmp_path, monkeypatch
+):
+    # `--dask tcp://127.0.0.1:1 -o run3` (nothing listens) was refused after the 20 s connect
+    # timeout, with run3/manifest.json written (and, with --force, the chunks of the run that
+    # was there removed). The scheduler's connect error is made at once here: a Client that
+    # raises what distributed.Client raises after its timeout (OSError)
+    distributed = pytest.importorskip("distributed")
+
+    class Unreachable:
+        def __init__(self, address, *args, **kwargs):
+            raise OSError(f"Timed out trying to connect to {address} after 20 s")
+
+    monkeypatch.setattr(distributed, "Client", Unreachable)
+    dask = ["--dask", "tcp://127.0.0.1:1"]
+    run = tmp_path / "run3"
+    rc, out, err = run_cli(BASE + ["--samples", "32", *dask, "-o", str(run)])
+    assert rc == 2 and "cannot reach the Dask scheduler tcp://127.0.0.1:1" in err, err
+    assert len(err.strip().splitlines()) == 1
+    assert not run.exists()
+    # a folder that holds a finished run keeps it, with or without --force
+    rc, out, err = run_cli(BASE + ["--samples", "16", "--chunk", "8", "-o", str(run)])
+    assert rc == 0, err
+    before = _entries(run)
+    assert "chunk-00001.npz" in before
+    for extra, words in (([], "holds another run"), (["--force"], "cannot reach the Dask")):
+        rc, out, err = run_cli(BASE + ["--samples", "32", "--chunk", "8", *dask, "-o", str(run),
+                                       *extra])  # fmt: skip
+        assert rc == 2 and words in err, err
+        assert _entries(run) == before
+
+
+def test_a_run_that_fails_before_any_chunk_leaves_no_manifest(tmp_path, monkeypatch):
+    # a run that fails before its first chunk is on disk (here: the chunk's own error) leaves
+    # neither the folder it made nor a manifest that would refuse the next run with other
+    # settings; an interrupted run keeps its chunks (test above)
+    import distortion.tolerance.montecarlo as mc
+    from raytrace.files.library import load_lens
+    from raytrace.tolerance import read_tolerance_spec
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("worker lost")
+
+    monkeypatch.setattr(mc, "run_chunk", broken)
+    lens, spec = load_lens(LENS), read_tolerance_spec(SPEC)
+    run = tmp_path / "run"
+    with pytest.raises(RuntimeError, match="worker lost"):
+        mc.monte_carlo(lens, spec, 32, fields_deg=[0.0, 10.0, 20.0], chunk_size=16, out_dir=run)
+    assert not run.exists()

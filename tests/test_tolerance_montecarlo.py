@@ -171,3 +171,14 @@ def test_batched_fit_equals_solve_linear(cooke, setup, mc64):
         for k in ("P1", "P2", "S1", "S2"):
             assert getattr(o, k)[i] == pytest.approx(v[k], abs=1e-9 * abs(v["P2"]) + 1e-14)
         assert o.K[i, 0] == pytest.approx(v["K1"], rel=1e-8)
+
+
+@pytest.mark.parametrize("levels", [(150,), (-1, 50), (50, float("nan")), (), ("median",)], ids=str)
+def test_percentiles_outside_0_to_100_are_refused_naming_them(cooke, setup, levels):
+    # percentiles=(150,) ran the whole Monte Carlo and then failed in numpy ("Percentiles must
+    # be in the range [0, 100]"), naming no argument; it is refused first, in one line
+    from distortion.tolerance.checks import ToleranceInputError
+
+    with pytest.raises(ToleranceInputError, match=r"^percentiles .*0 to 100") as e:
+        monte_carlo(cooke, _spec(), 4, setup=setup, percentiles=levels)
+    assert "\n" not in str(e.value)

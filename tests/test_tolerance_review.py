@@ -335,3 +335,28 @@ def test_every_bundled_spec_gives_a_sensitivity_table(name):
     spec = read_tolerance_spec(name)
     res = tolerance_sensitivity(load_lens(spec.lens), spec)
     assert len(res.names) == spec.n_items
+
+
+# ------------------------------------------------ an object inside the front focal length
+@pytest.mark.parametrize("run", ["sensitivity", "monte_carlo"])
+def test_an_object_inside_the_front_focal_length_is_refused_as_characteristic_distortion(lens, run):
+    # object_distance=2 (2 m meant; 2 mm is inside the 50 mm lens's front focal length) put the
+    # nominal paraxial image 12.2 mm before the lens (virtual), and the tolerance run returned
+    # ok with numbers 677 um off the object at infinity: it must be refused in the words (the
+    # same check) characteristic_distortion refuses it with
+    from distortion.characteristic import characteristic_distortion
+    from distortion.tolerance import monte_carlo, tolerance_sensitivity
+    from raytrace.errors import TraceError
+
+    spec = _read(ROOT / "lenses" / "tolerances" / "cooke-triplet-f4.toml")
+    with pytest.raises(TraceError) as ref:
+        characteristic_distortion(lens, FIELDS, object_distance=2)
+    with pytest.raises(TraceError) as got:
+        if run == "sensitivity":
+            tolerance_sensitivity(lens, spec, fields_deg=FIELDS, object_distance=2)
+        else:
+            monte_carlo(lens, spec, 4, fields_deg=FIELDS, object_distance=2)
+    msg = str(got.value)
+    assert msg == str(ref.value)
+    assert "before the last surface" in msg and "inside the front focal length" in msg
+    assert "2 mm" in msg and "1.5m for metres" in msg and "\n" not in msg

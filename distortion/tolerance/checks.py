@@ -23,6 +23,8 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
+
 from raytrace.tolerance import ToleranceSpec, ToleranceSpecError
 from raytrace.units import is_whole
 
@@ -186,3 +188,27 @@ def check_yield_limit(
             stacklevel=3,
         )
     return lim, deg
+
+
+def check_percentiles(levels, name: str = "percentiles") -> tuple[float, ...]:
+    """The envelope levels ``levels`` (%) as a tuple of floats: :class:`ToleranceInputError`
+    naming ``name`` unless they are one or more finite numbers from 0 to 100 (checked before a
+    run, not by numpy after it)."""
+    example = "e.g. (2.5, 50, 97.5)"
+    try:
+        vals = tuple(float(v) for v in np.asarray(levels, dtype=float).ravel())
+    except (TypeError, ValueError):
+        raise ToleranceInputError(
+            f"{name} {levels!r}: give levels in % from 0 to 100, {example}"
+        ) from None
+    if not vals:
+        raise ToleranceInputError(
+            f"{name} (): give at least one level in % from 0 to 100, {example}"
+        )
+    bad = [v for v in vals if not (math.isfinite(v) and 0.0 <= v <= 100.0)]
+    if bad:
+        raise ToleranceInputError(
+            f"{name} {vals!r}: {bad[0]:g} is not a level in % from 0 to 100; give levels "
+            f"from 0 to 100, {example}"
+        )
+    return vals

@@ -16,7 +16,10 @@ chunk_size, generator, done chunk numbers), ``chunk-NNNNN.npz`` (the perturbatio
 every :class:`ToleranceOutputs` array of instances [k·chunk, (k+1)·chunk)), ``summary.json`` at the
 end. Each file is written atomically (:func:`raytrace.files.output.write_atomic`), the manifest
 after each chunk: an interrupted run (Ctrl-C, a killed worker) keeps its finished chunks and a
-rerun with the same inputs computes only the missing ones.
+rerun with the same inputs computes only the missing ones. Nothing is written to ``out_dir``
+before every check has passed and the executor is connected (Dask installed, the scheduler
+reached): a refused run leaves the folder as it was, and a run that fails before its first chunk
+is on disk removes the manifest (and the folder) it made.
 """
 
 from __future__ import annotations
@@ -48,7 +51,14 @@ from raytrace.tolerance import (
 )
 
 from .checks import ToleranceInputError as ToleranceInputError
-from .checks import check_yield_limit, split_where, warn_units, where_of, whole
+from .checks import (
+    check_percentiles,
+    check_yield_limit,
+    split_where,
+    warn_units,
+    where_of,
+    whole,
+)
 from .outputs import (
     CURVES,
     DEFAULT_AZIMUTHS,
@@ -152,17 +162,26 @@ def _settings_hash(setup: ToleranceSetup) -> str:
 
 # ------------------------------------------------------------------------------ the store
 class _Store:
-    """Chunk files and the manifest in ``out_dir`` (module docstring)."""
+    """Chunk files and the manifest in ``out_dir`` (module docstring).
+
+    Made in two steps, so that a run refused by a later check (Dask not installed, a scheduler
+    that cannot be reached) leaves ``out_dir`` as it was: the constructor reads and checks what
+    the folder holds and writes nothing; :meth:`open` then creates the folder, removes the
+    chunks of a run being replaced and writes the manifest, once the run can start."""
 
     def __init__(self, out_dir, manifest: dict, resume: bool, overwrite: bool,
                  legacy_spec_hash: str | None = None):  # fmt: skip
         self.dir = Path(out_dir)
         if self.dir.exists() and not self.dir.is_dir():
             raise OutputError(f"{self.dir}: exists and is not a folder; give another out_dir")
-        self.dir.mkdir(parents=True, exist_ok=True)
         self.mpath = self.dir / "manifest.json"
         self.manifest = manifest
         self.done: set[int] = set()
+        #: what :meth:`open` does: remove the chunk files there (a run replaced or none)
+        self._clear = False
+        #: :meth:`open` created the folder / wrote the first manifest there (:meth:`undo`)
+        self._made_dir = False
+        self._fresh = not self.mpath.exists()
         if self.mpath.exists():
             try:
                 old = json.loads(self.mpath.read_text())
@@ -195,9 +214,9 @@ class _Store:
                         f"{self.dir}: holds this run already; pass resume=True to continue it or "
                         "overwrite=True to start again"
                     )
-                self._remove_chunks()
+                self._clear = True
         else:
-            others = sorted(p.name for p in self.dir.iterdir())
+            others = sorted(p.name for p in self.dir.iterdir()) if self.dir.is_dir() else []
             if others and not overwrite:
                 shown = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
                 raise OutputError(
@@ -205,8 +224,30 @@ class _Store:
                     "give a new or empty out_dir, or overwrite=True to use it anyway (its chunk "
                     "files are replaced)"
                 )
+            self._clear = True
+
+    def open(self) -> None:
+        """Make the folder ready for the run the constructor checked: create it, remove the
+        chunk files of a run it replaces, write the manifest."""
+        self._made_dir = not self.dir.exists()
+        self.dir.mkdir(parents=True, exist_ok=True)
+        if self._clear:
             self._remove_chunks()
         self._write_manifest()
+
+    def undo(self) -> None:
+        """After a run that failed before any chunk finished: remove the manifest :meth:`open`
+        wrote where there was none, and the folder if it made it and it is empty again (a rerun
+        with other settings is then not refused as "another run"). A folder that held a run
+        keeps its manifest (the run resumes there)."""
+        if not self._fresh or self.done:
+            return
+        try:
+            self.mpath.unlink(missing_ok=True)
+            if self._made_dir and not any(self.dir.iterdir()):
+                self.dir.rmdir()
+        except OSError:  # the run's own error is the one to report
+            pass
 
     def _remove_chunks(self) -> None:
         for f in self.dir.glob("chunk-*.npz"):
@@ -528,7 +569,8 @@ def monte_carlo(
     object_distance : float, mm (positive magnitude; inf), default the lens's.
     wavelength : float, nm, default the lens's reference wavelength.
     out_dir : path or None
-        Folder for chunks, manifest and summary.json; None keeps nothing on disk.
+        Folder for chunks, manifest and summary.json; None keeps nothing on disk. Written only
+        once the run can start (module docstring).
     resume, overwrite : bool
         Continue a matching run found in ``out_dir``; replace any other run there.
     executor : None | "local" | "local:N" | "tcp://HOST:PORT" | distributed.Client
@@ -586,6 +628,7 @@ def monte_carlo(
         )
     if summary not in SUMMARY_METHODS:
         raise ToleranceSpecError(f"summary {summary!r}: use one of {', '.join(SUMMARY_METHODS)}")
+    levels = check_percentiles(percentiles)
     streaming = summary == "streaming" or (summary == "auto" and n > EXACT_MAX_INSTANCES)
     st = setup or prepare(lens, spec, fields_deg=fields_deg, object_distance=object_distance,
                           wavelength=wavelength, grid_rings=grid_rings,
@@ -610,54 +653,58 @@ def monte_carlo(
                     "settings_hash": _settings_hash(st), "seed": seed, "n": n,
                     "chunk_size": cs, "generator": GENERATOR,
                     "compensator": spec.compensator.type}  # fmt: skip
+        # the folder is checked now and written only once the run can start (below)
         store = _Store(out_dir, manifest, resume, overwrite, legacy_spec_hash(spec))
         on_disk = set(store.done)
-    resumed = len(on_disk)
-    done_count = sum(b - a for k, a, b in chunks if k in on_disk)
-    if progress is not None and done_count:
-        progress(done_count, n)
-
-    half = np.array([max(abs(it.min), abs(it.max)) for it in spec.items])
-    failed = {"n": 0, "bad": np.zeros(spec.n_items), "good": np.zeros(spec.n_items)}
-
-    def feed(k: int, a: int, d: dict) -> None:
-        """A chunk's arrays into the summary (streaming) or the gathered results (exact)."""
-        bad = ~np.asarray(d["ok"], dtype=bool)
-        if bad.any():  # how far out each item lies in the failed instances, and in the others
-            r = np.abs(np.asarray(d["values"], dtype=float)) / half
-            failed["n"] += int(np.count_nonzero(bad))
-            failed["bad"] += r[bad].sum(axis=0)
-            failed["good"] += r[~bad].sum(axis=0)
-        if acc is not None:
-            acc.add(a, d)
-        else:
-            results[k] = d
-
-    def finish(k: int, a: int, b: int, d: dict) -> None:
-        nonlocal done_count
+    # Dask not installed, a scheduler out of reach: refused here, before the folder is written
+    client, close = (None, None)
+    if executor is not None and any(k not in on_disk for k, _, _ in chunks):
+        client, close = dask_client(executor)
+    try:
         if store is not None:
-            store.save(k, d)
-        feed(k, a, d)
-        done_count += b - a
-        if progress is not None:
+            store.open()
+        resumed = len(on_disk)
+        done_count = sum(b - a for k, a, b in chunks if k in on_disk)
+        if progress is not None and done_count:
             progress(done_count, n)
 
-    # the chunks that hold block 0 of a streamed summary come first (its range fixes the
-    # histograms); then every chunk in order (local) or as workers finish them (Dask)
-    block0 = summary_block if streaming else 0
-    first = [c for c in chunks if c[1] < block0]
-    rest = [c for c in chunks if c[1] >= block0]
-    if executor is None:
-        for k, a, b in first + rest:
-            if k in on_disk:
-                feed(k, a, store.load(k, b - a, st.n_curve))
+        half = np.array([max(abs(it.min), abs(it.max)) for it in spec.items])
+        failed = {"n": 0, "bad": np.zeros(spec.n_items), "good": np.zeros(spec.n_items)}
+
+        def feed(k: int, a: int, d: dict) -> None:
+            """A chunk's arrays into the summary (streaming) or the gathered results (exact)."""
+            bad = ~np.asarray(d["ok"], dtype=bool)
+            if bad.any():  # how far out each item lies in the failed instances, and in the others
+                r = np.abs(np.asarray(d["values"], dtype=float)) / half
+                failed["n"] += int(np.count_nonzero(bad))
+                failed["bad"] += r[bad].sum(axis=0)
+                failed["good"] += r[~bad].sum(axis=0)
+            if acc is not None:
+                acc.add(a, d)
             else:
-                finish(k, a, b, run_chunk(st, seed, a, b, parallel=True))
-    else:
-        client, close = (None, None)
-        if any(k not in on_disk for k, _, _ in chunks):
-            client, close = dask_client(executor)
-        try:
+                results[k] = d
+
+        def finish(k: int, a: int, b: int, d: dict) -> None:
+            nonlocal done_count
+            if store is not None:
+                store.save(k, d)
+            feed(k, a, d)
+            done_count += b - a
+            if progress is not None:
+                progress(done_count, n)
+
+        # the chunks that hold block 0 of a streamed summary come first (its range fixes the
+        # histograms); then every chunk in order (local) or as workers finish them (Dask)
+        block0 = summary_block if streaming else 0
+        first = [c for c in chunks if c[1] < block0]
+        rest = [c for c in chunks if c[1] >= block0]
+        if executor is None:
+            for k, a, b in first + rest:
+                if k in on_disk:
+                    feed(k, a, store.load(k, b - a, st.n_curve))
+                else:
+                    finish(k, a, b, run_chunk(st, seed, a, b, parallel=True))
+        else:
             # hash=False: a key of its own for each run. The default content-hashed key is the
             # same for a second run with the same setup on the same client, and the first run's
             # release of that key then deleted the second run's data ("lost dependencies")
@@ -669,12 +716,16 @@ def monte_carlo(
                 todo = [c for c in group if c[0] not in on_disk]
                 if todo:
                     _run_dask(client, shared, seed, todo, finish)
-        finally:
-            if close is not None:
-                close()
+    except Exception:
+        if store is not None:
+            store.undo()  # failed before any chunk finished: the folder as it was
+        raise
+    finally:
+        if close is not None:
+            close()
     _warn_failed(spec, failed, n, half)
     nom = evaluate(st, np.zeros((1, spec.n_items)), parallel=False)
-    q = np.asarray(percentiles, dtype=float)
+    q = np.asarray(levels, dtype=float)
     has_g = st.g is not None
     names = [k for k in SCALARS if k != "g" or has_g]
     if acc is not None:

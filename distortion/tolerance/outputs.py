@@ -236,10 +236,17 @@ def prepare(
     Fraser & Shortis's g_ss' (mm from the object plane to the first vertex, ``inf``, a length
     string such as ``"2m"`` or an image scale ``"10x"``); None takes the spec's ``[outputs]
     g_object_distance``, and without one g is not computed. Raises ToleranceSpecError for a spec
-    that does not fit the lens, TraceError when a nominal chief ray fails, DataError when g
-    cannot be defined (:func:`distortion.tolerance.gfactor.prepare_g`)."""
+    that does not fit the lens, TraceError when a nominal chief ray fails or the object lies
+    inside the front focal length (a virtual nominal image: :func:`raytrace.paraxial.plane_z`, as
+    :func:`distortion.characteristic.characteristic_distortion`), DataError when g cannot be
+    defined (:func:`distortion.tolerance.gfactor.prepare_g`)."""
     from raytrace.lens import require_lens
-    from raytrace.paraxial.conjugates import checked_wavelength, resolve_object_distance
+    from raytrace.paraxial.conjugates import (
+        ImagePlane,
+        checked_wavelength,
+        plane_z,
+        resolve_object_distance,
+    )
 
     require_lens(lens)
     if not isinstance(spec, ToleranceSpec):
@@ -276,9 +283,12 @@ def prepare(
             tx, ty = tr * np.cos(phi), tr * np.sin(phi)
             pts.append(np.degrees(np.column_stack([np.arctan(tx), np.arctan(ty)])))
     P = np.concatenate(pts, axis=0)
+    par = paraxial(lens.nominal(), object_distance=od, wavelength=wl)
+    # the nominal image plane: an object inside the front focal length has a virtual image
+    # (before the last surface), refused in characteristic_distortion's words (its check)
+    plane_z(par, [ImagePlane("gaussian")])
     aim = nominal_aim(lens, spec, P[:, 0], P[:, 1], object_distance=od, wavelength=wl)
     t = np.tan(np.radians(P))
-    par = paraxial(lens.nominal(), object_distance=od, wavelength=wl)
     object_per_t = None if math.isinf(od) else float(par.p0)
     F = fd.size
     _, As, pinv, sc = _design(t[F:], radial_terms, ()) if fit else (None, None, None, None)

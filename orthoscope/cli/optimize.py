@@ -445,14 +445,40 @@ def _edit_elements(args, lens, spec):
         )
     from raytrace.optimize import insert_design, split_design
 
-    flags = [f"--split {k}" for k in args.split or ()]
-    flags += [f"--insert {t}" for t in args.insert or ()]
+    flags = _edit_flags(args)
     for k, what, glass in sorted(edits, key=lambda e: e[0], reverse=True):
         if what == "split":
             lens, spec = split_design(lens, spec, k)
         else:
             lens, spec = insert_design(lens, spec, k, _glass_material(glass))
     return lens, replace(spec, start=f"{spec.start} edited by {' '.join(flags)}")
+
+
+def _edit_flags(args) -> list[str]:
+    """The --split K / --insert K:GLASS flags that edited the start lens (none for auto)."""
+    if args.split == ["auto"]:
+        return []
+    flags = [f"--split {k}" for k in args.split or ()]
+    return flags + [f"--insert {t}" for t in args.insert or ()]
+
+
+def _edited_start_error(args, spec, err):
+    """The error for a start lens on which an operand's chief ray fails (``err``, a
+    :class:`raytrace.optimize.solver.StartLensError`): when --split / --insert made that lens,
+    the fix is another edit (each half of a split element is half as thick, so its surfaces
+    meet nearer the axis; a plate's flat face can cut a concave neighbour: the chief ray of a
+    large field then meets overlapping surfaces); else ``err`` as it is."""
+    from raytrace.optimize.operands import ChiefRayError
+
+    flags = _edit_flags(args)
+    if not flags or not isinstance(err.cause, ChiefRayError):
+        return err
+    search = ", and no start of the search gave a design" if args.global_search else ""
+    auto = "" if args.global_search else " (--split auto tries every element)"
+    return CliError(
+        f"{' '.join(flags)}: on the start lens this makes, {err.cause.problem}{search}; split "
+        f"another element or insert elsewhere{auto}, or lower the operand's field in {spec.path}"
+    )
 
 
 def _glass_material(text: str):
@@ -516,12 +542,15 @@ def _run_local(args, spec, lens, out, inputs, res=None, stopped: str = "") -> in
     design evaluated so far, written and marked as interrupted (exit status 130), as --global
     does; a Ctrl-C before the start lens is evaluated keeps nothing."""
     from raytrace.optimize import optimize
+    from raytrace.optimize.solver import StartLensError
 
     name = MERIT_NAMES[spec.method]
     if res is None:
         prog = _Progress(args.quiet or args.json, "max|r|" if spec.method == "minimax" else "merit")
         try:
             res = optimize(lens, spec, progress=prog)
+        except StartLensError as e:
+            raise _edited_start_error(args, spec, e) from None
         finally:
             prog.done()
     stopped = res.stopped or stopped
@@ -568,11 +597,14 @@ def _run_local(args, spec, lens, out, inputs, res=None, stopped: str = "") -> in
 
 def _run_global(args, spec, lens, out, inputs, over) -> int:
     from raytrace.optimize import global_optimize
+    from raytrace.optimize.solver import StartLensError
 
     spec = replace(spec, search=replace(spec.search, **over))  # the notes tell the settings
     prog = GlobalProgress(spec.search.starts, args.quiet or args.json)
     try:
         res = global_optimize(lens, spec, progress=prog, executor=args.dask)
+    except StartLensError as e:
+        raise _edited_start_error(args, spec, e) from None
     finally:
         prog.close()
     table = _operand_table(res.operands)

@@ -189,6 +189,10 @@ def cmd_tolerance(args) -> int:
     run_mc = not args.sensitivity or args.samples is not None
     if run_mc:
         _run_size(args, spec)
+        if args.dask is not None:  # before the sensitivity table (--plot) and the run
+            from raytrace.executors import require_dask
+
+            require_dask()
     else:  # the Monte Carlo run checks its limits (and says when one looks like mm)
         from distortion.tolerance.checks import check_yield_limit
 

@@ -49,7 +49,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import OrthoscopeError
+from ..errors import OrthoscopeError, TraceError
 from ..lens import Lens
 from ..materials import model_glass
 from ..paraxial import paraxial
@@ -58,6 +58,7 @@ from .minimax import bounds_met, penalty_merit
 from .operands import OperandValue, evaluate, merit
 from .solver import (
     ASPHERIC_KINDS,
+    StartLensError,
     apply,
     bounds,
     check_spec,
@@ -688,7 +689,13 @@ def global_optimize(
                 stopped = "interrupted"
             except (OrthoscopeError, ValueError, ZeroDivisionError, FloatingPointError):
                 pass
-    vals = evaluate(final, spec.operands, check=False)  # check_spec ran before the starts
+    try:
+        vals = evaluate(final, spec.operands, check=False)  # check_spec ran before the starts
+    except TraceError as e:
+        if best_k >= 0:
+            raise
+        # no start gave a design that can be evaluated, and the start lens cannot be either
+        raise StartLensError(spec, e, ", kept: no start of the search gave a design") from None
     m = _search_merit(spec, vals)
     viol = max_violation(vals)
     if polished:

@@ -47,6 +47,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.optimize import linprog
 
+from ..errors import TraceError
 from ..lens import Lens
 from ..paraxial import paraxial
 from .operands import OperandValue
@@ -54,6 +55,7 @@ from .solver import (
     EVAL_FAILURES,
     EvaluationLog,
     OptimizationResult,
+    StartLensError,
     Stopped,
     apply,
     bounds,
@@ -270,6 +272,8 @@ def minimax(
             vals = checked_evaluate(lens, spec, xv, None if start else stop, log)
         except EVAL_FAILURES as err:
             if start:  # the start must evaluate: its own error, as damped least squares gives it
+                if isinstance(err, TraceError):
+                    raise StartLensError(spec, err) from None
                 raise
             raise _Failed(str(err)) from None
         e, g = split(spec, vals)

@@ -61,7 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import TraceError
-from ..kernels.codes import STATUS_TIR, status_message
+from ..kernels.codes import STATUS_AIM_FAILED, STATUS_NAMES, STATUS_TIR, status_message
 from ..lens import Lens
 from ..packing import pack
 from ..paraxial import (
@@ -84,18 +84,61 @@ class OperandValue:
     residual: float  # weight × (value − target) (one-sided operands: weight × violation)
 
 
+class ChiefRayError(TraceError):
+    """The real chief ray of a chief-ray operand fails on the lens evaluated.
+
+    Attributes
+    ----------
+    problem : str
+        ``LABEL: the chief ray fails (WORD: what happened)`` without the fix, for a caller that
+        knows a better one (the command line, for a start lens it edited); the message is
+        ``problem; FIX``.
+    status, surface : int
+        The ray's status code (:data:`raytrace.kernels.codes.STATUS_NAMES`) and the 1-based
+        surface where it failed (0 when unknown, as for ``aim_failed``).
+    """
+
+    #: what to do, for any lens: the field is the operand's, the lens the one evaluated
+    FIX = "lower the operand's field, or change the lens so that it passes that field"
+
+    def __init__(self, label: str, status: int, surface: int = 0) -> None:
+        word = STATUS_NAMES.get(status, f"status {status}")
+        if status == STATUS_AIM_FAILED:  # the kernel keeps no surface: say what it means
+            why = (
+                "the aim found no ray from this field through the stop centre that passes "
+                "every surface"
+            )
+        else:
+            why = status_message(status, surface)
+        self.problem = f"{label}: the chief ray fails ({word}: {why})"
+        self.status, self.surface = status, surface
+        super().__init__(f"{self.problem}; {self.FIX}")
+
+
 # ----------------------------------------------------------------------------- operands
 def spec_plane(plane) -> ImagePlane:
     """A spec's ``plane``: ``"gaussian"`` (default), ``"file"`` or a one-key table
-    ``{s_prime | from_last_vertex | defocus = mm}`` (``from_vertex`` is the old spelling of
-    ``from_last_vertex``)."""
+    ``{s_prime | from_last_vertex | defocus = LENGTH}`` (``from_vertex`` is the old spelling of
+    ``from_last_vertex``): a number in mm or a string with its unit (``"50.5mm"``), read by
+    :class:`~raytrace.paraxial.ImagePlane` as given. A value it refuses is a :class:`SpecError`
+    with its message (the callers name the operand)."""
     if plane is None or plane in ("gaussian", "file"):
         return ImagePlane(plane or "gaussian")
     if isinstance(plane, dict) and len(plane) == 1:
-        ((k, v),) = plane.items()
-        k = "from_last_vertex" if k == "from_vertex" else k
-        if k in ("s_prime", "from_last_vertex", "defocus") and isinstance(v, (int, float)):
-            return ImagePlane(k, float(v))
+        ((key, v),) = plane.items()
+        k = "from_last_vertex" if key == "from_vertex" else key
+        if k in ("s_prime", "from_last_vertex", "defocus"):
+            if isinstance(v, bool):  # a TOML true is no length (ImagePlane would read 1 mm)
+                raise SpecError(
+                    f"plane {key}: {v!r} is not a length; give mm or a length with its unit, "
+                    "e.g. 50.5mm"
+                )
+            try:
+                return ImagePlane(k, v)
+            except TraceError as e:  # its message starts with the kind: say the key as written
+                msg = str(e)
+                rest = msg[len(k) :] if msg.startswith(k) else f": {msg}"
+                raise SpecError(f"plane {key}{rest}") from None
     raise SpecError(
         f'bad plane {plane!r}: use "gaussian", "file" or {{s_prime|from_last_vertex|defocus = mm}}'
     )
@@ -417,7 +460,7 @@ def evaluate(
             fields, cr = chief[(od, kind, wl)]
             j = int(np.searchsorted(fields, float(p["field"])))
             if cr.status[j] != 0:
-                raise TraceError(f"{op.label()}: the chief ray fails (status {int(cr.status[j])})")
+                raise ChiefRayError(op.label(), int(cr.status[j]), int(cr.surface[j]))
             if t == "landing_angle":
                 v = float(cr.landing_angle_deg[j])
             elif t == "distortion_slope":  # dD0/ds' (raytrace.paraxial.distortion_slope)

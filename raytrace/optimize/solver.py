@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..errors import OrthoscopeError
+from ..errors import OrthoscopeError, TraceError
 from ..lens import Lens, require_lens
 from ..materials import Material
 from ..paraxial import gaussian_solved, paraxial
@@ -304,6 +304,31 @@ def limit_message(count: str) -> str:
     )
 
 
+class StartLensError(TraceError):
+    """An operand cannot be evaluated on the spec's start lens (the optimizers evaluate it before
+    any step): the message names the start lens, then the operand's own error.
+
+    Attributes
+    ----------
+    cause : TraceError
+        The operand's error (a :class:`~raytrace.optimize.operands.ChiefRayError` keeps its
+        problem apart from its fix).
+    """
+
+    def __init__(self, spec: DesignSpec, cause: TraceError, when: str = "") -> None:
+        self.cause = cause
+        super().__init__(f"the start lens ({spec.start}){when}: {cause}")
+
+
+def evaluate_start(lens: Lens, spec: DesignSpec, x: np.ndarray) -> tuple[OperandValue, ...]:
+    """The operands of ``spec`` on its start design ``lens`` at ``x`` (checked against the lens
+    by :func:`check_spec` before the run); a trace error is a :class:`StartLensError`."""
+    try:
+        return evaluate(apply(lens, spec, x), spec.operands, check=False)
+    except TraceError as e:
+        raise StartLensError(spec, e) from None
+
+
 def checked_evaluate(
     lens: Lens,
     spec: DesignSpec,
@@ -444,7 +469,7 @@ def optimize(
 
     stopped = ""
     try:
-        start_vals = evaluate(apply(lens, spec, x0), spec.operands, check=False)  # checked
+        start_vals = evaluate_start(lens, spec, x0)
         m0 = merit(start_vals)
         big = math.sqrt(m0 + 1.0) * 1e3
         best[0] = (m0, x0.copy())

@@ -530,8 +530,12 @@ def plane_problems(plane, *, allow_best: bool = False) -> list[str]:
         ((k, v),) = plane.items()
         if k not in PLANE_KEYS:
             return [f"plane: unknown key {k!r}{suggest(k, PLANE_KEYS)}"]
-        if not (_is_num(v) and math.isfinite(v)):
-            return [f"plane {k} must be a number (mm), got {v!r}"]
+        from .operands import spec_plane  # (operands imports this module)
+
+        try:  # the value as ImagePlane reads it: mm, or a length with its unit ("50.5mm")
+            spec_plane(plane)
+        except SpecError as e:
+            return [str(e)]
         return []
     return [
         f'plane {plane!r}: use "gaussian", "file" or a table {{ s_prime | from_last_vertex | '
