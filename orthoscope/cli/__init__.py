@@ -392,15 +392,38 @@ _ASCII = {
     "α": "alpha", "β": "beta", "γ": "gamma", "θ": "theta", "ρ": "rho", "ε": "eps", "δ": "d",
     "Δ": "D",
     "µ": "u", "μ": "u", "—": "-", "–": "-", "−": "-", "′": "'", "±": "+/-", "×": "x", "≤": "<=",
-    "≥": ">=", "∞": "inf", "°": " deg", "²": "^2", "³": "^3", "⁴": "^4", "√": "sqrt", "→": "->",
+    "≥": ">=", "∞": "inf", "°": " deg", "√": "sqrt", "→": "->",
     "Σ": "sum", "≈": "~", "…": "...", "’": "'", "“": '"', "”": '"', "ü": "u", "é": "e",
+    "λ": "lambda", "σ": "sigma", "φ": "phi", "ψ": "psi", "π": "pi", "∂": "d", "·": "*",
+    "≠": "!=", "⇒": "=>", "⇔": "<=>",
 }  # fmt: skip
+#: a run of superscripts is one exponent ("mm⁻¹" -> "mm^-1"), of subscripts one index ("Kᵢ" ->
+#: "K_i", "Σᵢ₌₁³" -> "sum_i=1^3")
+_SCRIPTS = {
+    "^": dict(zip("⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺", "0123456789-+", strict=True)),
+    "_": dict(zip("₀₁₂₃₄₅₆₇₈₉₋₊₌ᵢⱼₖ", "0123456789-+=ijk", strict=True)),
+}
 
 
 def _ascii_fallback(err: UnicodeError):
     """Codec error handler: Greek letters, dashes and units in ASCII words (non-UTF-8 locales)."""
     bad = err.object[err.start : err.end]
-    return "".join(_ASCII.get(ch, "?") for ch in bad), err.end
+    out, i = [], 0
+    while i < len(bad):
+        for mark, table in _SCRIPTS.items():
+            j = i
+            while j < len(bad) and bad[j] in table:
+                j += 1
+            if j > i:
+                out.append(mark + "".join(table[c] for c in bad[i:j]))
+                i = j
+                if i < len(bad) and _ASCII.get(bad[i], "?")[:1].isalpha():
+                    out.append(" ")  # "K_i lambda^2", not "K_ilambda^2"
+                break
+        else:
+            out.append(_ASCII.get(bad[i], "?"))
+            i += 1
+    return "".join(out), err.end
 
 
 def _ascii_safe_streams() -> None:

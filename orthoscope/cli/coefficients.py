@@ -15,7 +15,7 @@ from .common import (
     refuse_flags,
     warn,
 )
-from .variation import CONJ_HELP, UNITS_EPILOG
+from .variation import CONJ_HELP, PENTAX_CSV, units_epilog
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
@@ -265,7 +265,11 @@ def register(sub: argparse._SubParsersAction) -> None:
             "[--object 8x] gives Pestrecov's characteristic distortion in the image plane of the "
             "focus setting, whose principal distance is F0 = p0'/m_e (Eq. 8)."
         ),
-        epilog=UNITS_EPILOG,
+        epilog=units_epilog(
+            "orthoscope coefficients --lens cooke-triplet-f4 --focus 12x --focal-length-px 4000 "
+            "--json",
+            f"orthoscope coefficients {PENTAX_CSV} --profile 8,1.5 --principal-distance-mm 45",
+        ),
     )
     c.add_argument("profiles", nargs="?", metavar="PROFILES.csv", help="CSV of profiles.")
     c.add_argument(

@@ -35,6 +35,18 @@ UNITS_EPILOG = (
     "'j x' alone is a Gaussian profile (object in the plane of focus). g_ss' is Fraser & Shortis "
     "Eq. (6): dr_ss' = dr_s + g (dr_s' - dr_s); gamma_ss' is Brown's Eq. (2). " + CONJ_HELP
 )
+#: The Pentax profiles of Fraser & Shortis (1992) Table 1, a file in the repository.
+PENTAX_CSV = "lenses/fraser-shortis-1992-table1-pentax.csv"
+
+
+def units_epilog(*examples: str) -> str:
+    """The epilog of ``variation`` and ``coefficients``: :data:`UNITS_EPILOG`, wrapped as argparse
+    wraps it (the help formatter keeps a text with line breaks as written), then the examples
+    (each run by tests/test_docs.py)."""
+    import textwrap
+
+    lines = "\n".join(f"  {e}" for e in examples)
+    return textwrap.fill(UNITS_EPILOG, 78) + "\n\nExamples:\n" + lines
 
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
@@ -241,7 +253,12 @@ def register(sub: argparse._SubParsersAction) -> None:
             "distance, compared on a common radius grid; then the same analysis as the data "
             "mode, with Brown's Eq. (1) prediction beside the traced truth."
         ),
-        epilog=UNITS_EPILOG,
+        epilog=units_epilog(
+            "orthoscope variation --lens super-angulon-de975637 --scale-to-efl 65 --focus 12x "
+            "--objects 8x,16x,20x",
+            "orthoscope variation --lens tessar-fr1066698-inner-focus --configurations",
+            f"orthoscope variation {PENTAX_CSV}",
+        ),
     )
     q.add_argument(
         "profiles", nargs="?", metavar="PROFILES.csv", help="CSV of measured profiles (data mode)."

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -25,6 +26,35 @@ def untraced(fields: np.ndarray, status: np.ndarray) -> list[str]:
     return ["fields not traced: " + ", ".join(bad)] if bad else []
 
 
+def printed(text: str, stream=None) -> str:
+    """``text`` as ``stream`` (default: ``sys.stdout``) will write it, so that a table can be laid
+    out in the characters that reach the reader.
+
+    Unchanged where the stream's encoding holds every character; otherwise passed through the
+    stream's error handler: under a locale that cannot encode the tables' symbols the command line
+    writes them in ASCII (``α`` -> ``alpha``, ``°`` -> `` deg``; ``orthoscope.cli``), and a label
+    measured before that substitution would no longer match its column. A stream whose handler
+    refuses the text (``errors="strict"``) gets it unchanged, as before.
+
+    >>> import io
+    >>> printed("α (deg)", io.TextIOWrapper(io.BytesIO(), encoding="utf-8"))
+    'α (deg)'
+    >>> printed("α (deg)", io.TextIOWrapper(io.BytesIO(), encoding="ascii", errors="replace"))
+    '? (deg)'
+    """
+    stream = sys.stdout if stream is None else stream
+    enc = getattr(stream, "encoding", None) or "utf-8"
+    try:
+        text.encode(enc)
+        return text
+    except (UnicodeEncodeError, LookupError):
+        pass
+    try:
+        return text.encode(enc, getattr(stream, "errors", None) or "strict").decode(enc)
+    except (UnicodeError, LookupError):
+        return text
+
+
 def _cell(v: float, dec: int, signed: bool) -> str:
     if not math.isfinite(v):
         return "-"
@@ -45,7 +75,9 @@ def format_columns(
     """A table with one line per field (``layout="rows"``, the default of every command) or one
     column per field and one line per quantity (``layout="paper"``: Pestrecov's Tables I, II, V).
 
-    ``quantities`` items are ``(label, values, decimals, signed)``.
+    ``quantities`` items are ``(label, values, decimals, signed)``. The labels are laid out as
+    they will be printed (:func:`printed`: in ASCII under an ASCII-only locale, ``alpha (deg)``
+    for ``α (deg)``), so that the rule and the columns are as wide as the header the reader sees.
     """
     if layout == "auto":  # the old spelling: rows are the one default orientation now
         layout = "rows"
@@ -53,7 +85,7 @@ def format_columns(
         raise ValueError(f"unknown table layout {layout!r}; expected rows or paper")
     fcells = [f"{v + 0.0:g}" for v in fields]  # + 0.0: no "-0" for a table's -0.0000 axis row
     qcells = [[_cell(float(v), dec, sg) for v in vals] for _, vals, dec, sg in quantities]
-    labels = [field_label] + [q[0] for q in quantities]
+    labels = [printed(lab) for lab in [field_label] + [q[0] for q in quantities]]
     lw = max(len(s) for s in labels)
     out = list(title)
     if layout == "paper":

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from .jsonout import jsonable
+from .text import printed
 
 #: the scalar spreads listed, in order: (key, label, unit shown, factor from the output's unit)
 SPREADS = (
@@ -232,11 +233,13 @@ def format_monte_carlo(mc, limits=(), lens_name: str = "") -> str:
     nomc = np.asarray(mc.nominal.D_cal_um).reshape(-1)
     head = "  ".join(f"{'p' + format(p, 'g'):>8}" for p in want)
     lines.append("distortion along +y (µm): nominal lens and percentiles over the lenses")
-    lines.append(f"{'α deg':>7} {'nominal':>9}  {head}   |  {'cal nom':>9}  {head}".rstrip())
+    fl = printed("α deg")  # 'alpha deg' under an ASCII-only locale: the column widens to it
+    fw = max(7, len(fl))
+    lines.append(f"{fl:>{fw}} {'nominal':>9}  {head}   |  {'cal nom':>9}  {head}".rstrip())
     for j in _text_fields(f):
         a = "  ".join(_cell(env[i, j], 2, 8) for i in idx)
         b = "  ".join(_cell(envc[i, j], 2, 8) for i in idx)
-        lines.append(f"{f[j]:>7.2f} {_cell(nom[j], 2, 9)}  {a}   |  {_cell(nomc[j], 2, 9)}  {b}")
+        lines.append(f"{f[j]:>{fw}.2f} {_cell(nom[j], 2, 9)}  {a}   |  {_cell(nomc[j], 2, 9)}  {b}")
     lines += ["", "per-lens outputs: nominal, mean, standard deviation, 2.5 and 97.5 percentiles"]
     lines.append(
         f"{'':28} {'unit':>8} {'nominal':>12} {'mean':>12} {'std':>11} {'p2.5':>12} {'p97.5':>12}"

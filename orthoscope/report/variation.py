@@ -15,6 +15,7 @@ from distortion.variation.models import Conjugate
 from distortion.variation.traced import DEFINITION, FOCUSING, TracedVariation
 
 from .jsonout import float_list, jsonable
+from .text import printed
 
 
 def _num(x: float, fmt: str = ".3f") -> str:
@@ -79,7 +80,8 @@ def format_variation(a: VariationAnalysis) -> str:
     if a.gammas:
         out.append("")
         out.append("Brown γ_ss' (Eq. 2, thin lens, s = f(1 + N)):")
-        out.append(f"  {'plane':<16}{'N focus':>10}{'N object':>10}{'γ':>9}")
+        # printed: 'gamma' under an ASCII-only locale, still right-aligned over its column
+        out.append(f"  {'plane':<16}{'N focus':>10}{'N object':>10}{printed('γ'):>9}")
         for g in a.gammas:
             lab = f"{g.obj.label}({g.focus.label})"
             out.append(f"  {lab:<16}{g.scale_focus:>10.2f}{g.scale_object:>10.2f}{g.gamma:>9.4f}")
@@ -94,7 +96,8 @@ def format_variation(a: VariationAnalysis) -> str:
     for fs in a.focus_summaries:
         out.append("")
         out.append(f"Fraser–Shortis Eq. (6), focus {fs.focus.label}:")
-        out.append(f"  {'plane':<16}{'g':>8}{'σ_g':>8}{'used':>6}{'weak':>6}{'e (µm)':>9}  note")
+        sg, eu = printed("σ_g"), printed("e (µm)")
+        out.append(f"  {'plane':<16}{'g':>8}{sg:>8}{'used':>6}{'weak':>6}{eu:>9}  note")
         for p in fs.planes:
             e = p.estimate
             lab = f"{p.obj.label}({p.focus.label})"
