@@ -518,3 +518,7 @@ def test_cli_grid(tmp_path, capsys):
     assert png.stat().st_size > 0 and vec.stat().st_size > 0
     assert main(["distortion", "cooke-triplet-f4", "--grid", "5x5", "--calibrate", "minimax"]) == 2
     assert "does not combine" in capsys.readouterr().err
+    # --at and --value (calibration flags) were ignored with --grid
+    for flag, value in (("--at", "5"), ("--value", "50")):
+        assert main(["distortion", "cooke-triplet-f4", "--grid", "5x5", flag, value]) == 2
+        assert f"--grid (2-D distortion) does not combine with {flag}" in capsys.readouterr().err

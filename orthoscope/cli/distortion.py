@@ -375,6 +375,8 @@ def _grid(args, lens) -> int:
             ("--fields", args.fields is not None),
             ("--steps", args.steps is not None),
             ("--calibrate", args.calibrate is not None),
+            ("--at", args.at is not None),
+            ("--value", args.value is not None),
             ("--csv", args.csv),
             ("--plot", args.plot),
             ("--plot-rotation", args.plot_rotation),
