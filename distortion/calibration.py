@@ -55,13 +55,22 @@ def axis_spread(values: np.ndarray, on_axis: float) -> float:
     return float(np.max(v) - np.min(v))
 
 
-def looks_like_radians(angle_deg: float, span_deg: float) -> bool:
+#: How near (degrees) a field of the curve an angle read as radians must land to look like
+#: radians: a value rounded to 0.01 rad is within 0.29° of the angle it stands for.
+RADIANS_MATCH_DEG = 0.5
+
+
+def looks_like_radians(angle_deg: float, fields_deg: np.ndarray) -> bool:
     """Whether a field angle given in degrees looks like radians: 0 < |a| <= π/2 and, read as
-    radians, within 1.1 × ``span_deg`` (the largest field of the curve, degrees) — 0.65 for
-    37.5° on a lens of 45°. Used where such a value is no field of the curve (a field of 0.65°
-    that the curve holds is taken as it is)."""
-    a = abs(float(angle_deg))
-    return 0.0 < a <= math.pi / 2 and math.degrees(a) <= 1.1 * span_deg
+    radians, within :data:`RADIANS_MATCH_DEG` of a nonzero field of the curve (0.65 for 37.5°,
+    0.79 for 45°). Used where such a value is no field of the curve; any other value is taken
+    as degrees (1 on a lens of 55° is a field of 1°)."""
+    a = float(angle_deg)
+    if not 0.0 < abs(a) <= math.pi / 2:
+        return False
+    f = np.asarray(fields_deg, dtype=float)
+    f = f[f != 0.0]
+    return bool(f.size) and float(np.min(np.abs(f - math.degrees(a)))) <= RADIANS_MATCH_DEG
 
 
 def match_fields(fields: np.ndarray, at, what: str, *, angles: bool = False) -> list[int]:
@@ -69,8 +78,8 @@ def match_fields(fields: np.ndarray, at, what: str, *, angles: bool = False) -> 
 
     ``angles``: the fields are angles in degrees; an ``at`` value not strictly between −90° and
     90° is refused with the tracer's message (:func:`~distortion.curve.check_field_angles`), and
-    one that is no field point but, read as radians, lies within the curve's angles says that it
-    looks like radians (``0.65`` for 37.5°).
+    one that is no field point but, read as radians, lands on one of the curve's fields says
+    that it looks like radians (``0.65`` for 37.5°; :func:`looks_like_radians`).
     """
     lo, hi = float(np.min(fields)), float(np.max(fields))
     span = max(abs(lo), abs(hi), 1.0)
@@ -84,7 +93,7 @@ def match_fields(fields: np.ndarray, at, what: str, *, angles: bool = False) -> 
     for a in at:
         a = float(a)
         unit = ""
-        if angles and looks_like_radians(a, span):
+        if angles and looks_like_radians(a, fields):
             unit = (
                 f"; {a:g} looks like radians ({a:g} rad = {math.degrees(a):.4g}°): the fields are "
                 "in degrees"

@@ -361,11 +361,12 @@ def _check_rows(lens, par, clip, c0, sensor, max_field_deg, fmt, theta_max, step
     if _table_count(theta_max, step) > 0:
         return
     # a row needs theta_max > 0.05 step: the largest step that gives one, rounded down to two
-    # significant digits (and strictly below the bound)
+    # significant digits, and checked as the table counts rows (0.05 * 6.0 is 0.30000000000000004
+    # in floating point, so a format of 0.3 deg gets no row at the bound 6.0 itself)
     bound = theta_max / 0.05
     e = math.floor(math.log10(bound)) - 1
     best = math.floor(bound / 10.0**e) * 10.0**e
-    if best >= bound:
+    while best > 0 and _table_count(theta_max, best) == 0:
         best -= 10.0**e
     smaller = f"field_step_deg={best:.{max(-e, 0)}f} or less"
     why = (

@@ -557,23 +557,24 @@ def test_distortion_at_fields_are_the_calibrate_commands_check():
         ["distortion", "topogon-like-pestrecov", "--fields", fields, "--calibrate", "two-point",
          "--at", "0.65,0.79"], *common, listing)  # fmt: skip
     assert e1.split("error: ", 1)[1] == e2.split("error: ", 1)[1]  # the same message
-    # the same without --fields: the default fields (0, 4.5, … 45) do not hold 0.65
+    # the same without --fields: 0.79 rad = 45.26° lands on the default fields' 45 (0.65 rad =
+    # 37.24° lands on none of 0, 4.5, … 45: it is a field of 0.65° as far as anyone can tell)
     _one_line_error(
         ["distortion", "topogon-like-pestrecov", "--calibrate", "two-point", "--at", "0.65,0.79"],
-        "field 0.65 is not one of the curve's field points (0, 4.5, 9,",
-        common[1],
+        "field 0.79 is not one of the curve's field points (0, 0.65, 4.5, 9,",
+        "0.79 looks like radians (0.79 rad = 45.26°): the fields are in degrees",
     )
-    # fields in degrees are traced too (37.5 is no default field), and 0.65 in --fields is taken
-    # as degrees: the user said so
+    # fields in degrees are traced too (37.5 is no default field); 0.65 in --fields is taken as
+    # degrees (the user said so); 1 on a lens of 55° (1 rad = 57.3°, no field) is a field of 1°
     for argv in (
-        ["--at", "37.5,45"],
-        ["--fields", "0,0.65,20,45", "--at", "0.65,45"],
+        ["topogon-like-pestrecov", "--calibrate", "two-point", "--at", "37.5,45"],
+        ["topogon-like-pestrecov", "--calibrate", "two-point", "--fields", "0,0.65,20,45"]
+        + ["--at", "0.65,45"],
+        ["super-angulon-de975637", "--max-field", "55", "--calibrate", "zero-at", "--at", "1"],
     ):
         from support import run_cli
 
-        rc, out, err = run_cli(
-            ["distortion", "topogon-like-pestrecov", "--calibrate", "two-point", *argv, "--json"]
-        )
+        rc, out, err = run_cli(["distortion", *argv, "--json"])
         assert rc == 0, err
         at = [float(a) for a in argv[-1].split(",")]
         fields = json.loads(out)["distortion"]["fields"]

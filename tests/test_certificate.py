@@ -406,9 +406,15 @@ def test_a_sensor_in_metres_is_refused_saying_so(topogon, sensor):
     assert msg.startswith("sensor") and "metres" in msg and "230" in msg and "\n" not in msg
 
 
-def test_a_max_field_with_no_tabulated_field_is_refused_naming_it(topogon):
-    with pytest.raises(DataError, match=r"^max_field_deg=0\.1: .*no tabulated field"):
-        calibration_certificate(topogon, max_field_deg=0.1, date=DATE)
+@pytest.mark.parametrize("max_field", [0.1, 0.3, 0.37])
+def test_a_max_field_with_no_tabulated_field_is_refused_naming_it(topogon, max_field):
+    with pytest.raises(DataError, match=rf"^max_field_deg={max_field}: .*no tabulated field") as e:
+        calibration_certificate(topogon, max_field_deg=max_field, date=DATE)
+    # the step it suggests gives a row (0.3 suggested 6.0, which 0.05 * 6.0 =
+    # 0.30000000000000004 refused again)
+    step = float(re.search(r"field_step_deg=([0-9.]+) or less", str(e.value)).group(1))
+    c = calibration_certificate(topogon, max_field_deg=max_field, field_step_deg=step, date=DATE)
+    assert c.fields_deg.size >= 1
 
 
 @pytest.mark.parametrize(

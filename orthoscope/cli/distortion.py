@@ -42,8 +42,8 @@ METHOD_HELP = (
 )
 AT_HELP = (
     "Field(s) for two-point (two) or zero-at (one): degrees or object heights, A,B; traced with "
-    "the run's fields (a value up to pi/2 that is no field of the run is refused as looking like "
-    "radians; list it in --fields to calibrate there)."
+    "the run's fields (a value up to pi/2 that is no field of the run but, read as radians, lands "
+    "on one is refused as looking like radians; list it in --fields to calibrate there)."
 )
 EXAGGERATION_HELP = (
     "Plot exaggeration k of the distortion scale (Eq. 14: tan rho_k = k (Fc/F0 - 1)). Default: 200."
@@ -128,11 +128,10 @@ def cmd_distortion(args) -> int:
         raise CliError("--at and --value need --calibrate METHOD")
     at = at_fields(args.at) or ()
     if args.calibrate:  # --at names fields of the run: calibrate's own check, before the trace
-        span = max(float(np.max(np.abs(fields))), 1.0)
-        # the --at fields are traced too, except one that looks like radians (0.65 for 37.5°):
-        # unless the run's fields hold it, calibrate's check refuses it, saying so
+        # the --at fields are traced too, except one that looks like radians (0.65 where the
+        # run has 37.5°): unless the run's fields hold it, calibrate's check refuses it, saying so
         fields = np.union1d(
-            fields, [a for a in at if kind != "angle" or not looks_like_radians(a, span)]
+            fields, [a for a in at if kind != "angle" or not looks_like_radians(a, fields)]
         )
         calibration_fields(fields, args.calibrate, at, angles=kind == "angle")
     res = _characteristic(lens, fields, kind, od, planes, args, wavelength=args.wavelength)
