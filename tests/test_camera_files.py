@@ -230,6 +230,23 @@ def test_australis_text_round_trip_and_errors(tmp_path):
         read_calibration(tmp_path / "bad.aus")
 
 
+def test_an_x_ray_panel_calibration_with_a_pitch_above_0_1_mm_reads(tmp_path):
+    """Review of cfa9e08 (F1): this file (a PerkinElmer XRD 1621 panel, 2048 x 2048 pixels of
+    200 µm, c = 1000 mm; the reviewer's xray.aus) read before cfa9e08 and was then refused for
+    its pitch above 0.1 mm. It reads again, with no warning."""
+    import warnings
+
+    keys = ["image_width 2048", "image_height 2048", "pixel_width_mm 0.2", "pixel_height_mm 0.2"]
+    keys += ["c 1000.0", "xp 0.0", "yp -0.0"] + [f"{k} 0.0" for k in "K1 K2 K3 P1 P2 b1 b2".split()]
+    path = tmp_path / "xray.aus"
+    path.write_text("format orthoscope-australis 1\n" + "\n".join(keys) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        cam = read_calibration(path)
+    assert (cam.model, cam.width, cam.height) == ("australis", 2048, 2048)
+    assert cam.pixel_size_mm == (0.2, 0.2) and cam["c"] == 1000.0
+
+
 def test_writers_refuse_to_overwrite_and_to_lose_terms(tmp_path):
     cam = _opencv(5)
     write_calibration(cam, tmp_path / "a.yml")

@@ -513,7 +513,14 @@ def test_points_beyond_the_fold_get_a_status_not_a_number():
     "ps, match",
     [
         ((3.9, 3.9), r"camera model opencv: pixel_size_mm=\(3.9, 3.9\): a pixel pitch of 3.9 mm is "
-         r"above 0.1 mm; micrometres\? give \(0.0039, 0.0039\) mm"),
+         r"above 1 mm; micrometres\? give \(0.0039, 0.0039\) mm"),
+        # 0.8 µm given in µm: inside the pitch range (X-ray panels reach 0.2 mm), but 6000 px of
+        # 0.8 mm make a 4.8 m sensor
+        ((0.8, 0.8), r"camera model opencv: pixel_size_mm=\(0.8, 0.8\): 6000x4000 pixels of that "
+         r"pitch make a 4800x3200 mm sensor, larger than 1000 mm; micrometres\? give "
+         r"\(0.0008, 0.0008\) mm$"),
+        ((0.2, 0.2), r"6000x4000 pixels of that pitch make a 1200x800 mm sensor, larger than "
+         r"1000 mm; check the pitch \(mm\) and the image size \(pixels\)$"),
         ((6e-6, 6e-6), r"pixel_size_mm=\(6e-06, 6e-06\): a pixel pitch of 6e-06 mm is below "
          r"0.0003 mm; metres\? give \(0.006, 0.006\) mm"),
         ((0.0, 0.006), r"pixel_size_mm=\(0, 0.006\): give \(pitch_x, pitch_y\) in mm"),
@@ -521,10 +528,38 @@ def test_points_beyond_the_fold_get_a_status_not_a_number():
     ],
 )  # fmt: skip
 def test_a_pixel_size_in_the_wrong_unit_is_refused_by_the_camera(ps, match):
-    """The pitch range of Sensor.from_spec (0.3..100 µm), said in mm where the keyword is mm."""
+    """The pitch range of Sensor.from_spec (0.3..1000 µm), said in mm where the keyword is mm;
+    above 0.1 mm the sensor the pitch makes stays within Sensor's 1000 mm."""
     with pytest.raises(Exception, match=match) as e:
         CameraModel.create("opencv", 6000, 4000, pixel_size_mm=ps, fx=8333.0, fy=8333.0,
                            cx=2999.5, cy=1999.5)  # fmt: skip
     from distortion.errors import DataError
 
     assert e.type is DataError
+
+
+@pytest.mark.parametrize(
+    "model, size, ps, c_px",
+    [
+        ("opencv", (3072, 3072), (0.139, 0.139), 7000.0),  # Varex PaxScan 4343 (139 µm)
+        ("australis", (2048, 2048), (0.2, 0.2), 5000.0),  # PerkinElmer XRD 1621 (200 µm)
+        ("opencv", (1800, 1800), (0.127, 0.127), 1200.0),  # film scanned at 200 dpi (127 µm)
+    ],
+)
+def test_an_x_ray_panel_or_scanned_film_pitch_is_taken(model, size, ps, c_px, tmp_path):
+    """Review of cfa9e08 (F1): a pitch above 0.1 mm was refused, so X-ray flat panels and film
+    scanned at 200 dpi could not be built, written or read back; now they are, silently."""
+    import warnings
+
+    from distortion.camera import pinhole_camera
+
+    w, h = size
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        cam = pinhole_camera(model, w, h, c_px, c_px, (w - 1) / 2, (h - 1) / 2, pixel_size_mm=ps)
+        assert cam.pixel_size_mm == ps
+        path = tmp_path / ("c.aus" if model == "australis" else "c.json")
+        write_calibration(cam, path)
+        back = read_calibration(path)
+    if model == "australis":  # the pitch is in the file and the model
+        assert back.pixel_size_mm == ps and back["c"] == pytest.approx(c_px * ps[0])

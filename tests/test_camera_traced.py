@@ -755,7 +755,7 @@ def test_distortion_at_a_corner_of_a_nearly_degenerate_rational_model():
 
 # ---------------------------------------------------------- values in the wrong unit, refused where
 # they enter (review 2026-12, camera units sweep): the pitch range of Sensor.from_spec
-# (0.3..100 µm) said in mm, the grid limit of distortion_grid (raytrace.limits.MAX_FIELDS)
+# (0.3..1000 µm) said in mm, the grid limit of distortion_grid (raytrace.limits.MAX_FIELDS)
 def _bare_cam(**kw) -> CameraModel:
     base = dict(fx=8333.0, fy=8333.0, cx=2999.5, cy=1999.5, k1=-0.05)
     base.update(kw)
@@ -765,7 +765,7 @@ def _bare_cam(**kw) -> CameraModel:
 @pytest.mark.parametrize(
     "ps, match",
     [
-        ((6, 6), r"^pixel_size_mm=\(6, 6\): a pixel pitch of 6 mm is above 0.1 mm; micrometres\? "
+        ((6, 6), r"^pixel_size_mm=\(6, 6\): a pixel pitch of 6 mm is above 1 mm; micrometres\? "
          r"give \(0.006, 0.006\) mm$"),
         ((0, 0), r"^pixel_size_mm=\(0, 0\): give \(pitch_x, pitch_y\) in mm, two positive numbers"),
         ((math.nan, math.nan), r"^pixel_size_mm=\(nan, nan\): give \(pitch_x, pitch_y\) in mm"),
@@ -838,7 +838,7 @@ def test_calibrated_models_refuse_a_number_of_radii_that_makes_no_profile(n):
     [
         (0.05, r"^focal_length_mm=0.05 mm is far from the calibrations' principal distances 51.2 "
          r"and 50.64 mm \(c/f = 1024 and 1013; c = f \(1 \+ magnification\), so c/f lies within "
-         r"0.5\.\.5\): metres\? 0.05 m = 50 mm; give f in mm$"),
+         r"0.5\.\.8, macro up to 7:1\): metres\? 0.05 m = 50 mm; give f in mm$"),
         (50000, r"^focal_length_mm=50000 mm is far from .* micrometres\? 50000 µm = 50 mm; give f "
          r"in mm$"),
         (5.0, r"^focal_length_mm=5 mm is far from .* centimetres\? 5 cm = 50 mm; give f in mm$"),
@@ -849,3 +849,29 @@ def test_calibrated_models_refuse_a_focal_length_far_from_the_calibrations(f, ma
     with pytest.raises(DataError, match=match):
         calibrated_models_by_distance(c1, 1000, c2, 3000, focal_length_mm=f, focus=2000,
                                       object_distances=[1500])  # fmt: skip
+
+
+def _macro_cam(c_mm: float, k1: float) -> CameraModel:
+    ps = 0.0043  # mm
+    return CameraModel.create("opencv", 6000, 4000, pixel_size_mm=(ps, ps), fx=c_mm / ps,
+                              fy=c_mm / ps, cx=2999.5, cy=1999.5, k1=k1)  # fmt: skip
+
+
+@pytest.mark.parametrize("m1, m2", [(2.0, 5.0), (1.0, 5.0), (5.0, 7.0)])
+def test_calibrated_models_take_a_macro_lens_at_up_to_7_to_1(m1, m2):
+    """Review of cfa9e08 (F4): c/f above 5 was refused, but 5:1 macro lenses exist (Canon MP-E
+    65 mm, Laowa 2.5-5x): c/f = 1 + m = 6 at 5x. Thin-lens geometry of an f = 65 mm lens
+    calibrated at m1 and m2: c = f (1 + m), s = f (1 + 1/m) (object distance from the lens)."""
+    f = 65.0
+    c1, c2 = _macro_cam(f * (1 + m1), -0.02), _macro_cam(f * (1 + m2), -0.03)
+    s1, s2 = f * (1 + 1 / m1), f * (1 + 1 / m2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        t = calibrated_models_by_distance(c1, s1, c2, s2, focal_length_mm=f, focus=s1,
+                                          object_distances=[s1, s2])  # fmt: skip
+    assert len(t.cameras) == 2
+    # the same f in centimetres is still refused, saying so (c/f = 60 at 5x)
+    with pytest.raises(DataError, match=r"c/f lies within 0.5\.\.8, macro up to 7:1\): "
+                       r"centimetres\? 6.5 cm = 65 mm; give f in mm$"):  # fmt: skip
+        calibrated_models_by_distance(c1, s1, c2, s2, focal_length_mm=6.5, focus=s1,
+                                      object_distances=[s1])  # fmt: skip

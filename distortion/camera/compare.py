@@ -262,8 +262,9 @@ def compare_cameras(
         Same image size (pixels).
     pixel_size_mm : (float, float), optional
         Pixel pitch (mm) for profiles in mm and µm (default: the cameras' own); two positive
-        numbers within 0.0003..0.1 mm (the pitch range of :meth:`Sensor.from_spec
-        <distortion.camera.Sensor.from_spec>`: a larger one reads as µm and is refused).
+        numbers within 0.0003..1 mm (the pitch range of :meth:`Sensor.from_spec
+        <distortion.camera.Sensor.from_spec>`: a larger one reads as µm and is refused;
+        :func:`~distortion.camera.sensor.check_pixel_size_mm`).
     grid : (int, int) or int
         Columns × rows of the map over the sensor (n: n × n), whole numbers of at least 2; at
         most :data:`raytrace.limits.MAX_FIELDS` points without ``allow_large`` (the limit of

@@ -218,7 +218,7 @@ def convert_camera_model(
         and the 8 coefficients k1..k6 p1 p2 — give 12 or 14 to add prism and tilt).
     pixel_size_mm:
         Pixel size (mm) for a target in mm (``australis``) when the source has none; checked
-        as :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it (0.0003..0.1 mm).
+        as :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it (0.0003..1 mm).
     exact:
         Try exact algebra first (default; not when ``free`` is given: naming what a refit may
         change asks for a refit). ``False`` forces a refit.

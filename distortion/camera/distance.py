@@ -52,9 +52,10 @@ METHODS = ("brown", "fraser-shortis")
 MIN_RADII = 3
 #: the range of c / f accepted between the calibrations' principal distance c and the focal
 #: length f of Brown's formulas: c = f (1 + m) for a thin lens at magnification m, so c/f is 1
-#: at infinity and 2 at 1:1; 0.5..5 leaves room for a nominal f and macro up to 4:1, while f in
-#: metres or µm (c/f near 1000 or 0.001), centimetres (10) or inches (25) falls outside
-FOCAL_RATIO_RANGE = (0.5, 5.0)
+#: at infinity and 2 at 1:1; 0.5..8 leaves room for a nominal f and macro up to 7:1 (5:1 macro
+#: lenses exist: Canon MP-E 65 mm, Laowa 2.5-5x, c/f = 6 at 5x), while f in metres or µm (c/f
+#: near 1000 or 0.001), centimetres (10 or more) or inches (25 or more) falls outside
+FOCAL_RATIO_RANGE = (0.5, 8.0)
 #: unit slips tried for a refused focal length: (name, symbol, mm per unit)
 _SLIPS = (("metres", "m", 1000.0), ("centimetres", "cm", 10.0), ("inches", "in", 25.4),
           ("micrometres", "µm", 1e-3))  # fmt: skip
@@ -266,7 +267,7 @@ def _check_focal_length(f: float, cals: Sequence[CameraModel], ps) -> None:
         f"focal_length_mm={f:g} mm is far from the calibrations' principal distances "
         f"{' and '.join(f'{c:.4g}' for c in cs)} mm (c/f = "
         f"{' and '.join(f'{c / f:.4g}' for c in cs)}; c = f (1 + magnification), so c/f lies "
-        f"within {lo:g}..{hi:g}): {fix}"
+        f"within {lo:g}..{hi:g}, macro up to {hi - 1:g}:1): {fix}"
     )
 
 
@@ -326,15 +327,15 @@ def calibrated_models_by_distance(
         Distances from the lens (mm, or with a unit: ``"2m"``; ``"inf"``), beyond f.
     focal_length_mm : float
         f of Brown's formulas (mm). Refused when the calibrations' principal distance c is not
-        within 0.5..5 × f (:data:`FOCAL_RATIO_RANGE`; c = f (1 + magnification)): f in metres,
-        centimetres, inches or µm.
+        within 0.5..8 × f (:data:`FOCAL_RATIO_RANGE`; c = f (1 + magnification), macro up to
+        7:1): f in metres, centimetres, inches or µm.
     object_distances : sequence
         s' of each row (distances from the lens).
     method : {"brown", "fraser-shortis"}
         Eq. (1), or Eq. (6) with ``g``.
     pixel_size_mm : (float, float), optional
         Pixel pitch (mm) when the calibrations carry none (checked as
-        :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it: 0.0003..0.1 mm).
+        :func:`~distortion.camera.sensor.check_pixel_size_mm` checks it: 0.0003..1 mm).
     n_radii : int
         Radii of the profiles, from half-diagonal / n_radii to the half-diagonal: a whole
         number, at least 3 (:data:`MIN_RADII`: k1, k2, k3 are fitted to them), at most
@@ -365,7 +366,7 @@ def calibrated_models_by_distance(
     if (c1.width, c1.height) != (c2.width, c2.height):
         raise DataError("the two calibrations are of different image sizes")
     if pixel_size_mm is not None:
-        pixel_size_mm = check_pixel_size_mm(pixel_size_mm)
+        pixel_size_mm = check_pixel_size_mm(pixel_size_mm, pixels=(c1.width, c1.height))
     ps = pixel_size_mm or c1.pixel_size_mm or c2.pixel_size_mm
     if ps is None:
         raise DataError("give pixel_size_mm=(pitch_x, pitch_y) in mm: the profiles are in mm")

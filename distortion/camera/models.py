@@ -938,7 +938,9 @@ class CameraModel:
         Image size in pixels.
     pixel_size_mm:
         (pitch_x, pitch_y) in mm: needed by models in mm (``australis``) and to relate pixels to
-        a sensor; optional otherwise.
+        a sensor; optional otherwise. Checked by
+        :func:`~distortion.camera.sensor.check_pixel_size_mm` (0.0003..1 mm; above 0.1 mm the
+        sensor it makes with the image size must stay within 1000 mm).
     """
 
     model: str
@@ -970,7 +972,9 @@ class CameraModel:
                 raise DataError(f"camera model {name}: image {n} must be a positive integer")
             object.__setattr__(self, n, int(v))
         if self.pixel_size_mm is not None:
-            ps = check_pixel_size_mm(self.pixel_size_mm, f"camera model {name}: ")
+            ps = check_pixel_size_mm(
+                self.pixel_size_mm, f"camera model {name}: ", (self.width, self.height)
+            )
             object.__setattr__(self, "pixel_size_mm", ps)
         elif spec.frame == "photo_mm":
             raise DataError(
@@ -1140,10 +1144,16 @@ def camera_from_sensor(
     Raises
     ------
     DataError
-        A principal distance that is not positive and finite, or in the wrong unit (a field
-        angle at the sensor's farthest corner above 87° or below 0.057°:
+        A principal distance that is not positive and finite, or in metres (a field angle at
+        the sensor's farthest corner above 87°:
         :func:`~distortion.camera.sensor.check_principal_distance_mm`), an unknown model, a
         parameter the model does not have.
+
+    Warns
+    -----
+    UnitWarning
+        A principal distance that may be in µm (a field angle at the sensor's farthest corner
+        below 0.057°; a telescope can have one): it is taken in mm.
     """
     dx, dy = sensor.principal_point_offset_mm
     largest = math.hypot(sensor.width_mm / 2.0 + abs(dx), sensor.height_mm / 2.0 + abs(dy))

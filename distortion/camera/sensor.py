@@ -7,7 +7,9 @@ COLMAP and Metashape at +0.5; photogrammetric mm with y up, origin at the sensor
 from __future__ import annotations
 
 import math
+import os
 import re
+import sys
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -24,17 +26,28 @@ from .conventions import (
     to_opencv_pixels,
 )
 
-# plausible ranges: phone sensors have ~0.5 µm pixels, scientific CCDs up to ~30 µm, film
-# scanners / line arrays rarely more; a sensor is between a fraction of a mm and ~0.5 m.
-PITCH_RANGE_UM = (0.3, 100.0)
-SIZE_RANGE_MM = (0.5, 1000.0)
+#: plausible pixel pitches (µm): phone sensors have ~0.56 µm pixels, scientific CCDs up to
+#: ~30 µm, X-ray flat panels 75..200 µm (Varex 4343: 139 µm; PerkinElmer XRD1621: 200 µm), film
+#: scanned at 200 dpi 127 µm. A pitch in mm given for µm (6 µm as 6 mm: 6000 µm) lies above.
+PITCH_RANGE_UM = (0.3, 1000.0)
+#: plausible sensor sides (mm): from a chip-on-tip endoscope sensor (OmniVision OV6948:
+#: 200 px of 1.75 µm, 0.35 mm) to ~0.5 m; 36 mm given in metres (0.036) lies below.
+SIZE_RANGE_MM = (0.1, 1000.0)
 MAX_PIXELS = 1_000_000
-#: the largest principal distance accepted, as a multiple of the sensor's largest radius from the
-#: principal point: 1000 is a field half-angle of 0.057°. A 50 mm lens given in µm (50000) on a
-#: full-frame sensor (half-diagonal 21.6 mm) is 2311, a 4.3 mm phone lens given in µm on a
-#: 7.7 mm-diagonal sensor 1117; long lenses stay far below (2000 mm on APS-C, half-diagonal
-#: 14.2 mm: 141). A telescope of more than 1000 × the sensor's half-diagonal is refused too.
+#: a pixel pitch (mm) above which :func:`check_pixel_size_mm` also checks the sensor it makes
+#: with the image's pixel count (the upper bound of the pitch range before X-ray panels)
+LARGE_PITCH_MM = 0.1
+#: the principal distance above which a warning asks whether it is in µm, as a multiple of the
+#: sensor's largest radius from the principal point: 1000 is a field half-angle of 0.057°. A
+#: 50 mm lens given in µm (50000) on a full-frame sensor (half-diagonal 21.6 mm) is 2311, a
+#: 4.3 mm phone lens given in µm on a 7.7 mm-diagonal sensor 1117; camera lenses stay far below
+#: (2000 mm on APS-C, half-diagonal 14.2 mm: 141), but telescopes do not (an ASI224, radius
+#: 3.05 mm, on a C14 at 3910 mm: 1280; at 7000 mm: 2292), so a larger one is warned of, not
+#: refused.
 MAX_PRINCIPAL_DISTANCE_RATIO = 1000.0
+#: a principal-point offset read as µm is suggested only beyond this many sensor half-diagonals
+#: (a shift, rise or crop puts it off the sensor by less)
+OFFSET_SLIP_RATIO = 10.0
 
 _PAIR = re.compile(r"^\s*([^x×*,]+?)\s*(?:[x×*,]\s*([^x×*,]+?))?\s*$", re.IGNORECASE)
 _NUM_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([a-zA-Zµμ]*)\s*$")
@@ -49,6 +62,20 @@ _UM = {
     "nm": 1e-3,
 }
 _MM = {"": 1.0, "mm": 1.0, "cm": 10.0, "m": 1000.0, "um": 1e-3, "µm": 1e-3, "μm": 1e-3}
+
+
+def _caller_level() -> int:
+    """``stacklevel`` for a warning issued by the function that calls this one: the first frame
+    outside :mod:`distortion.camera` (a dataclass's generated ``__init__`` counts as inside),
+    so the warning names the user's line and not :meth:`Sensor.from_spec`'s."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    f, level = sys._getframe(1), 1
+    while f is not None:
+        name = f.f_code.co_filename
+        if not (name.startswith("<") or os.path.dirname(os.path.abspath(name)) == here):
+            break
+        f, level = f.f_back, level + 1
+    return level
 
 
 def unit_slip(value: float, lo: float, hi: float, factor: float = 1000.0) -> float | None:
@@ -93,16 +120,20 @@ def _pair_text(value) -> str:
     return "(" + ", ".join(f"{v:g}" for v in vals) + ")"
 
 
-def check_pixel_size_mm(pixel_size_mm, head: str = "") -> tuple[float, float]:
+def check_pixel_size_mm(pixel_size_mm, head: str = "", pixels=None) -> tuple[float, float]:
     """``(pitch_x, pitch_y)`` in mm, checked as :meth:`Sensor.from_spec` checks a pixel pitch:
-    two positive finite numbers within :data:`PITCH_RANGE_UM` (0.0003..0.1 mm); one above that
+    two positive finite numbers within :data:`PITCH_RANGE_UM` (0.0003..1 mm); one above that
     reads as micrometres given for mm, one below as metres (the message says which and gives
-    the pair in mm). ``head`` is put before the message (e.g. ``"camera model opencv: "``).
+    the pair in mm). With ``pixels`` (columns, rows), a pitch above :data:`LARGE_PITCH_MM`
+    (X-ray panels, scanned film) must make with them a sensor within the upper bound of
+    :data:`SIZE_RANGE_MM` (1000 mm), as a :class:`Sensor`'s size must: a sub-µm phone pitch
+    given in µm (0.56 for 0.56 µm) passes the pitch range but makes a sensor of metres (16320
+    columns: 9139 mm). ``head`` is put before the message (e.g. ``"camera model opencv: "``).
 
     Raises
     ------
     DataError
-        ``pixel_size_mm=(6, 6): a pixel pitch of 6 mm is above 0.1 mm; micrometres? give
+        ``pixel_size_mm=(6, 6): a pixel pitch of 6 mm is above 1 mm; micrometres? give
         (0.006, 0.006) mm``.
     """
     label = f"{head}pixel_size_mm={_pair_text(pixel_size_mm)}"
@@ -131,6 +162,18 @@ def check_pixel_size_mm(pixel_size_mm, head: str = "") -> tuple[float, float]:
         else:
             fix = "give the pitch in mm, e.g. (0.006, 0.006)"
         raise DataError(f"{label}: a pixel pitch of {v:g} mm is {side}; {fix}")
+    if pixels is not None and max(vals) > LARGE_PITCH_MM:
+        cols, rows = pixels
+        w, h = cols * vals[0], rows * vals[1]
+        top = SIZE_RANGE_MM[1]
+        if max(w, h) > top:
+            fix = "check the pitch (mm) and the image size (pixels)"
+            if all(v / 1000.0 >= lo for v in vals):
+                fix = f"micrometres? give ({vals[0] / 1000.0:g}, {vals[1] / 1000.0:g}) mm"
+            raise DataError(
+                f"{label}: {cols}x{rows} pixels of that pitch make a {w:.4g}x{h:.4g} mm sensor, "
+                f"larger than {top:g} mm; {fix}"
+            )
     return vals[0], vals[1]
 
 
@@ -141,13 +184,22 @@ def check_principal_distance_mm(
     positive finite number, and a field angle atan(r / c) that a camera has — at most
     atan(:data:`distortion.coefficients.MAX_RADIUS_RATIO`) = 87° (the bound of
     :func:`distortion.coefficients.opencv_model`: c in metres, or a pitch in mm for µm, gives
-    more) and at least atan(1 / :data:`MAX_PRINCIPAL_DISTANCE_RATIO`) = 0.057° (c in µm gives
-    less). ``what`` names the value (``"principal_distance_mm=0.05:"`` names the keyword).
+    more; refused). ``what`` names the value (``"principal_distance_mm=0.05:"`` names the
+    keyword).
+
+    A c of more than :data:`MAX_PRINCIPAL_DISTANCE_RATIO` × r (a field angle below 0.057°) is
+    taken, with a :class:`~distortion.errors.UnitWarning`: a lens given in µm lands there, and
+    so does a telescope (3910 mm on a 3.05 mm radius is 1280 × r).
 
     Raises
     ------
     DataError
         Naming ``what``, the ratio and field angle, and the unit the value looks like.
+
+    Warns
+    -----
+    UnitWarning
+        c above :data:`MAX_PRINCIPAL_DISTANCE_RATIO` × r, naming the µm reading where it fits.
     """
     from ..coefficients import MAX_RADIUS_RATIO  # not at import: coefficients imports models
 
@@ -173,13 +225,15 @@ def check_principal_distance_mm(
         )
     if c > hi:
         fix = (
-            f"micrometres? {c:g} µm = {alt:g} mm; give c in mm"
-            if alt is not None
-            else "is it in the wrong unit?"
+            f"micrometres? {c:g} µm = {alt:g} mm" if alt is not None else "is it in the wrong unit?"
         )
-        raise DataError(
-            f"{what} {c:g} mm is {c / r:.4g} times the sensor's largest radius {r:.3g} mm "
-            f"{angle}; more than {MAX_PRINCIPAL_DISTANCE_RATIO:g} times is refused: {fix}"
+        warnings.warn(
+            UnitWarning(
+                f"{what} {c:g} mm is {c / r:.4g} times the sensor's largest radius {r:.3g} mm "
+                f"{angle}, more than {MAX_PRINCIPAL_DISTANCE_RATIO:g} times; taken as {c:g} mm "
+                f"(a telescope can be that long): {fix}"
+            ),
+            stacklevel=_caller_level(),
         )
     return c
 
@@ -317,8 +371,10 @@ class Sensor:
     principal_point_offset_mm:
         (dx, dy) of the principal point (where the optical axis meets the sensor) from the sensor
         centre, in mm, photogrammetric axes: **x right, y up** (Australis' xp, yp of a camera
-        whose image centre is the sensor centre); on the sensor (|dx| ≤ width/2, |dy| ≤
-        height/2): an offset beyond it is refused (as µm when it would fit read so).
+        whose image centre is the sensor centre). An offset off the sensor (|dx| > width/2 or
+        |dy| > height/2: a shift or rise, a cropped image) is taken with a
+        :class:`~distortion.errors.UnitWarning`, which suggests µm when the offset is more than
+        :data:`OFFSET_SLIP_RATIO` half-diagonals and would lie on the sensor read so.
 
     Build it from strings or numbers with :meth:`from_spec`; the constructor checks
     consistency and ranges and raises :class:`~distortion.errors.DataError` naming the fix.
@@ -363,23 +419,34 @@ class Sensor:
                     f"{self.height_px} pixels makes pixels of {px:.4g} x {py:.4g} µm, far from "
                     "square: width and height swapped in one of them?"
                 ),
-                stacklevel=3,
+                stacklevel=_caller_level(),
             )
 
     def _check_offset(self) -> None:
-        """Refuse a principal point off the sensor (|dx| > width/2 or |dy| > height/2; on the
-        edge is on it); when it would lie on it read as µm, say so."""
+        """Warn (:class:`~distortion.errors.UnitWarning`) of a principal point off the sensor
+        (|dx| > width/2 or |dy| > height/2; on the edge is on it). A shift or rise lens, or a
+        calibration of a cropped image, puts it there, so it is taken; the warning asks whether
+        it is in µm only when the offset is more than :data:`OFFSET_SLIP_RATIO` half-diagonals
+        (no shift or crop reaches that) and would lie on the sensor read as µm."""
         dx, dy = self.principal_point_offset_mm
         hw, hh = self.width_mm / 2.0, self.height_mm / 2.0
         if abs(dx) <= hw and abs(dy) <= hh:
             return
-        fix = "give the offset from the sensor centre in mm (x right, y up)"
-        if abs(dx) / 1000.0 <= hw and abs(dy) / 1000.0 <= hh:
-            fix = f"micrometres? give ({dx / 1000.0:g}, {dy / 1000.0:g}) mm"
-        raise DataError(
-            f"principal-point offset {dx:g},{dy:g}: ({dx:g}, {dy:g}) mm lies outside the "
-            f"{self.width_mm:g}x{self.height_mm:g} mm sensor (|dx| ≤ {hw:g}, |dy| ≤ {hh:g} mm); "
-            f"{fix}"
+        ratio = math.hypot(dx, dy) / math.hypot(hw, hh)  # in half-diagonals
+        far = ratio > OFFSET_SLIP_RATIO
+        if not far:
+            fix = "taken as given (a shift or rise, or a cropped image, puts it there)"
+        elif abs(dx) / 1000.0 <= hw and abs(dy) / 1000.0 <= hh:
+            fix = f"taken as given: micrometres? give ({dx / 1000.0:g}, {dy / 1000.0:g}) mm"
+        else:
+            fix = f"taken as given, {ratio:.0f} half-diagonals from the centre: is it in mm?"
+        warnings.warn(
+            UnitWarning(
+                f"principal-point offset {dx:g},{dy:g}: ({dx:g}, {dy:g}) mm lies off the "
+                f"{self.width_mm:g}x{self.height_mm:g} mm sensor (|dx| ≤ {hw:g}, |dy| ≤ "
+                f"{hh:g} mm; the offset is from the sensor centre in mm, x right, y up); {fix}"
+            ),
+            stacklevel=_caller_level(),
         )
 
     # ---- construction -----------------------------------------------------------------------
@@ -404,7 +471,8 @@ class Sensor:
             pixel count the count is size / pitch rounded to whole pixels and the size becomes
             count × pitch.
         principal_point_offset_mm:
-            (dx, dy) from the sensor centre in mm, x right, y up (or ``"dx,dy"``); on the sensor.
+            (dx, dy) from the sensor centre in mm, x right, y up (or ``"dx,dy"``); off the
+            sensor it is warned of (:class:`Sensor`).
         """
         given = [
             n
