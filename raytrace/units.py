@@ -106,10 +106,10 @@ def length_mm(
     return v
 
 
-#: The largest distance of an image plane (mm, exclusive): Zemax, CODE V and OSLO read a
-#: distance of 1e10 (lens units) or more as infinity (``raytrace/files``: zemax.py, codev.py,
-#: oslo.py), so a plane that far is no finite plane (1e10 mm is 10,000 km: no image plane of a
-#: lens lies near it, and 1e300 was traced to distortions of 1e296 mm).
+#: The largest distance of an image plane (mm, exclusive). 1e10 mm is 10,000 km: no image plane
+#: of a lens lies near it (1e300 was traced to distortions of 1e296 mm). It is the threshold the
+#: Zemax, CODE V and OSLO files use for an object at infinity (their object distance of 1e10 lens
+#: units or more: ``raytrace/files``: zemax.py, codev.py, oslo.py), taken over for image planes.
 PLANE_LIMIT_MM = 1e10
 
 
@@ -133,14 +133,15 @@ def plane_distance_mm(value: float | str, what: str) -> float:
     Raises
     ------
     UnitError
-        Not a length, not finite, or 1e10 mm or more away (a distance lens files read as
+        Not a length, not finite, or 1e10 mm or more away (where lens files put an object at
         infinity).
     """
     v = length_mm(value, what)
     if abs(v) >= PLANE_LIMIT_MM:
         raise UnitError(
-            f"{what}={v:g} mm is not a plane position: lens-design programs read 1e10 mm or more "
-            "as infinity; give a distance within ±1e10 mm (mm, or a length with its unit: 50.5mm)"
+            f"{what}={v:g} mm is not a plane position: 1e10 mm or more is where lens files put "
+            "an object at infinity; give a distance within ±1e10 mm (mm, or a length with its "
+            "unit: 50.5mm)"
         )
     return v
 

@@ -194,10 +194,11 @@ def test_an_image_plane_that_is_no_length_names_the_keyword(cooke, value, says):
 @pytest.mark.parametrize("kw", ["s_prime", "from_last_vertex", "defocus"])
 @pytest.mark.parametrize("value", [1e300, -1e300, 1e10, "1e7m"])
 def test_an_image_plane_at_the_distance_lens_files_call_infinity_is_refused(cooke, kw, value):
-    # 1e300 was traced (max |D0| = 5e296 mm) while inf was refused; Zemax, CODE V and OSLO read
-    # a distance of 1e10 mm or more as infinity (raytrace/files: zemax.py, codev.py, oslo.py)
+    # 1e300 was traced (max |D0| = 5e296 mm) while inf was refused; Zemax, CODE V and OSLO files
+    # put an object at infinity at a distance of 1e10 or more (raytrace/files: zemax.py,
+    # codev.py, oslo.py)
     mm = length_mm(value, kw)
-    says = f"{kw}={mm:g} mm is not a plane position: lens-design programs read 1e10 mm or more"
+    says = f"{kw}={mm:g} mm is not a plane position: 1e10 mm or more is where lens files put"
     for call in (
         lambda: ImagePlane(kw, value),
         lambda: osc.characteristic_distortion(cooke, [0, 10], **{kw: value}),
