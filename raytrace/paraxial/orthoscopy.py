@@ -211,7 +211,7 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float | str) -> PestrecovC
     s_prime : float or str
         The image plane, mm from the second principal point H' (positive toward the image), or a
         string with a length unit as the command line takes it (``"50.5mm"``;
-        :func:`raytrace.units.plane_distance_mm`; TraceError naming ``s_prime``).
+        :class:`~raytrace.paraxial.ImagePlane`; TraceError naming ``s_prime``).
 
     Returns
     -------
@@ -220,13 +220,9 @@ def pestrecov_constants(par: ParaxialResult, s_prime: float | str) -> PestrecovC
         ``scale`` = M0 (finite conjugates, dimensionless, signed) or F0 (object at infinity, mm)
         and ``infinite``.
     """
-    from ..errors import TraceError
-    from ..units import UnitError, plane_distance_mm
+    from .conjugates import ImagePlane  # (conjugates imports this module)
 
-    try:
-        sp = plane_distance_mm(s_prime, "s_prime")
-    except UnitError as e:  # the error every image-plane keyword raises (ImagePlane)
-        raise TraceError(str(e)) from None
+    sp = ImagePlane("s_prime", s_prime).value  # the one reading of an image-plane distance
     return PestrecovConstants(sp, par.p0, sp - par.HpE0p, float(_scale(par, sp)), par.infinite)
 
 
