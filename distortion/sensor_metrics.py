@@ -387,11 +387,9 @@ def sensor_metrics(grid, plane: int = 0) -> SensorMetrics:
         lattice, fewer than 3 or an even number of rows or columns, a middle row or column that
         is not the picture's centre line.
     """
-    if not 0 <= int(plane) < grid.n_planes:
-        raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")
+    p = grid.plane_index(plane)
     if len(grid.shape) != 2:
         raise DataError("the picture metrics need a 2-D grid of fields (rows x columns)")
-    p = int(plane)
     ref = np.asarray(grid.reference_xy[p], dtype=float)
     if not np.all(np.isfinite(ref)):  # the lattice's shape is all that matters here
         ref = np.zeros(2)

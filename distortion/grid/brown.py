@@ -325,9 +325,7 @@ def fit_brown_conrady(
         ``plane`` out of range, or an image that does not grow with the field (no positive
         camera constant).
     """
-    if not 0 <= int(plane) < grid.n_planes:
-        raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")
-    p = int(plane)
+    p = grid.plane_index(plane)
     t = np.stack([grid.tx.ravel(), grid.ty.ravel()], axis=1)
     img = grid.actual[p].reshape(-1, 2)
     off = (0.0, 0.0)

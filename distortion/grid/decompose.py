@@ -494,9 +494,7 @@ def decompose_distortion(
         raise DataError(
             f"camera_constant={camera_constant!r}; use one of {', '.join(CAMERA_CONSTANTS)}"
         )
-    if not 0 <= int(plane) < grid.n_planes:
-        raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")
-    p = int(plane)
+    p = grid.plane_index(plane)
     pp = None if principal_point == "fit" else tuple(grid.named_point(principal_point)[p])
     if pp is not None and not all(math.isfinite(v) for v in pp):
         raise DataError(f"the {principal_point} point of plane {p} could not be traced")

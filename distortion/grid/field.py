@@ -171,6 +171,13 @@ class DistortionGrid(FieldKindMixin):
     def ok(self) -> np.ndarray:
         return self.status == 0
 
+    def plane_index(self, plane: int) -> int:
+        """``plane`` as a 0-based index of the grid's image planes; DataError when out of
+        range."""
+        if not 0 <= int(plane) < self.n_planes:
+            raise DataError(f"plane={plane}: the grid has {self.n_planes} image plane(s) (0-based)")
+        return int(plane)
+
     def plane_label(self, i: int) -> str:
         return plane_label(self.s_prime[i], self.defocus[i])
 

@@ -320,17 +320,11 @@ def analyze_csv(
     focal_length_mm : float, optional
         Focal length f in mm, overriding the file's ``# focal_length_mm:`` metadata; γ_ss'
         (Eq. 2) needs it when the distances are in metres.
-    r_min, r_max : float, optional
-        Radial range in mm (radii in the image) over which g_ss' is estimated; default all
-        common radii.
-    threshold_um : float
-        Radii where |δr_s' − δr_s| < ``threshold_um`` (µm) are left out of the g_ss' estimate
-        (weak determination); default :data:`~distortion.variation.models.WEAK_THRESHOLD_UM`
-        (0.5 µm).
-    method : {"lsq", "mean"}
-        How g_ss' is estimated from Eq. (6): ``"lsq"`` (default) least squares through the
-        origin of δr_ss' − δr_s against δr_s' − δr_s; ``"mean"`` the mean of the pointwise
-        ratios over the radial range, as in the paper.
+    r_min, r_max, threshold_um, method
+        As :func:`analyze_variation`: the radial range over which g_ss' is estimated (mm;
+        default all common radii), the weak-determination threshold (µm; default
+        :data:`~distortion.variation.models.WEAK_THRESHOLD_UM`, 0.5 µm) and the g_ss' estimate
+        (``"lsq"``, the default, or ``"mean"``).
 
     Returns
     -------

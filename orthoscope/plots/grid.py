@@ -23,12 +23,6 @@ FIGSIZE_SQUARE = (6.4, 6.0)
 COMPONENTS = ("total", "radial", "decentering", "thin_prism", "offset", "scale", "residual")
 
 
-def _plane(grid: DistortionGrid, plane: int) -> int:
-    if not 0 <= int(plane) < grid.n_planes:
-        raise DataError(f"plane={plane}: the grid has {grid.n_planes} image plane(s) (0-based)")
-    return int(plane)
-
-
 def nice_factor(value: float) -> float:
     """The largest 1-2-5 number ≤ ``value`` (≥ 1): a readable exaggeration factor."""
     if not (value > 1.0) or not math.isfinite(value):
@@ -43,7 +37,7 @@ def nice_factor(value: float) -> float:
 def default_exaggeration(grid: DistortionGrid, plane: int = 0, fraction: float = 0.05) -> float:
     """A 1-2-5 factor k with which the largest |D| appears as about ``fraction`` of the grid's
     half-size (1 when the distortion is already that large)."""
-    p = _plane(grid, plane)
+    p = grid.plane_index(plane)
     ideal = grid.ideal[p]
     half = 0.5 * float(np.nanmax(ideal[..., 0]) - np.nanmin(ideal[..., 0]))
     half = max(half, 0.5 * float(np.nanmax(ideal[..., 1]) - np.nanmin(ideal[..., 1])))
@@ -108,7 +102,7 @@ def plot_grid_distortion(
     -------
     matplotlib.figure.Figure
     """
-    p = _plane(grid, plane)
+    p = grid.plane_index(plane)
     if len(grid.shape) != 2:
         raise DataError("plot_grid_distortion needs a 2-D grid of fields (rows x columns)")
     k = default_exaggeration(grid, p) if exaggeration is None else float(exaggeration)
@@ -171,7 +165,7 @@ def plot_distortion_vectors(
     -------
     matplotlib.figure.Figure
     """
-    p = _plane(grid, plane)
+    p = grid.plane_index(plane)
     if component not in COMPONENTS:
         raise DataError(f"component={component!r}; use one of {', '.join(COMPONENTS)}")
     if component == "total":
@@ -298,7 +292,7 @@ def plot_radial_by_azimuth(
     matplotlib.figure.Figure
     """
     g = curves.grid
-    p = _plane(g, plane)
+    p = g.plane_index(plane)
     fig, ax = figure_with_zero(ax)
     ax.grid(True, **GRID)
     handles, labels = [], []

@@ -63,6 +63,7 @@ from .solver import (
     checked_evaluate,
     continuous,
     limit_message,
+    local_result,
     max_violation,
     start_values,
     variable_scales,
@@ -402,18 +403,4 @@ def minimax(
     elif converged and spec.merit_goal is not None and m > spec.merit_goal:
         converged = False
         message = f"max weighted residual {m:.6g} is above the goal {spec.merit_goal:.6g}"
-    message += log.note()
-    return OptimizationResult(
-        lens=final,
-        x=np.asarray(x, dtype=float),
-        merit_start=m0,
-        merit=m,
-        operands=vals,
-        evaluations=log.n,
-        converged=converged,
-        message=message,
-        seconds=time.perf_counter() - t0,
-        stopped=stopped,
-        method="minimax",
-        violation=viol,
-    )
+    return local_result(log, t0, final, x, m0, m, vals, converged, message, stopped, "minimax")

@@ -513,22 +513,42 @@ def optimize(
         msg = f"merit {m:.6g} is above the goal {spec.merit_goal:.6g}" + (
             f": {msg}" if status == 0 else f" (the solver stopped: {why})"
         )
-    msg += log.note()
-    return OptimizationResult(
-        lens=final,
-        x=np.asarray(x_final, dtype=float),
-        merit_start=m0,
-        merit=m,
-        operands=vals,
-        evaluations=log.n,
-        converged=converged,
-        message=msg,
-        seconds=time.perf_counter() - t0,
-        stopped=stopped,
-        violation=max_violation(vals),
-    )
+    return local_result(log, t0, final, x_final, m0, m, vals, converged, msg, stopped)
 
 
 def max_violation(values: tuple[OperandValue, ...]) -> float:
     """The largest weighted violation of a bound operand (0 when every bound is met)."""
     return max((abs(o.residual) for o in values if o.operand.bounded), default=0.0)
+
+
+def local_result(
+    log: EvaluationLog,
+    t0: float,
+    lens: Lens,
+    x,
+    merit_start: float,
+    merit: float,
+    operands: tuple[OperandValue, ...],
+    converged: bool,
+    message: str,
+    stopped: str,
+    method: str = "least_squares",
+) -> OptimizationResult:
+    """The :class:`OptimizationResult` of a local run (damped least squares or minimax), its
+    fields in their order less the run's bookkeeping: ``log`` gives the evaluation count and
+    adds its note on failed evaluations to ``message``, ``t0`` (``time.perf_counter()`` at the
+    start) the wall time, and ``operands`` the largest bound violation."""
+    return OptimizationResult(
+        lens=lens,
+        x=np.asarray(x, dtype=float),
+        merit_start=merit_start,
+        merit=merit,
+        operands=operands,
+        evaluations=log.n,
+        converged=converged,
+        message=message + log.note(),
+        seconds=time.perf_counter() - t0,
+        stopped=stopped,
+        method=method,
+        violation=max_violation(operands),
+    )
