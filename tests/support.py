@@ -250,6 +250,35 @@ def default_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+@contextlib.contextmanager
+def ctrl_c_child(argv: list[str], *, cwd, group: bool = False, **popen):
+    """``python -m orthoscope ARGV`` as a child that sees Ctrl-C (its default SIGINT disposition),
+    its stderr piped; with ``group``, in a session (process group) of its own. ``popen``: more
+    keywords of :class:`subprocess.Popen`. A child still running when the block ends is killed,
+    with its group where it has one: a long run left behind would slow the rest."""
+    import os
+    import signal
+    import subprocess
+
+    p = subprocess.Popen(
+        [sys.executable, "-m", "orthoscope", *argv],
+        cwd=cwd,
+        stderr=subprocess.PIPE,
+        start_new_session=group,
+        preexec_fn=default_sigint,
+        **popen,
+    )
+    try:
+        yield p
+    finally:
+        if p.poll() is None:
+            if group:
+                os.killpg(p.pid, signal.SIGKILL)
+            else:
+                p.kill()
+            p.wait()
+
+
 def interrupt_group(argv: list[str], *, cwd, ready: Callable[[str], bool]):
     """A real Ctrl-C in a terminal: ``python -m orthoscope ARGV`` in a session of its own (its
     default SIGINT disposition, unbuffered), its stderr read line by line until ``ready(line)``,
@@ -260,18 +289,9 @@ def interrupt_group(argv: list[str], *, cwd, ready: Callable[[str], bool]):
     import signal
     import subprocess
 
-    p = subprocess.Popen(
-        [sys.executable, "-m", "orthoscope", *argv],
-        cwd=cwd,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-        env=dict(os.environ, PYTHONUNBUFFERED="1"),
-        preexec_fn=default_sigint,
-    )
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
     before: list[str] = []
-    try:
+    with ctrl_c_child(argv, cwd=cwd, group=True, stdout=subprocess.PIPE, text=True, env=env) as p:
         while True:
             line = p.stderr.readline()
             assert line, "the command ended before it could be interrupted: " + "".join(before)
@@ -280,10 +300,6 @@ def interrupt_group(argv: list[str], *, cwd, ready: Callable[[str], bool]):
                 break
         os.killpg(p.pid, signal.SIGINT)
         out, err = p.communicate(timeout=60)
-    finally:
-        if p.poll() is None:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait()
     return before, p.returncode, out, err
 
 

@@ -40,43 +40,26 @@ W, H = 3001, 1999  # odd and non-square
 TOL = 1e-9  # px, issue 17 done-when
 
 # magnitude ranges of random coefficients (random sign unless noted); small enough that every
-# map is one-to-one over the test field
+# map is one-to-one over the test field. The decentering and thin-prism terms of both kinds of
+# model share one range each.
+DECENTERING = (2e-4, 8e-4)
+THIN_PRISM = (1e-4, 5e-4)
 PERSPECTIVE = {
-    "k1": (0.05, 0.1),
-    "k2": (0.01, 0.03),
-    "k3": (1e-3, 5e-3),
-    "k4": (1e-3, 5e-3),
-    "k5": (1e-3, 3e-3),
-    "k6": (1e-4, 1e-3),
-    "p1": (2e-4, 8e-4),
-    "p2": (2e-4, 8e-4),
-    "s1": (1e-4, 5e-4),
-    "s2": (1e-4, 5e-4),
-    "s3": (1e-4, 5e-4),
-    "s4": (1e-4, 5e-4),
-    "tau_x": (5e-3, 2e-2),
-    "tau_y": (5e-3, 2e-2),
-    "k": (0.03, 0.08),
-}
+    "k1": (0.05, 0.1), "k2": (0.01, 0.03), "k3": (1e-3, 5e-3),  # OpenCV radial
+    "k4": (1e-3, 5e-3), "k5": (1e-3, 3e-3), "k6": (1e-4, 1e-3),  # OpenCV rational
+    **dict.fromkeys(("p1", "p2"), DECENTERING),
+    **dict.fromkeys(("s1", "s2", "s3", "s4"), THIN_PRISM),
+    "tau_x": (5e-3, 2e-2), "tau_y": (5e-3, 2e-2),  # OpenCV sensor tilt
+    "k": (0.03, 0.08),  # COLMAP SIMPLE_RADIAL, DIVISION
+}  # fmt: skip
 FISHEYE = {
-    "k0": (0.01, 0.04),
-    "k1": (0.01, 0.04),
-    "k2": (2e-3, 6e-3),
-    "k3": (2e-4, 8e-4),
-    "k4": (2e-5, 8e-5),
-    "k5": (2e-6, 8e-6),
-    "p0": (2e-4, 8e-4),
-    "p1": (2e-4, 8e-4),
-    "p2": (2e-4, 8e-4),
-    "sx1": (1e-4, 5e-4),
-    "sy1": (1e-4, 5e-4),
-    "s0": (1e-4, 5e-4),
-    "s1": (1e-4, 5e-4),
-    "s2": (1e-4, 5e-4),
-    "s3": (1e-4, 5e-4),
-    "alpha": (1e-3, 3e-3),
-    "k": (0.01, 0.04),
-}
+    "k0": (0.01, 0.04), "k1": (0.01, 0.04), "k2": (2e-3, 6e-3),  # theta polynomial
+    "k3": (2e-4, 8e-4), "k4": (2e-5, 8e-5), "k5": (2e-6, 8e-6),
+    **dict.fromkeys(("p0", "p1", "p2"), DECENTERING),
+    **dict.fromkeys(("sx1", "sy1", "s0", "s1", "s2", "s3"), THIN_PRISM),
+    "alpha": (1e-3, 3e-3),  # OpenCV fisheye skew
+    "k": (0.01, 0.04),  # COLMAP SIMPLE_RADIAL_FISHEYE
+}  # fmt: skip
 POSITIVE = {"omega": (0.3, 0.9), "alpha": (0.3, 0.7), "beta": (0.8, 1.2)}  # FOV, EUCM
 
 
@@ -295,27 +278,21 @@ def _metashape_manual(p, w, h, x, y):
     return np.column_stack([u, v])
 
 
+def signed_random_camera(model: str, seed: int, ranges: dict, **fixed) -> CameraModel:
+    """MODEL on the W x H sensor: the FIXED parameters as given, and each of RANGES a magnitude
+    drawn uniformly from its (lo, hi) with a random sign (drawn in RANGES's order)."""
+    rng = np.random.default_rng(seed)
+    drawn = {n: rng.uniform(lo, hi) * rng.choice([-1, 1]) for n, (lo, hi) in ranges.items()}
+    return CameraModel.create(model, W, H, **fixed, **drawn)
+
+
 def random_metashape(seed=0):
-    rng = np.random.default_rng(77 + seed)
-    s = lambda lo, hi: rng.uniform(lo, hi) * rng.choice([-1, 1])  # noqa: E731
-    return CameraModel.create(
-        "metashape",
-        W,
-        H,
-        f=3200.0,
-        cx=s(15, 40),
-        cy=s(15, 40),
-        b1=s(5, 20),
-        b2=s(0.5, 2),
-        k1=s(0.05, 0.1),
-        k2=s(0.01, 0.03),
-        k3=s(1e-3, 5e-3),
-        k4=s(1e-4, 5e-4),
-        p1=s(2e-4, 8e-4),
-        p2=s(2e-4, 8e-4),
-        p3=s(0.05, 0.2),
-        p4=s(0.05, 0.2),
-    )
+    ranges = {
+        "cx": (15, 40), "cy": (15, 40), "b1": (5, 20), "b2": (0.5, 2),
+        "k1": (0.05, 0.1), "k2": (0.01, 0.03), "k3": (1e-3, 5e-3), "k4": (1e-4, 5e-4),
+        "p1": (2e-4, 8e-4), "p2": (2e-4, 8e-4), "p3": (0.05, 0.2), "p4": (0.05, 0.2),
+    }  # fmt: skip
+    return signed_random_camera("metashape", 77 + seed, ranges, f=3200.0)
 
 
 def test_metashape_equals_manual_formula():
@@ -384,24 +361,13 @@ def test_round_trip_opencv_metashape_colmap_opencv_through_files(tmp_path):
 
 # ---- Australis (Brown / Fraser) -----------------------------------------------------------------
 def random_australis():
-    rng = np.random.default_rng(1997)
-    s = lambda lo, hi: rng.uniform(lo, hi) * rng.choice([-1, 1])  # noqa: E731
-    return CameraModel.create(
-        "australis",
-        W,
-        H,
-        pixel_size_mm=(0.0078, 0.0079),
-        c=25.0,
-        xp=s(0.02, 0.1),
-        yp=s(0.02, 0.1),
-        K1=s(5e-5, 1e-4),
-        K2=s(5e-8, 1e-7),
-        K3=s(5e-11, 1e-10),
-        P1=s(5e-6, 2e-5),
-        P2=s(5e-6, 2e-5),
-        b1=s(5e-5, 2e-4),
-        b2=s(2e-5, 1e-4),
-    )
+    ranges = {
+        "xp": (0.02, 0.1), "yp": (0.02, 0.1),
+        "K1": (5e-5, 1e-4), "K2": (5e-8, 1e-7), "K3": (5e-11, 1e-10),
+        "P1": (5e-6, 2e-5), "P2": (5e-6, 2e-5), "b1": (5e-5, 2e-4), "b2": (2e-5, 1e-4),
+    }  # fmt: skip
+    fixed = dict(pixel_size_mm=(0.0078, 0.0079), c=25.0)
+    return signed_random_camera("australis", 1997, ranges, **fixed)
 
 
 def test_australis_correction_is_fraser_1997():

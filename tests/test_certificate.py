@@ -20,10 +20,10 @@ import json
 import math
 import re
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 import pytest
+from support import ROOT
 
 import distortion.grid
 from distortion.certificate import calibration_certificate
@@ -41,7 +41,6 @@ from orthoscope.report.certificate import (
 )
 from raytrace.files.library import load_lens
 
-ROOT = Path(__file__).resolve().parents[1]
 DATE = "2026-01-31"
 
 

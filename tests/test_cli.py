@@ -568,6 +568,14 @@ def _err_lines(err: str) -> list[str]:
     return [ln for ln in err.strip().splitlines() if "compiling" not in ln]
 
 
+def _refused(capsys, *argv) -> tuple[list[str], str]:
+    """``orthoscope ARGV``, which must be refused: exit status 2, nothing on stdout. Returns the
+    lines of its stderr (compile notices left out) and the stderr itself."""
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2 and out == "", err
+    return _err_lines(err), err
+
+
 @pytest.mark.parametrize(
     "argv",
     [
@@ -582,9 +590,8 @@ def test_s_with_object_s_is_refused(argv, capsys):
     # --s is the deprecated spelling of --object-s: both given, the last one won, with the
     # deprecation line said at parse time (now refused before any work, as every deprecated
     # spelling with its flag: test_a_deprecated_spelling_with_its_flag_is_refused)
-    rc, out, err = run(capsys, *argv)
-    assert rc == 2 and out == ""
-    assert _err_lines(err) == [
+    lines, _ = _refused(capsys, *argv)
+    assert lines == [
         f"orthoscope {argv[0]}: error: --s and --object-s both give the object's s (--s is the "
         "deprecated spelling of --object-s): give --object-s alone"
     ]
@@ -593,6 +600,7 @@ def test_s_with_object_s_is_refused(argv, capsys):
 @pytest.mark.parametrize(
     "argv,said",
     [
+        # a deprecated spelling in a refused run
         (["distortion", "cooke-triplet-f4", "--s", "-1000", "--fields", "abc"],
          "--fields: expected a number"),
         (["distortion", "cooke-triplet-f4", "--s", "abc"], "--s: 'abc' is not a number"),
@@ -602,13 +610,23 @@ def test_s_with_object_s_is_refused(argv, capsys):
          "--at and --value need --calibrate"),
         (["trace", "cooke-triplet-f4", "--s", "-1000", "--object-distance", "1m"],
          "give the object one way"),
+        # an old spelling of a plane flag, named as typed
+        (["distortion", "cooke-triplet-f4", "--image-distance", "50", "--defocus", "1"],
+         "give the image planes one way, not --image-distance, --defocus"),
+        (["distortion", "cooke-triplet-f4", "--image-distance", "abc"], "--image-distance: "),
+        (["distortion", "cooke-triplet-f4", "--image-distance", "50,50"],
+         "--image-distance: the plane 50 is listed twice"),
+        (["trace", "cooke-triplet-f4", "--image-from-vertex", "50", "--defocus", "1"],
+         "give the image planes one way, not --image-from-vertex, --defocus"),
     ],
 )  # fmt: skip
-def test_a_refused_run_with_a_deprecated_spelling_prints_the_refusal_alone(argv, said, capsys):
-    # the deprecation line was said at parse time, before the refusal
-    rc, out, err = run(capsys, *argv)
-    lines = _err_lines(err)
-    assert rc == 2 and out == "" and len(lines) == 1 and said in lines[0], err
+def test_a_refusal_is_one_line_naming_the_flags_as_typed(argv, said, capsys):
+    # the deprecation line was said at parse time, before the refusal; and an old spelling was
+    # named by its new one in these refusals ("not --s-prime, --defocus" for --image-distance 50
+    # --defocus 1): the user is told what they wrote, in one line
+    lines, err = _refused(capsys, *argv)
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"orthoscope {argv[0]}: error: {said}"), lines[0]
     assert "deprecated" not in err
 
 
@@ -683,9 +701,8 @@ def test_a_deprecated_spelling_with_its_flag_is_refused(
     argv = [a.format(data=DATA, specs=DATA.parent.parent / "lenses" / "specs", tmp=tmp_path)
             for a in argv]  # fmt: skip
     both = [old, value, new, value] if old_first else [new, value, old, value]
-    rc, out, err = run(capsys, *argv, *both)
-    assert rc == 2 and out == "", err
-    assert _err_lines(err) == [
+    lines, _ = _refused(capsys, *argv, *both)
+    assert lines == [
         f"orthoscope {argv[0]}: error: {old} and {new} both give {what} ({old} is the "
         f"deprecated spelling of {new}): give {new} alone"
     ]
@@ -696,11 +713,10 @@ def test_repeated_planes_of_both_spellings_are_refused(capsys):
     # distortion's --s-prime is repeatable (more planes from one trace), but the README and the
     # design doc call --image-distance an old spelling, not a second list: mixing them is
     # refused like any pair (before: two planes, s' = 50 and 51, and a deprecation line)
-    rc, out, err = run(
+    lines, _ = _refused(
         capsys, "distortion", "cooke-triplet-f4", "--s-prime", "50", "--image-distance", "51"
     )
-    assert rc == 2 and out == ""
-    assert _err_lines(err) == [
+    assert lines == [
         "orthoscope distortion: error: --image-distance and --s-prime both give the image "
         "plane's s' (--image-distance is the deprecated spelling of --s-prime): give --s-prime "
         "alone"
@@ -774,28 +790,5 @@ def test_an_alias_of_a_flag_that_does_not_note_it_is_refused():
 )  # fmt: skip
 def test_two_object_flags_are_named_as_flags(argv, flags, capsys):
     # before: the API's keywords, "give the object one way, not object_distance and object_s"
-    rc, out, err = run(capsys, *argv)
-    assert rc == 2 and out == ""
-    assert _err_lines(err) == [f"orthoscope {argv[0]}: error: give the object one way, not {flags}"]
-
-
-@pytest.mark.parametrize(
-    "argv,said",
-    [
-        (["distortion", "cooke-triplet-f4", "--image-distance", "50", "--defocus", "1"],
-         "give the image planes one way, not --image-distance, --defocus"),
-        (["distortion", "cooke-triplet-f4", "--image-distance", "abc"], "--image-distance: "),
-        (["distortion", "cooke-triplet-f4", "--image-distance", "50,50"],
-         "--image-distance: the plane 50 is listed twice"),
-        (["trace", "cooke-triplet-f4", "--image-from-vertex", "50", "--defocus", "1"],
-         "give the image planes one way, not --image-from-vertex, --defocus"),
-        (["distortion", "cooke-triplet-f4", "--s", "abc"], "--s: 'abc' is not a number"),
-    ],
-)  # fmt: skip
-def test_a_plane_or_object_flag_is_named_as_typed(argv, said, capsys):
-    # an old spelling was named by its new one in these refusals ("not --s-prime, --defocus"
-    # for --image-distance 50 --defocus 1): the user is told what they wrote
-    rc, out, err = run(capsys, *argv)
-    lines = _err_lines(err)
-    assert rc == 2 and out == "" and len(lines) == 1, err
-    assert lines[0].startswith(f"orthoscope {argv[0]}: error: {said}"), lines[0]
+    lines, _ = _refused(capsys, *argv)
+    assert lines == [f"orthoscope {argv[0]}: error: give the object one way, not {flags}"]

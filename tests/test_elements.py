@@ -14,12 +14,10 @@ splitting").
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 from dataclasses import replace
 
 import pytest
-from support import cooke_split_spec, singlet, singlet_spec
+from support import cooke_split_spec, run_cli, singlet, singlet_spec
 
 from raytrace.elements import insert_element, split_element, surface_map
 from raytrace.errors import LensError
@@ -197,10 +195,10 @@ def test_cli_split_writes_a_lens_that_records_the_edit(tmp_path):
         '  { type = "rms_spot", plane = "best", target = 0, weight = 1000 } ]\n',
         encoding="utf-8",
     )
-    cmd = [sys.executable, "-m", "orthoscope", "optimize", str(spec), "--quiet", "-o"]
+    cmd = ["optimize", str(spec), "--quiet", "-o"]
     out = tmp_path / "two.toml"
-    r = subprocess.run([*cmd, str(out), "--split", "1"], capture_output=True, text=True)
-    assert r.returncode == 0, r.stderr
+    rc, _, err = run_cli([*cmd, str(out), "--split", "1"])
+    assert rc == 0, err
     two = load_lens(str(out))
     assert two.n_surfaces == 4
     assert "edited by --split 1" in two.notes
@@ -208,9 +206,9 @@ def test_cli_split_writes_a_lens_that_records_the_edit(tmp_path):
         ("--split=2", "no element starts at surface 2"),
         ("--insert=1", "AFTER:GLASS"),
     ):
-        bad = subprocess.run([*cmd, str(tmp_path / "x.toml"), flag], capture_output=True, text=True)
-        lines = [x for x in bad.stderr.splitlines() if "compiling" not in x]
-        assert bad.returncode == 2 and len(lines) == 1 and msg in lines[0], bad.stderr
+        rc, _, err = run_cli([*cmd, str(tmp_path / "x.toml"), flag])
+        lines = [x for x in err.splitlines() if "compiling" not in x]
+        assert rc == 2 and len(lines) == 1 and msg in lines[0], err
     assert not (tmp_path / "x.toml").exists()
 
 
@@ -301,13 +299,13 @@ def test_scan_splits_tries_every_element_and_the_cli_keeps_the_best(tmp_path):
     text += '  { type = "rms_spot", field = 0, plane = "best", target = 0, weight = 1000 } ]\n'
     (tmp_path / "s.toml").write_text(text, encoding="utf-8")
     out = tmp_path / "best.toml"
-    cmd = [sys.executable, "-m", "orthoscope", "optimize", str(tmp_path / "s.toml"), "-o", str(out)]
-    r = subprocess.run([*cmd, "--split", "auto", "--write-anyway"], capture_output=True, text=True)
-    assert r.returncode in (0, 1), r.stderr
+    cmd = ["optimize", str(tmp_path / "s.toml"), "-o", str(out)]
+    rc, _, err = run_cli([*cmd, "--split", "auto", "--write-anyway"])
+    assert rc in (0, 1), err
     for t in trials:
-        assert f"--split {t.surface}: merit {t.merit:.6g}" in r.stderr
+        assert f"--split {t.surface}: merit {t.merit:.6g}" in err
     written = load_lens(str(out))
     assert written.n_surfaces == 8
     assert f"edited by --split {best.surface} (best of --split auto" in written.notes
-    bad = subprocess.run([*cmd, "--split", "auto", "--global"], capture_output=True, text=True)
-    assert bad.returncode == 2 and "--split auto tries each element alone" in bad.stderr
+    rc, _, err = run_cli([*cmd, "--split", "auto", "--global"])
+    assert rc == 2 and "--split auto tries each element alone" in err

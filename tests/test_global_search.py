@@ -20,15 +20,13 @@ from __future__ import annotations
 
 import math
 import os
-import subprocess
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
-from support import cooke_multimodal_spec_text, interrupt_group, singlet, singlet_spec
+from support import cooke_multimodal_spec_text, interrupt_group, run_cli, singlet, singlet_spec
 
 from raytrace import AIR, Aperture, Field, Lens, Surface
 from raytrace.files.library import load_lens
@@ -465,19 +463,7 @@ def test_cli_dask_flags_are_checked(tmp_path: Path):
         (["--global", "--dask", "tcp://host:70000"], "the port must be 1 to 65535"),
         (["--global", "--dask", many], "worker processes on a machine with"),
     ):
-        r = subprocess.run(
-            [
-                sys.executable,
-                "-m",
-                "orthoscope",
-                "optimize",
-                str(spec),
-                "-o",
-                str(tmp_path / "x.toml"),
-                *flags,
-            ],
-            capture_output=True,
-            text=True,
-        )
-        lines = [x for x in r.stderr.splitlines() if "compiling" not in x]
-        assert r.returncode == 2 and len(lines) == 1 and msg in lines[0], r.stderr
+        rc, _, err = run_cli(["optimize", str(spec), "-o", str(tmp_path / "x.toml"), *flags])
+        lines = [x for x in err.splitlines() if "compiling" not in x]
+        assert rc == 2 and len(lines) == 1 and msg in lines[0], err
+        assert not (tmp_path / "x.toml").exists()

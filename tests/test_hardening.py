@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from support import default_sigint, run_cli
+from support import ctrl_c_child, run_cli
 
 from orthoscope.cli import COMMANDS, COMPILE_NOTICE, build_parser
 
@@ -223,14 +223,7 @@ def test_runs_under_a_non_utf8_locale(mod, argv, work):
     ids=["chief-rays", "bulk-trace"],
 )
 def test_ctrl_c_exits_130_with_one_line_within_a_second(argv, wait, work):
-    p = subprocess.Popen(
-        [sys.executable, "-m", "orthoscope", *argv],
-        cwd=work,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        preexec_fn=default_sigint,
-    )
-    try:
+    with ctrl_c_child(argv, cwd=work, stdout=subprocess.DEVNULL) as p:
         time.sleep(wait)  # inside the kernel run
         assert p.poll() is None, "the command finished before it could be interrupted"
         t0 = time.monotonic()
@@ -238,10 +231,6 @@ def test_ctrl_c_exits_130_with_one_line_within_a_second(argv, wait, work):
         rc = p.wait(timeout=30)
         dt = time.monotonic() - t0
         err = p.stderr.read().decode()
-    finally:
-        if p.poll() is None:  # never leave a long run behind (it would slow the rest)
-            p.kill()
-            p.wait()
     assert rc == 130, err
     lines = [ln for ln in err.strip().splitlines() if COMPILE_NOTICE not in ln]
     assert lines == [f"orthoscope {argv[1]}: interrupted"]

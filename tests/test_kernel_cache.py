@@ -10,16 +10,36 @@ import subprocess
 import sys
 from pathlib import Path
 
+from raytrace.files.library import load_lens
+from raytrace.trace import chief_rays
+
 ROOT = Path(__file__).resolve().parents[1]
 
 CHILD = """
-import warnings, math
+import warnings
 warnings.simplefilter("always")
-import numpy as np
 from raytrace.files.library import load_lens
 from raytrace.trace import chief_rays
 cr = chief_rays(load_lens("topogon-us2031792-fig1"), [0.0, 7.0])
 print("HEIGHT", repr(float(cr.heights_at(cr.z_last[0] + 51.9415)[1])))
+"""
+
+# The same chief ray (7 deg) through the one-kernel ray_paths, from the start the aim found in
+# the test process (argv): the uncached child then compiles one small kernel (about 8 s cold)
+# instead of the aim kernel and everything it inlines (about 50 s), and the flat surface added
+# at the image plane (51.9415 mm after the last vertex) gives its height there.
+CHILD_PATHS = """
+import dataclasses, sys, warnings
+warnings.simplefilter("always")
+from raytrace.files.library import load_lens
+from raytrace.lens import Surface
+from raytrace.trace import ray_paths
+lens = load_lens("topogon-us2031792-fig1")
+image = Surface(curvature=0.0, thickness=0.0, material=lens.surfaces[-1].material)
+lens = dataclasses.replace(lens, surfaces=lens.surfaces + (image,))
+y, z, m, n = map(float, sys.argv[1:])
+rp = ray_paths(lens, [[0.0, y, z]], [[0.0, m, n]])
+print("HEIGHT", repr(float(rp.y[0, -1])))
 """
 
 
@@ -40,14 +60,20 @@ def test_unwritable_cache_falls_back_to_uncached_with_one_warning(tmp_path):
         if not k.startswith("NUMBA_CACHE") and k not in ("HOME", "XDG_CACHE_HOME")
     }
     env.update(HOME="/proc/no-home", XDG_CACHE_HOME="/proc/no-cache", PYTHONPATH=str(tmp_path))
+    cr = chief_rays(load_lens("topogon-us2031792-fig1"), [7.0])
+    start = [repr(float(a[0])) for a in (cr.y_start, cr.z_start, cr.M_start, cr.N_start)]
     r = subprocess.run(
-        [sys.executable, "-c", CHILD], cwd=tmp_path, env=env, capture_output=True, text=True
+        [sys.executable, "-c", CHILD_PATHS, *start],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
     )
     assert r.returncode == 0, r.stderr
     warned = [ln for ln in r.stderr.splitlines() if "KernelCacheWarning" in ln]
     assert len(warned) == 1, r.stderr
     assert "NUMBA_CACHE_DIR" in warned[0]
-    # the uncached kernels give the published chief-ray height (US 2,031,792: 8.1121 mm at 7 deg,
+    # the uncached kernel gives the published chief-ray height (US 2,031,792: 8.1121 mm at 7 deg,
     # see tests/test_trace.py)
     h = float(r.stdout.split("HEIGHT")[1])
     assert abs(h - 8.1121) < 6e-4

@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 
 import pytest
-from support import read_spec_text
+from support import ROOT, read_spec_text
 
 from raytrace.glass import catalog_glasses
 from raytrace.optimize import (
@@ -22,7 +22,6 @@ from raytrace.optimize import (
     start_lens,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
 HEAD = 'start = "cooke-triplet-f4"\n'
 OK_VAR = 'variables = [ { kind = "curvature", surface = 1 } ]\n'
 OK_OP = 'operands = [ { type = "efl", target = 50 } ]\n'

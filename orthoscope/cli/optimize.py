@@ -123,7 +123,7 @@ class GlobalProgress:
 
 #: Quick runs of this command for the per-command tests (tests/test_hardening.py): argv lists
 #: with {data} = tests/data, {specs} = lenses/specs, {tmp} = a scratch folder.
-SAMPLES = [["optimize", "{specs}/twinplex-like-55-525.toml", "-o", "{tmp}/designed.toml"]]
+SAMPLES = [["optimize", "{data}/specs/cooke-efl.toml", "-o", "{tmp}/designed.toml"]]
 #: Output options (flag, suffix) the tests aim at inputs, existing files and failing disks.
 OUTPUTS = [("-o", ".toml")]
 
