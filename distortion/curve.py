@@ -157,14 +157,17 @@ def requested_fields(
     Raises
     ------
     TraceError
-        Both ``fields_deg`` and ``heights_mm`` given.
+        Both ``fields_deg`` and ``heights_mm`` given, or a value that is no field (a bool, a
+        complex number: :func:`raytrace.trace.chief.field_values`).
     """
     if fields_deg is not None and heights_mm is not None:
         raise TraceError(f"give fields_deg or {heights_name}, not both")
+    from raytrace.trace.chief import field_values
+
     if heights_mm is not None:
-        return "height", np.atleast_1d(np.asarray(heights_mm, dtype=float)).ravel()
+        return "height", np.atleast_1d(field_values(heights_mm, heights_name)).ravel()
     if fields_deg is not None:
-        return "angle", np.atleast_1d(np.asarray(fields_deg, dtype=float)).ravel()
+        return "angle", np.atleast_1d(field_values(fields_deg, "fields_deg")).ravel()
     fk = lens.field.kind if not (infinite and lens.field.kind == "height") else "angle"
     return fk, np.linspace(0.0, lens.field.value, 11)
 
@@ -205,8 +208,9 @@ def fields_and_abscissa(
     from raytrace.paraxial import orthoscopy_abscissa
 
     fk, f = requested_fields(lens, par.infinite, fields_deg, object_heights_mm)
-    if f.size == 0:
-        raise TraceError("no fields given")
+    if f.size == 0:  # the words of every trace (chief_rays, distortion_grid, ...)
+        name = "object_heights_mm" if object_heights_mm is not None else "fields_deg"
+        raise TraceError(f"no fields given: {name} is empty")
     kind = curve_field_kind(fk, par.infinite)
     return fk, f, kind, orthoscopy_abscissa(par, f, fk)
 

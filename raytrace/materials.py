@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import TraceError
+from .units import real_number
 
 LAMBDA_D = 587.5618
 LAMBDA_F = 486.1327
@@ -72,6 +73,21 @@ BASES = ("relative", "absolute")
 #: worst values of 1.07e-3 and 7.29e-3 over 400–700 nm (both at 405 nm). Beyond it the error
 #: grows: median 1.8e-3 at 1200 nm, 4.1e-3 at 1500 nm, 1.4e-2 at 2300 nm; 2.5e-3 at 300 nm.
 MODEL_RANGE_NM: tuple[float, float] = (365.01, 1013.98)
+
+
+#: The d-line indices (nd) a fixed index or a model glass may have: 1 (vacuum, air) to 4.1.
+#: Germanium, ~4.0 in the infrared (and opaque in the visible), has the highest index of any
+#: optical material; in the visible and near IR the highest-index catalog glasses stay near 2.2
+#: (Sumita K-PSFn215 2.154; ZnSe ~2.6, silicon ~3.5 in the IR). 1 exactly is legal for a fixed
+#: index (air, dummy surfaces) and for a model glass (no dispersion: (nd − 1)/vd = 0; the native
+#: reader has always taken nd >= 1, and tests/test_prescription.py draws model glasses from
+#: nd = 1). A value outside is a slip (an Abbe number given for nd, 0.5 for 1.5), refused where
+#: it is built.
+INDEX_RANGE = (1.0, 4.1)
+#: The Abbe numbers (vd) a model glass may have: above 0, at most 120. The largest of real
+#: optical materials lie near 100 (the shipped catalogs, :mod:`raytrace.glass.catalog`: MgF2
+#: 106.2 in Misc, Sumita K-FIR100UV 101.0; CaF2 ~95); 120 leaves margin.
+ABBE_RANGE = (0.0, 120.0)
 
 
 class OutOfRangeWarning(UserWarning):
@@ -127,11 +143,14 @@ class Material:
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
             raise ValueError(f"unknown material kind {self.kind!r}")
-        if self.kind != "catalog" and not (math.isfinite(self.nd) and self.nd > 0.0):
-            raise ValueError(f"refractive index must be a positive finite number, got {self.nd}")
+        if self.kind != "catalog":
+            nd = real_number(self.nd, "nd", "a refractive index such as 1.5168", error=ValueError)
+            object.__setattr__(self, "nd", nd)
+            if not (math.isfinite(nd) and nd > 0.0):
+                raise ValueError(f"refractive index must be a positive finite number, got {nd}")
+        if self.kind in ("index", "model"):
+            self._check_range()
         if self.kind == "model":
-            if not (math.isfinite(self.vd) and self.vd > 0.0):
-                raise ValueError(f"Abbe number must be a positive finite number, got {self.vd}")
             if self.model == "":
                 object.__setattr__(self, "model", "cauchy2")
             if self.model not in MODELS:
@@ -145,6 +164,32 @@ class Material:
                 )
             if not self.coefficients:
                 raise ValueError(f"catalog material {self.name!r} has no dispersion coefficients")
+
+    def _check_range(self) -> None:
+        """Refuse an nd outside :data:`INDEX_RANGE` and, for a model glass, a vd outside
+        :data:`ABBE_RANGE`: ValueError naming the value and the fix."""
+        (lo, hi), (vlo, vhi) = INDEX_RANGE, ABBE_RANGE
+        nd, model = self.nd, self.kind == "model"
+        what = "model glass" if model else "fixed index"
+        if model:
+            vd = real_number(self.vd, "vd", "an Abbe number such as 64.17", error=ValueError)
+            object.__setattr__(self, "vd", vd)
+            if not (math.isfinite(vd) and vd > 0.0):
+                raise ValueError(f"Abbe number must be a positive finite number, got {vd}")
+        swapped = model and lo < self.vd <= hi and vlo < nd <= vhi
+        hint = f"; nd and vd swapped? give nd {self.vd:g}, vd {nd:g}" if swapped else ""
+        if not lo <= nd <= hi:
+            side = f"below {lo:g}" if nd < lo else f"above {hi:g}"
+            raise ValueError(
+                f"{what} nd={nd:g} is {side}: a refractive index (d line) is {lo:g} (air) to "
+                f"{hi:g} (germanium, ~4.0 in the infrared, has the highest); give e.g. 1.5168"
+                f"{hint}"
+            )
+        if model and not vlo < self.vd <= vhi:
+            raise ValueError(
+                f"{what} vd={self.vd:g} is above {vhi:g}: an Abbe number is above {vlo:g} and at "
+                f"most {vhi:g} (MgF2, 106, is among the highest); give e.g. 64.17{hint}"
+            )
 
     @property
     def is_air(self) -> bool:
@@ -322,9 +367,9 @@ def model_glass(nd: float, vd: float, model: str = "cauchy2") -> Material:
     Parameters
     ----------
     nd : float
-        Refractive index at the d line (587.56 nm); positive, finite.
+        Refractive index at the d line (587.56 nm): 1 to 4.1 (:data:`INDEX_RANGE`).
     vd : float
-        Abbe number (nd − 1)/(nF − nC); positive, finite.
+        Abbe number (nd − 1)/(nF − nC): above 0, at most 120 (:data:`ABBE_RANGE`).
     model : str
         The dispersion law, one of :data:`MODELS`: ``"cauchy2"`` (default; ``""`` means it),
         ``"buchdahl-rayoptics"``, ``"buchdahl-optiland"``.
@@ -337,9 +382,9 @@ def model_glass(nd: float, vd: float, model: str = "cauchy2") -> Material:
     Raises
     ------
     ValueError
-        nd or vd not positive and finite, an unknown ``model``.
+        nd or vd not a number or outside its range, an unknown ``model``.
     """
-    return Material("model", float(nd), float(vd), model=model)
+    return Material("model", nd, vd, model=model)
 
 
 def fixed_index(n: float) -> Material:
@@ -348,7 +393,7 @@ def fixed_index(n: float) -> Material:
     Parameters
     ----------
     n : float
-        The refractive index at every wavelength (positive, finite).
+        The refractive index at every wavelength: 1 (air) to 4.1 (:data:`INDEX_RANGE`).
 
     Returns
     -------
@@ -358,6 +403,6 @@ def fixed_index(n: float) -> Material:
     Raises
     ------
     ValueError
-        An index that is not positive and finite.
+        An index that is not a number or outside :data:`INDEX_RANGE`.
     """
-    return Material("index", float(n))
+    return Material("index", n)

@@ -30,6 +30,12 @@ WAVELENGTH_UNITS = {"nm": 1.0, "um": 1000.0, "µm": 1000.0, "mm": 1e6}
 #: the range of wavelengths the project accepts (nm): deep UV to far IR
 WAVELENGTH_RANGE_NM = (100.0, 30000.0)
 
+#: what an ``object_distance`` may be (raytrace.paraxial.resolve_object_distance), for the
+#: messages that refuse one
+OBJECT_DISTANCE_FORMS = (
+    "mm (or a length with its unit: 1.5m, 250mm), 'inf' or an image scale such as '12x'"
+)
+
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _RE = re.compile(rf"^\s*({_NUM}|[-+]?inf(?:inity)?)\s*([a-zA-Zµ×]*)\s*$")
 
@@ -40,6 +46,133 @@ def is_whole(value) -> bool:
     import numbers
 
     return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+
+
+def _not_real(value) -> str | None:
+    """What ``value`` is when ``float()`` would take it (or its imaginary part would be lost)
+    though it is no real number: ``"a bool, not a number"`` (``True`` would read as 1) or ``"a
+    complex number"``; None otherwise. Looks at Python and numpy scalars and 0-d arrays (their
+    ``dtype``) without importing numpy."""
+    kind = getattr(getattr(value, "dtype", None), "kind", None)
+    if isinstance(value, bool) or kind == "b":
+        return "a bool, not a number"
+    if isinstance(value, complex) or kind == "c":  # numpy's complex128 is a complex
+        return "a complex number"
+    return None
+
+
+def number_problem(value) -> str | None:
+    """Why ``value`` is no real number (``"a bool, not a number"``, ``"a complex number"``,
+    ``"not a number"``), or None when ``float()`` reads it as one (numbers, numpy scalars and
+    0-d arrays, numeric strings). For the messages of converters that check a sequence item by
+    item (:func:`real_number` checks one value)."""
+    why = _not_real(value)
+    if why is None:
+        try:
+            float(value)
+        except (TypeError, ValueError, OverflowError):
+            return "not a number"
+    return why
+
+
+def _shown(value, limit: int = 60) -> str:
+    """``repr(value)`` on one line (an array's repr spans lines), cut to ``limit`` characters."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _refusal(what: str, expected: str, value, why: str | None) -> str:
+    """The one line of a value that is not the number a keyword takes."""
+    return f"{what}: expected {expected}, got {_shown(value)}" + (f" ({why})" if why else "")
+
+
+def real_number(
+    value, what: str, expected: str = "a number", *, error: type[Exception] = UnitError
+) -> float:
+    """``value`` as a float where a real number enters: an int, a float, a numpy scalar or 0-d
+    array, or a string that ``float()`` reads (``"10"``, ``"1e3"``). NaN and inf are returned
+    as they are (the caller's range check names them).
+
+    Parameters
+    ----------
+    value
+        The value as given.
+    what : str
+        The keyword's name, for the message.
+    expected : str
+        What to give, for the message (``"a length in mm"``).
+    error : type
+        The exception class to raise: the caller's own (:class:`UnitError`, or e.g.
+        :class:`raytrace.errors.TraceError` where a trace request is checked).
+
+    Raises
+    ------
+    error
+        A bool (``True`` is no length of 1 mm), a complex number, a sequence, or anything else
+        that is not one real number: ``"{what}: expected {expected}, got 1j (a complex
+        number)"``.
+    """
+    why = _not_real(value)
+    if why is None:
+        try:
+            return float(value)
+        except (TypeError, ValueError, OverflowError):
+            pass
+    raise error(_refusal(what, expected, value, why))
+
+
+def real_array(value, what: str, expected: str = "numbers", *, error: type[Exception] = UnitError):
+    """``value`` as a float64 array of its own shape, as ``np.asarray(value, float)`` reads it
+    (numbers, numeric strings such as ``"10"``; ``None`` becomes NaN for the caller's finiteness
+    check), where the fields or angles of a call enter. Refused, as :func:`real_number` refuses
+    a scalar: bools (also inside a list, where numpy would read ``[0, True]`` as ``[0, 1]``),
+    complex numbers (numpy would drop the imaginary part), ragged lists and values that are no
+    numbers.
+
+    Parameters
+    ----------
+    value
+        A number, a sequence or an array.
+    what : str
+        The keyword's name, for the message.
+    expected : str
+        What to give, for the message (``"field angles in degrees"``).
+    error : type
+        The exception class to raise (the caller's own).
+
+    Returns
+    -------
+    ndarray
+        float64, the shape of ``value``.
+    """
+    import numpy as np
+
+    if isinstance(value, np.ndarray) and value.dtype.kind in "fiu":  # the common case, fast
+        return value.astype(np.float64, copy=False)
+    why = _not_real(value) or _any_not_real(value)
+    if why is None:
+        try:
+            a = np.asarray(value)
+            why = _not_real(a)
+            if why is None and a.dtype.kind == "O":
+                why = _any_not_real(a.ravel().tolist())
+            if why is None:
+                return a.astype(np.float64)
+        except (TypeError, ValueError, OverflowError):
+            pass
+    raise error(_refusal(what, expected, value, why))
+
+
+def _any_not_real(items) -> str | None:
+    """:func:`_not_real` of the first item of a (nested) list or tuple that is no real number,
+    or None."""
+    if not isinstance(items, list | tuple):
+        return None
+    for x in items:
+        why = _not_real(x) or _any_not_real(x)
+        if why is not None:
+            return why
+    return None
 
 
 def split_unit(text: str) -> tuple[float, str]:
@@ -92,13 +225,11 @@ def length_mm(
             )
         v *= LENGTH_UNITS[unit]
     else:
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise UnitError(
-                f"{what}: expected a length in mm (a number, or a string with its unit such as "
-                f"50.5mm or 0.05m), got {value!r}"
-            ) from None
+        v = real_number(
+            value,
+            what,
+            "a length in mm (a number, or a string with its unit such as 50.5mm or 0.05m)",
+        )
     if math.isnan(v) or (math.isinf(v) and not allow_inf):
         raise UnitError(f"{what}: expected a finite length, got {value!r}")
     if positive and not v > 0:
@@ -167,10 +298,7 @@ def wavelength_nm(value: float | str, what: str = "wavelength") -> float:
             raise UnitError(f"{what}: unknown wavelength unit {unit!r} in {value!r}; use nm or um")
         v *= WAVELENGTH_UNITS[unit]
     else:
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise UnitError(f"{what}: expected a number of nm, got {value!r}") from None
+        v = real_number(value, what, "a number of nm")
     if not math.isfinite(v):
         raise UnitError(f"{what}: expected a finite wavelength in nm, got {value!r}")
     if v <= 0:
@@ -200,7 +328,7 @@ def image_scale(value: float | str, what: str = "image scale") -> float:
         if unit not in ("", "x"):
             raise UnitError(f"{what}: {value!r} is not an image scale such as 12x")
     else:
-        v = float(value)
+        v = real_number(value, what, "an image scale N such as 12 or '12x'")
     if not (math.isfinite(v) and v > 0):
         raise UnitError(
             f"{what}: N must be a positive finite number (12x: m0 = -1/12), got {value!r}"

@@ -79,6 +79,40 @@ def test_bad_specs_raise_clear_errors(kw, match):
         Sensor.from_spec(**kw)
 
 
+@pytest.mark.parametrize(
+    ("kw", "says"),
+    [
+        (dict(size=(36j, 24), pixels=(6000, 4000)),
+         "sensor size (36j, 24): give (width, height) in mm (36j is a complex number)"),
+        (dict(size=(True, True), pixels=(6000, 4000)),
+         "sensor size (True, True): give (width, height) in mm (True is a bool, not a number)"),
+        (dict(size="36x24", pitch_um=6j),
+         "pixel pitch 6j: give one value or (x, y) in µm (6j is a complex number)"),
+        (dict(size="36x24", pitch_um=np.True_),
+         "pixel pitch np.True_: give one value or (x, y) in µm (np.True_ is a bool, not a number)"),
+        (dict(size="36x24", pitch_um=(6, 6j)), "pixel pitch (6, 6j): give one value or (x, y)"),
+        (dict(size="36x24", pixels=(6000, True)), "pixel count (6000, True): give (columns, rows)"),
+        (dict(size="36x24", pixels="6000x4000", principal_point_offset_mm=(1j, 0)),
+         "principal-point offset (1j, 0): give (dx, dy) in mm (x right, y up) (1j is a complex"),
+    ],
+)  # fmt: skip
+def test_sensor_values_that_are_no_numbers_are_refused_naming_the_value(kw, says):
+    # (36j, 24) and pitch 6j raised float()'s bare TypeError ("'complex' object is not
+    # iterable" for the pitch); a pitch of True was a 1 µm pixel, a size of (True, True) 1 mm
+    with pytest.raises(DataError) as e:
+        Sensor.from_spec(**kw)
+    assert str(e.value) == says or str(e.value).startswith(says), str(e.value)
+
+
+def test_sensor_numbers_as_numpy_scalars_and_strings_are_taken():
+    a = Sensor.from_spec(size=(np.float64(36), "24"), pixels=(np.int64(6000), 4000.0))
+    b = Sensor.from_spec(size="36x24", pitch_um=np.float32(6.0))
+    c = Sensor.from_spec(size="36x24", pitch_um=np.array(6.0))
+    for s in (a, b, c):
+        assert (s.width_px, s.height_px) == (6000, 4000)
+        assert s.pixel_pitch_um == pytest.approx((6.0, 6.0))
+
+
 def test_principal_point_in_each_convention():
     # odd, non-square: 3001 x 1999 px of 5 µm, principal point 0.1 mm right and 0.05 mm up
     s = Sensor.from_spec(pixels="3001x1999", pitch_um=5, principal_point_offset_mm=(0.1, 0.05))

@@ -200,3 +200,32 @@ def test_bad_requests(triplet):
         characteristic_distortion(triplet, [10.0], s_prime=50.0, defocus=0.0)
     with pytest.raises(TraceError, match="finite object"):
         characteristic_distortion(triplet, object_heights_mm=[1.0])
+
+
+@pytest.mark.parametrize(
+    ("analysis", "kw", "value", "says"),
+    [
+        ("characteristic_distortion", "fields_deg", [0, 1j], "fields_deg: expected field angles "
+         "in degrees (a number or a list of numbers), got [0, 1j] (a complex number)"),
+        ("characteristic_distortion", "fields_deg", True, "fields_deg: expected field angles in "
+         "degrees (a number or a list of numbers), got True (a bool, not a number)"),
+        ("characteristic_distortion", "object_heights_mm", [0, np.True_],
+         "object_heights_mm: expected object heights in mm"),
+        ("characteristic_distortion", "fields_deg", [], "no fields given: fields_deg is empty"),
+        ("pupil_analysis", "fields_deg", [0, 1j], "fields_deg: expected field angles in degrees"),
+        ("lateral_colour", "fields_deg", [False, True], "(a bool, not a number)"),
+        ("radial_by_azimuth", "fields_deg", [0, 1j], "fields_deg: expected field angles"),
+        ("radial_by_azimuth", "object_radii_mm", [0, 1j], "object_radii_mm: expected object radii"),
+    ],
+)  # fmt: skip
+def test_fields_that_are_no_numbers_are_refused_by_every_1d_analysis(
+    cooke, analysis, kw, value, says
+):
+    # [0, 1j] raised float()'s bare TypeError from requested_fields; True traced a field of 1
+    # degree (the 1-D analyses all convert their fields in requested_fields)
+    import orthoscope as osc
+
+    od = {"object_distance": 1000} if kw != "fields_deg" else {}
+    with pytest.raises(TraceError) as e:
+        getattr(osc, analysis)(cooke, **{kw: value}, **od)
+    assert says in str(e.value) and "\n" not in str(e.value), str(e.value)

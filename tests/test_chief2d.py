@@ -205,6 +205,28 @@ def test_bad_requests():
         chief_rays_2d(lens)
 
 
+@pytest.mark.parametrize(
+    ("kw", "says"),
+    [
+        (dict(fields_x_deg=[], fields_y_deg=[]), "no fields given: fields_x_deg is empty"),
+        (dict(fields_x_deg=0.0, fields_y_deg=[]), "no fields given: fields_y_deg is empty"),
+        (dict(object_x_mm=[], object_distance=1000), "no fields given: object_x_mm is empty"),
+        (dict(fields_x_deg=[0, 1j], fields_y_deg=[0, 5]), "fields_x_deg: expected field angles "
+         "in degrees (a number or a list of numbers), got [0, 1j] (a complex number)"),
+        (dict(fields_x_deg=[0, 5], fields_y_deg=True), "fields_y_deg: expected field angles in "
+         "degrees (a number or a list of numbers), got True (a bool, not a number)"),
+        (dict(object_x_mm=[0, 1], object_y_mm=[2j, 0], object_distance=1000),
+         "object_y_mm: expected object coordinates in mm"),
+    ],
+)  # fmt: skip
+def test_empty_fields_and_fields_that_are_no_numbers_are_refused(kw, says):
+    # [] and [] returned an empty result (characteristic_distortion and distortion_grid refuse
+    # "no fields given"); [0, 1j] raised float()'s bare TypeError; True traced 1 degree
+    with pytest.raises(TraceError) as e:
+        chief_rays_2d(load_lens("cooke-triplet-f4"), **kw)
+    assert says in str(e.value), str(e.value)
+
+
 def _optiland_chief_points(op, lens, X, Y):
     """optiland's chief-ray points (…, 2) on its image surface (mm) for the fields ``X``, ``Y`` in
     its field units (normalised by its max field), at the lens's wavelength."""

@@ -273,9 +273,13 @@ def test_an_output_under_a_file_says_it_is_a_file(tmp_path):
 
 
 # ------------------------------------------- radial_by_azimuth / distortion_grid: empty, range
-@pytest.mark.parametrize("az", [[0, math.nan], [math.inf], [0, -math.inf], [1j]])
+@pytest.mark.parametrize(
+    "az", [[0, math.nan], [math.inf], [0, -math.inf], [1j], [0, True], np.array([0, 45j])]
+)
 def test_azimuths_that_are_no_angles_are_named(cooke, az):
-    # [0, nan] said "fields must be finite numbers" (the wrong keyword); [1j] a TypeError
+    # [0, nan] said "fields must be finite numbers" (the wrong keyword); [1j] a TypeError;
+    # [0, True] was traced at 0 and 1 degree, np.array([0, 45j]) at 0 and 0 (the imaginary
+    # part dropped with a ComplexWarning)
     with pytest.raises(TraceError) as e:
         radial_by_azimuth(cooke, az, fields_deg=[0, 10])
     assert str(e.value).startswith("azimuths_deg must be finite angles in degrees"), str(e.value)

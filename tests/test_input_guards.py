@@ -10,10 +10,10 @@ import warnings
 
 import numpy as np
 import pytest
-from support import CORPUS, run_cli
+from support import CORPUS, TEST_DATA, run_cli
 
 import orthoscope as osc
-from raytrace.errors import TraceError
+from raytrace.errors import PrescriptionError, TraceError
 from raytrace.files import read_lens_file
 from raytrace.glass import catalog_glasses
 from raytrace.glass.catalog import RETIRED
@@ -23,6 +23,7 @@ from raytrace.materials import (
     AIR,
     MODEL_RANGE_NM,
     MODELS,
+    Material,
     OutOfRangeError,
     OutOfRangeWarning,
     fixed_index,
@@ -315,3 +316,68 @@ def test_the_range_is_where_the_model_error_is_as_in_the_visible():
     assert np.all(p95 <= vis_p95.max()), p95.max() / vis_p95.max()
     out_med, _ = _model_error_stats(np.array([300.0, 1200.0, 1500.0, 2300.0]))
     assert np.all(out_med > 1.5 * vis_med.max()), out_med / vis_med.max()
+
+
+# --------------------------------------------------------------------------------------------
+# 3. indices and Abbe numbers that no optical material has are refused where they are built
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("build", "says"),
+    [
+        (lambda: fixed_index(0.5), "fixed index nd=0.5 is below 1: a refractive index (d "
+         "line) is 1 (air) to 4.1 (germanium, ~4.0 in the infrared, has the highest); give e.g. "
+         "1.5168"),
+        (lambda: fixed_index(15), "fixed index nd=15 is above 4.1: a refractive index (d line)"),
+        (lambda: model_glass(15, 60), "model glass nd=15 is above 4.1: a refractive index (d "
+         "line) is 1 (air) to 4.1"),
+        (lambda: model_glass(0.99, 60), "model glass nd=0.99 is below 1: a refractive index"),
+        (lambda: model_glass(64.17, 1.5168), "give e.g. 1.5168; nd and vd swapped? give nd "
+         "1.5168, vd 64.17"),
+        (lambda: model_glass(1.5168, 250), "model glass vd=250 is above 120: an Abbe number is "
+         "above 0 and at most 120 (MgF2, 106, is among the highest); give e.g. 64.17"),
+        (lambda: Material("model", 1.5, 121.0, model="buchdahl-optiland"), "model glass vd=121"),
+        (lambda: fixed_index(1.5j), "nd: expected a refractive index such as 1.5168, got 1.5j "
+         "(a complex number)"),
+        (lambda: fixed_index(True), "got True (a bool, not a number)"),
+        (lambda: model_glass(1.5, [60]), "vd: expected an Abbe number such as 64.17, got [60]"),
+    ],
+)  # fmt: skip
+def test_an_index_or_abbe_number_no_material_has_is_refused(build, says):
+    # fixed_index(0.5) and model_glass(15, 60) were built (and traced); fixed_index(1.5j) raised
+    # float()'s bare TypeError
+    with pytest.raises(ValueError) as e:
+        build()
+    assert says in str(e.value) and "\n" not in str(e.value), str(e.value)
+
+
+def test_the_ends_of_the_ranges_and_numpy_numbers_are_materials():
+    # air (n = 1 exactly: dummy surfaces, index-matched gaps) and germanium-like indices stay
+    # legal, as do the Abbe numbers of CaF2 (95), MgF2 (106.2, the Misc catalog) and the ends
+    for n in (1.0, np.float64(1.5168), 4.0, 4.1, np.int64(2), "1.6"):
+        assert fixed_index(n).nd == float(n)
+    for nd, vd in (
+        (1.0, 0.5),
+        (4.1, 120.0),
+        (1.4338, 94.99),
+        (1.377744, 106.2176),
+        (np.float32(1.62), 60),
+    ):
+        m = model_glass(nd, vd)
+        assert (m.nd, m.vd) == (float(nd), float(vd))
+
+
+def test_a_lens_file_with_an_impossible_model_glass_says_where(tmp_path):
+    # the Material's refusal reaches the reader's one line with the file and line (a Zemax
+    # model glass of nd 15 went through as one: GLAS ___BLANK only checked nd > 0)
+    good = (TEST_DATA / "cooke-triplet-f4.zmx").read_text()
+    line = "  GLAS ___BLANK 1 0 1.61659 3.663E+1 0 0 0 0 0 0"
+    assert good.splitlines()[73] == line
+    path = tmp_path / "bad-glass.zmx"
+    path.write_text(good.replace(line, "  GLAS ___BLANK 1 0 15 3.663E+1 0 0 0 0 0 0"))
+    with pytest.raises(PrescriptionError) as e:
+        read_lens_file(path)
+    msg = str(e.value)
+    assert "bad-glass.zmx:74" in msg and "GLAS ___BLANK: model glass nd=15 is above 4.1" in msg, msg
+    assert "\n" not in msg

@@ -369,6 +369,61 @@ def test_field_beyond_lens_gets_status_not_crash():
         chief_rays(lens, object_heights_mm=[1.0])  # object at infinity
 
 
+@pytest.mark.parametrize(
+    ("kw", "value", "says"),
+    [
+        ("fields_deg", [0, 1j], "fields_deg: expected field angles in degrees (a number or a list "
+         "of numbers), got [0, 1j] (a complex number)"),
+        ("fields_deg", np.array([0, 10j]), "(a complex number)"),
+        ("fields_deg", True, "fields_deg: expected field angles in degrees (a number or a list of "
+         "numbers), got True (a bool, not a number)"),
+        ("fields_deg", [True, False], "got [True, False] (a bool, not a number)"),
+        ("fields_deg", [0, np.True_], "(a bool, not a number)"),
+        ("fields_deg", [[0, 1], [2]], "fields_deg: expected field angles in degrees"),
+        ("fields_deg", [], "no fields given: fields_deg is empty"),
+        ("object_heights_mm", [0, 5j], "object_heights_mm: expected object heights in mm"),
+        ("object_heights_mm", [], "no fields given: object_heights_mm is empty"),
+    ],
+)  # fmt: skip
+def test_fields_that_are_no_numbers_are_refused_naming_the_keyword(cooke, kw, value, says):
+    # [0, 1j] raised float()'s bare TypeError; True traced a field of 1 degree, [True, False]
+    # fields of 1 and 0; [] returned an empty result where characteristic_distortion refuses
+    od = {"object_distance": 1000} if kw == "object_heights_mm" else {}
+    with pytest.raises(TraceError) as e:
+        chief_rays(cooke, **{kw: value}, **od)
+    assert says in str(e.value) and "\n" not in str(e.value), str(e.value)
+
+
+def test_fields_as_numpy_scalars_ints_and_numeric_strings_are_traced(cooke):
+    ref = chief_rays(cooke, [0.0, 10.0])
+    for f in ([0, 10], np.array([0, 10]), [np.float32(0), np.int64(10)], ["0", "10"]):
+        cr = chief_rays(cooke, f)
+        np.testing.assert_array_equal(cr.fields, ref.fields)
+        np.testing.assert_array_equal(cr.y_last, ref.y_last)
+    for f in ("10", np.float64(10), np.array(10.0)):
+        assert chief_rays(cooke, f).y_last[0] == ref.y_last[1]
+
+
+@pytest.mark.parametrize(
+    ("kw", "value", "says"),
+    [
+        ("field_deg", 1j, "field_deg: expected one field angle in degrees (a number), got 1j"),
+        ("field_deg", np.True_, "field_deg: expected one field angle in degrees (a number), "
+         "got np.True_ (a bool, not a number)"),
+        ("object_height_mm", 2j, "object_height_mm: expected one object height in mm"),
+    ],
+)  # fmt: skip
+def test_a_fan_field_that_is_no_number_names_the_keyword(cooke, kw, value, says):
+    # ray_fan(lens, 1j) raised float()'s bare TypeError; np.True_ traced 1 degree
+    from raytrace.trace import ray_fan, spot_diagram
+
+    od = {"object_distance": 1000} if kw == "object_height_mm" else {}
+    for f in (ray_fan, spot_diagram):
+        with pytest.raises(TraceError) as e:
+            f(cooke, **{kw: value}, **od)
+        assert says in str(e.value), str(e.value)
+
+
 def test_chief_rays_paraxial_limit():
     """Real chief rays at 1e-4 of the field reproduce the paraxial chief-ray heights (y-nu trace
     through the paraxial entrance pupil, written in this file) to 1e-9 relative."""

@@ -11,13 +11,14 @@ from __future__ import annotations
 import math
 import warnings
 
+import numpy as np
 import pytest
 
 import orthoscope as osc
 from orthoscope.cli import main
-from raytrace.errors import TraceError
+from raytrace.errors import LensError, OrthoscopeError, TraceError
 from raytrace.paraxial import ImagePlane, pestrecov_constants
-from raytrace.units import UnitError, length_mm, wavelength_nm
+from raytrace.units import UnitError, image_scale, length_mm, wavelength_nm
 
 #: a unit glued to a value that already has one ("0.55nmum", "5mmm", "5mmmm", "0.55nmnm")
 DOUBLED = ("nmum", "nmnm", "nmm", "umum", "µmum", "mmum", "mmm", "cmm")
@@ -222,3 +223,81 @@ def test_cli_s_prime_at_infinity_distance_is_refused_in_one_line(capsys):
     out, err = capsys.readouterr()
     assert rc == 2 and out == ""
     assert err.count("\n") == 1 and "--s-prime 1e+300 mm is not a plane position" in err, err
+
+
+# ------------------------------------ bools and complex numbers where a number with a unit enters
+@pytest.mark.parametrize(
+    ("f", "value", "says"),
+    [
+        (length_mm, True, "x: expected a length in mm (a number, or a string with its unit such "
+         "as 50.5mm or 0.05m), got True (a bool, not a number)"),
+        (length_mm, np.True_, "got np.True_ (a bool, not a number)"),
+        (length_mm, 1j, "got 1j (a complex number)"),
+        (length_mm, np.complex128(5), "(a complex number)"),
+        (wavelength_nm, True, "x: expected a number of nm, got True (a bool, not a number)"),
+        (wavelength_nm, 587j, "x: expected a number of nm, got 587j (a complex number)"),
+        (image_scale, True, "x: expected an image scale N such as 12 or '12x', got True (a bool"),
+        (image_scale, 12j, "x: expected an image scale N such as 12 or '12x', got 12j (a complex"),
+        (image_scale, [12], "x: expected an image scale N such as 12 or '12x', got [12]"),
+    ],
+)  # fmt: skip
+def test_a_bool_or_complex_number_is_no_value_with_a_unit(f, value, says):
+    # length_mm(True) was 1 mm and wavelength_nm(True) 1 nm (refused only as out of range);
+    # image_scale(12j) raised a bare TypeError from float()
+    msg = refusal(f, value, "x")
+    assert says in msg and "\n" not in msg, msg
+
+
+@pytest.mark.parametrize(
+    ("f", "value", "expected"),
+    [
+        (length_mm, "1.5m", 1500.0),
+        (length_mm, np.float64(2.5), 2.5),
+        (length_mm, np.array(3.0), 3.0),
+        (length_mm, np.int64(4), 4.0),
+        (length_mm, 5, 5.0),
+        (wavelength_nm, np.float32(550.0), 550.0),
+        (wavelength_nm, "587.5618", 587.5618),
+        (image_scale, np.int64(12), 12.0),
+        (image_scale, "12", 12.0),
+    ],
+)
+def test_numpy_scalars_ints_and_numeric_strings_stay_numbers(f, value, expected):
+    assert f(value, "x") == pytest.approx(expected, rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("kw", "value", "says"),
+    [
+        ("object_distance", 1j, "object_distance: expected mm (or a length with its unit: 1.5m, "
+         "250mm), 'inf' or an image scale such as '12x', got 1j (a complex number)"),
+        ("object_distance", [1000, 2000], "object_distance: expected mm (or a length with its "
+         "unit: 1.5m, 250mm), 'inf' or an image scale such as '12x', got [1000, 2000]"),
+        ("object_distance", True, "got True (a bool, not a number)"),
+        ("object_s", True, "object_s: expected a length in mm"),
+        ("object_scale", 12j, "object_scale: expected an image scale N"),
+    ],
+)  # fmt: skip
+def test_an_object_that_is_no_distance_names_the_keyword(cooke, kw, value, says):
+    # object_distance=1j and [1000, 2000] raised float()'s bare TypeError (no keyword named);
+    # object_distance=True traced an object 1 mm from the first vertex
+    # the class of each function's other refusals of the keyword (NaN, a negative distance):
+    # TraceError in a trace, LensError in paraxial(), UnitError for object_s / object_scale
+    for call, error in (
+        (lambda: osc.chief_rays(cooke, [0, 10], **{kw: value}), TraceError),
+        (lambda: osc.characteristic_distortion(cooke, [0, 10], **{kw: value}), TraceError),
+        (lambda: osc.paraxial(cooke, **{kw: value}), LensError),
+    ):
+        with pytest.raises(OrthoscopeError) as e:
+            call()
+        if kw == "object_distance":
+            assert isinstance(e.value, error), repr(e.value)
+        assert says in str(e.value) and "\n" not in str(e.value), str(e.value)
+
+
+def test_paraxial_object_distance_keeps_its_error_class(cooke):
+    # a number that is no distance is a LensError in paraxial(), as NaN or a negative one is
+    for value in (1j, [1000.0], True, math.nan):
+        with pytest.raises(LensError, match="object"):
+            osc.paraxial(cooke, object_distance=value)
+    assert osc.paraxial(cooke, object_distance=np.float64(1000.0)).object_distance == 1000.0

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from raytrace.units import number_problem
+
 from ..errors import DataError, UnitWarning
 from .conventions import (
     from_opencv_pixels,
@@ -109,6 +111,32 @@ def size_problem(value_mm: float) -> str | None:
     return why + "; sizes are in mm (a full-frame sensor is 36x24)"
 
 
+def _numbers(values, what: str, fix: str, given=None) -> tuple[float, ...]:
+    """The items of the sequence ``values`` as floats: numbers, numpy scalars or numeric
+    strings, as ``float()`` reads them. The one conversion of this module's number pairs;
+    ``given`` is the value as the caller got it, for the message (default ``values``).
+
+    Raises
+    ------
+    DataError
+        ``values`` is no sequence, or an item is a bool, a complex number or no number
+        (:func:`raytrace.units.number_problem`): ``"{what} (36j, 24): {fix} (36j is a complex
+        number)"``.
+    """
+    shown = repr(values if given is None else given)
+    try:
+        items = tuple(values)
+    except TypeError:
+        items = None
+    if items is None or isinstance(values, str | bytes):
+        raise DataError(f"{what} {shown}: {fix}")
+    for v in items:
+        why = number_problem(v)
+        if why is not None:
+            raise DataError(f"{what} {shown}: {fix} ({v!r} is {why})")
+    return tuple(float(v) for v in items)
+
+
 def _pair_text(value) -> str:
     """``(6, 6)`` of a sequence of numbers, else its repr (for the messages)."""
     if isinstance(value, str | bytes):
@@ -137,9 +165,9 @@ def check_pixel_size_mm(pixel_size_mm, head: str = "", pixels=None) -> tuple[flo
         (0.006, 0.006) mm``.
     """
     label = f"{head}pixel_size_mm={_pair_text(pixel_size_mm)}"
-    try:
-        vals = tuple(float(v) for v in pixel_size_mm)
-    except (TypeError, ValueError):
+    try:  # a bool or a complex number is no pitch either
+        vals = _numbers(pixel_size_mm, "pixel_size_mm", "")
+    except DataError:
         vals = ()
     if (
         isinstance(pixel_size_mm, str)
@@ -207,7 +235,7 @@ def check_principal_distance_mm(
         c = float(principal_distance_mm)
     except (TypeError, ValueError):
         c = math.nan
-    if isinstance(principal_distance_mm, bool) or not (math.isfinite(c) and c > 0):
+    if number_problem(principal_distance_mm) or not (math.isfinite(c) and c > 0):
         raise DataError(f"{what} give the principal distance c in mm, a positive number (e.g. 50)")
     r = float(largest_radius_mm)
     lo, hi = r / MAX_RADIUS_RATIO, r * MAX_PRINCIPAL_DISTANCE_RATIO  # c in mm
@@ -272,10 +300,10 @@ def parse_size_mm(size: str | Sequence[float]) -> tuple[float, float]:
             a = a + mb.group(2)  # '36x24mm': the unit written once applies to both
         w, _ = _number(a, "sensor width", _MM, "mm")
     else:
-        vals = tuple(size)
+        vals = _numbers(size, "sensor size", "give (width, height) in mm")
         if len(vals) != 2:
             raise DataError(f"sensor size {size!r}: give (width, height) in mm")
-        w, h = float(vals[0]), float(vals[1])
+        w, h = vals
     if not (math.isfinite(w) and math.isfinite(h) and w > 0 and h > 0):
         label = size.strip() if isinstance(size, str) else f"{w:g}x{h:g}"
         raise DataError(f"sensor {label}: width and height must be positive (mm)")
@@ -299,7 +327,7 @@ def parse_pixels(pixels: str | Sequence[int]) -> tuple[int, int]:
         except ValueError:
             raise DataError(f"pixel count {pixels!r}: not two numbers; e.g. '6000x4000'") from None
     else:
-        fv = tuple(float(v) for v in pixels)
+        fv = _numbers(pixels, "pixel count", "give (columns, rows)")
         if len(fv) != 2:
             raise DataError(f"pixel count {pixels!r}: give (columns, rows)")
     for v in fv:
@@ -318,10 +346,13 @@ def parse_pitch_um(pitch: str | float | Sequence[float]) -> tuple[float, float]:
         py, uy = _number(b, "pixel pitch", _UM, "µm") if b is not None else (px, ux)
         explicit = ux or uy
         vals = (px, py)
-    elif isinstance(pitch, int | float | np.floating | np.integer):
-        vals, explicit = (float(pitch), float(pitch)), False
+    elif np.ndim(pitch) == 0 and not isinstance(pitch, bytes):  # one number
+        vals, explicit = (
+            _numbers((pitch, pitch), "pixel pitch", "give one value or (x, y) in µm", pitch),
+            False,
+        )
     else:
-        vals = tuple(float(v) for v in pitch)
+        vals = _numbers(pitch, "pixel pitch", "give one value or (x, y) in µm")
         if len(vals) != 2:
             raise DataError(f"pixel pitch {pitch!r}: give one value or (x, y) in µm")
         explicit = False
@@ -350,7 +381,7 @@ def _parse_offset(off) -> tuple[float, float]:
             raise DataError(f"principal-point offset {off!r}: give 'dx,dy' in mm (x right, y up)")
         vals = tuple(_number(p, "principal-point offset", _MM, "mm")[0] for p in parts)
     else:
-        vals = tuple(float(v) for v in off)
+        vals = _numbers(off, "principal-point offset", "give (dx, dy) in mm (x right, y up)")
         if len(vals) != 2:
             raise DataError(f"principal-point offset {off!r}: give (dx, dy) in mm")
     if not all(math.isfinite(v) for v in vals):
@@ -389,11 +420,17 @@ class Sensor:
     def __post_init__(self) -> None:
         for name in ("width_px", "height_px"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not float(v) == int(v) or not 0 < int(v) <= MAX_PIXELS:
+            if (
+                number_problem(v) is not None
+                or not math.isfinite(float(v))
+                or not float(v) == int(v)
+                or not 0 < int(v) <= MAX_PIXELS
+            ):
                 raise DataError(f"Sensor {name}={v!r}: a whole number of pixels, 1..{MAX_PIXELS}")
             object.__setattr__(self, name, int(v))
         for name in ("width_mm", "height_mm"):
-            v = float(getattr(self, name))
+            v = getattr(self, name)
+            (v,) = _numbers((v,), f"Sensor {name}", "give a size in mm", v)
             if not (math.isfinite(v) and v > 0):
                 raise DataError(f"Sensor {name}={v!r}: must be positive (mm)")
             why = size_problem(v)

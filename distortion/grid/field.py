@@ -71,7 +71,7 @@ from raytrace.errors import TraceError
 from raytrace.lens import Lens, require_lens
 from raytrace.limits import MAX_FIELDS
 from raytrace.paraxial import ImagePlane, ParaxialResult
-from raytrace.units import is_whole
+from raytrace.units import is_whole, real_array
 
 from ..curve import FieldKindMixin, curve_field_kind, plane_label, requested_fields
 from ..errors import DataError
@@ -663,9 +663,9 @@ def radial_by_azimuth(
     # field of 100° would otherwise wrap through tan into one within ±90° and be traced
     checked_aim_request(kind, par.object_distance, r, heights="object radii")
     what = "azimuths_deg must be finite angles in degrees (from +x toward +y)"
-    try:
-        az = np.atleast_1d(np.asarray(azimuths_deg, dtype=float)).ravel()
-    except (TypeError, ValueError):
+    try:  # numbers only: a bool or a complex number is refused (raytrace.units.real_array)
+        az = np.atleast_1d(real_array(azimuths_deg, "azimuths_deg", error=ValueError)).ravel()
+    except ValueError:
         raise TraceError(f"{what}, got {azimuths_deg!r}") from None
     if az.size == 0:
         raise TraceError("no azimuths given: azimuths_deg is empty")

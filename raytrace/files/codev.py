@@ -564,13 +564,15 @@ class _SeqParser(LineParser):
             return AIR
         if normalize_name(name) in self.private:
             return self.private[normalize_name(name)]
-        code = parse_glass_code(name)
-        if code is not None:
-            return code
-        try:
+        try:  # a code outside raytrace.materials.INDEX_RANGE / ABBE_RANGE: ValueError
+            code = parse_glass_code(name)
+            if code is not None:
+                return code
             r = resolve_glass(name)
         except PrescriptionError as e:
             raise self.err(f"glass {name}: {e.reason}", line, no) from None
+        except ValueError as e:
+            raise self.err(f"glass {name}: {e}", line, no) from None
         if r.warning:
             self.warn(f"line {line}: {r.warning}")
         return r.material

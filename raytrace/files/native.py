@@ -82,7 +82,7 @@ import numpy as np
 from ..errors import LensError, PrescriptionError
 from ..frames import AFTER_MODES, ORDERS, Placement
 from ..lens import APERTURE_KINDS, IMAGE_FIELDS, Aperture, ClearAperture, Field, Lens, Surface
-from ..materials import AIR, LAMBDA_D, Material, fixed_index, model_glass
+from ..materials import AIR, LAMBDA_D, Material, fixed_index
 from ..qtype import FORMS, QType
 from .output import check_reads_back, write_atomic
 from .text import decode_text, read_bytes, solve_paraxial_image
@@ -442,7 +442,10 @@ def _material(
         v = _number(src, n, "n (fixed refractive index)", line, surface)
         if v < 1.0:
             raise src.error(f"n (fixed refractive index) must be >= 1, got {v!r}", line, surface)
-        return fixed_index(v)
+        try:  # at most raytrace.materials.INDEX_RANGE's upper bound
+            return fixed_index(v)
+        except ValueError as e:
+            raise src.error(f"n (fixed refractive index): {e}", line, surface) from None
     if glass is None:
         return AIR
     help_ = (
@@ -463,10 +466,8 @@ def _material(
                 line,
                 surface,
             )
-        if model is None:
-            return model_glass(nd, vd)
-        try:
-            return Material("model", nd, vd, model=model)
+        try:  # within raytrace.materials.INDEX_RANGE and ABBE_RANGE
+            return Material("model", nd, vd, model=model or "")
         except ValueError as e:
             raise src.error(f"glass {glass!r}: {e}", line, surface) from None
     if model is not None:

@@ -446,16 +446,21 @@ class _ZmxParser(LineParser):
             vd = number(args[4], "GLAS vd", self.fail, line)
             if not (nd > 0.0) or vd < 0.0:
                 raise self.err(f"GLAS {name}: nd must be > 0 and vd >= 0, got {nd}, {vd}", line)
-            return fixed_index(nd) if vd == 0.0 else model_glass(nd, vd)
+            try:  # within raytrace.materials.INDEX_RANGE (and ABBE_RANGE)
+                return fixed_index(nd) if vd == 0.0 else model_glass(nd, vd)
+            except ValueError as e:
+                raise self.err(f"GLAS {name}: {e}", line) from None
         if name.upper() == "AIR":
             return AIR
-        code = parse_glass_code(name)
-        if code is not None:
-            return code
-        try:
+        try:  # a code or printed nd/vd outside raytrace.materials.INDEX_RANGE: ValueError
+            code = parse_glass_code(name)
+            if code is not None:
+                return code
             r = resolve_glass(name, gcat, printed=printed_nd_vd(args))
         except PrescriptionError as e:
             raise self.err(f"GLAS {name}: {e.reason}", line, no) from None
+        except ValueError as e:
+            raise self.err(f"GLAS {name}: {e}", line, no) from None
         if r.warning:
             self.warn(f"line {line}: {r.warning}")
         return r.material

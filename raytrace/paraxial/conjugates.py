@@ -256,7 +256,7 @@ def resolve_object_distance(
     ]
     if len(given) > 1:
         raise TraceError(f"give the object one way, not {' and '.join(given)}")
-    from ..units import UnitError, image_scale, length_mm
+    from ..units import OBJECT_DISTANCE_FORMS, UnitError, image_scale, length_mm, real_number
 
     if object_s is not None:  # a number (mm) or a length with its unit ("-1.5m")
         return object_distance_for_s(lens, length_mm(object_s, "object_s"), wavelength)
@@ -277,10 +277,9 @@ def resolve_object_distance(
             object_distance = length_mm(t, "object_distance", allow_inf=True)
         except UnitError:
             raise TraceError(
-                f"object_distance {object_distance!r}: expected mm (or a length with its unit: "
-                "1.5m, 250mm), 'inf' or an image scale such as '12x'"
+                f"object_distance {object_distance!r}: expected {OBJECT_DISTANCE_FORMS}"
             ) from None
-    od = float(object_distance)
+    od = real_number(object_distance, "object_distance", OBJECT_DISTANCE_FORMS, error=TraceError)
     if not od > 0:
         raise TraceError(
             f"object_distance must be a positive magnitude (mm from the object plane to the "

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import LensError
 from ..lens import Lens, require_lens
-from ..units import WAVELENGTH_RANGE_NM
+from ..units import OBJECT_DISTANCE_FORMS, WAVELENGTH_RANGE_NM, real_number
 
 
 @dataclass(frozen=True)
@@ -436,7 +436,10 @@ def paraxial(
             object_scale=object_scale,
             wavelength=wavelength,
         )
-    od = lens.object_distance if object_distance is None else float(object_distance)
+    if object_distance is None:
+        od = lens.object_distance
+    else:  # a bool or a complex number is no distance (raytrace.units.real_number)
+        od = real_number(object_distance, "object_distance", OBJECT_DISTANCE_FORMS, error=LensError)
     if not (od > 0.0):
         raise LensError(f"object distance must be a positive magnitude or inf, got {od}")
     require_centred(lens)

@@ -406,10 +406,38 @@ def chief_rays(
         f = np.array([0.0, lens.field.value])
     else:
         fk = "angle" if fields_deg is not None else "height"
-        f = np.atleast_1d(np.asarray(fields_deg if fk == "angle" else object_heights_mm, float))
+        name = "fields_deg" if fk == "angle" else "object_heights_mm"
+        f = np.atleast_1d(field_values(fields_deg if fk == "angle" else object_heights_mm, name))
+        if f.size == 0:  # as characteristic_distortion: no field, no chief ray
+            raise TraceError(f"no fields given: {name} is empty")
     if wavelengths is not None:
         return aim(lens, f, fk, od, clip=clip, wavelengths=wavelengths)
     return aim(lens, f, fk, od, wavelength, clip)
+
+
+def field_values(value: npt.ArrayLike, name: str) -> np.ndarray:
+    """The fields given as keyword ``name`` (``fields_deg``, ``object_heights_mm``,
+    ``fields_x_deg``, ...) as a float64 array of their shape: the one conversion of the field
+    keywords of every trace (:func:`raytrace.units.real_array`). Numbers and numeric strings
+    (``"10"``) are read; None becomes NaN (refused by :func:`checked_aim_request` as not
+    finite).
+
+    Raises
+    ------
+    TraceError
+        A bool, a complex number, a ragged list or a value that is no number, naming the
+        keyword: ``fields_deg: expected field angles in degrees (a number or a list of
+        numbers), got [0, 1j] (a complex number)``.
+    """
+    from ..units import real_array
+
+    unit = {
+        "object_heights_mm": "object heights in mm",
+        "object_radii_mm": "object radii in mm",
+        "object_x_mm": "object coordinates in mm",
+        "object_y_mm": "object coordinates in mm",
+    }.get(name, "field angles in degrees")
+    return real_array(value, name, f"{unit} (a number or a list of numbers)", error=TraceError)
 
 
 def resolve_wavelengths(lens: Lens, wavelengths) -> tuple[float, ...]:

@@ -47,6 +47,7 @@ from .chief import (
     aim_start,
     aim_tolerance,
     checked_aim_request,
+    field_values,
     transfer,
 )
 from .results import RayStatus, field_unit, object_words, status_name
@@ -220,6 +221,10 @@ def chief_rays_2d(
     if given is None:
         raise TraceError("give fields_x_deg / fields_y_deg (degrees) or object_x_mm / object_y_mm")
     kind, fx, fy = given
+    names = ("fields_x_deg", "fields_y_deg") if kind == "angle" else ("object_x_mm", "object_y_mm")
+    for name, a in zip(names, (fx, fy), strict=True):
+        if a.size == 0:  # as characteristic_distortion and distortion_grid
+            raise TraceError(f"no fields given: {name} is empty")
     try:
         fx, fy = np.broadcast_arrays(fx, fy)
     except ValueError:
@@ -263,8 +268,9 @@ def requested_fields_2d(
     if not (angles or heights):
         return None
     a, b = (fields_x_deg, fields_y_deg) if angles else (object_x_mm, object_y_mm)
-    x = np.asarray(0.0 if a is None else a, dtype=np.float64)
-    y = np.asarray(0.0 if b is None else b, dtype=np.float64)
+    nx, ny = ("fields_x_deg", "fields_y_deg") if angles else ("object_x_mm", "object_y_mm")
+    x = field_values(0.0 if a is None else a, nx)
+    y = field_values(0.0 if b is None else b, ny)
     return ("angle" if angles else "height"), x, y
 
 

@@ -72,10 +72,18 @@ def _field(lens: Lens, field_deg, object_height_mm, finite: bool) -> tuple[float
     if object_height_mm is not None:
         if not finite:
             raise TraceError("object heights need a finite object distance")
-        return float(object_height_mm), "height"
+        return _one_field(object_height_mm, "object_height_mm", "one object height in mm"), "height"
     if field_deg is None:
         return 0.0, "angle"
-    return float(field_deg), "angle"
+    return _one_field(field_deg, "field_deg", "one field angle in degrees"), "angle"
+
+
+def _one_field(value, name: str, expected: str) -> float:
+    """One field as a float (:func:`raytrace.units.real_number`; a numpy bool or a complex
+    number is refused, naming the keyword)."""
+    from ..units import real_number
+
+    return real_number(value, name, f"{expected} (a number)", error=TraceError)
 
 
 def _trace_field(
