@@ -44,6 +44,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from raytrace.units import is_whole
+
 from .camera.models import radial_polynomial, scale_radial_coefficients
 from .errors import DataError
 
@@ -154,8 +156,9 @@ def fit_radial(
         raise DataError(f"unknown form {form!r} (expected 'gaussian' or 'balanced')")
     if radius not in _RADIUS:
         raise DataError(f"unknown radius convention {radius!r} (expected {_RADIUS})")
-    if n_terms < 1:
-        raise DataError("n_terms must be at least 1")
+    if not (is_whole(n_terms) and n_terms >= 1):
+        why = "" if is_whole(n_terms) else f" (a whole number of odd terms), got {n_terms!r}"
+        raise DataError(f"n_terms must be at least 1{why}")
     r = np.asarray(r_mm, dtype=float)
     d_um = np.asarray(dr_um, dtype=float)
     if r.shape != d_um.shape or r.ndim != 1:

@@ -10,12 +10,14 @@ Both edits add two surfaces; ``surface_map`` tells where an old surface number l
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable
 from dataclasses import replace
 
 from .errors import LensError
 from .lens import Lens, Surface
 from .materials import AIR, Material
+from .units import number_problem
 
 #: the air gap (mm) between the two halves of a split element, and around an inserted one
 DEFAULT_GAP = 0.1
@@ -114,6 +116,11 @@ def split_element(lens: Lens, surface: int, *, gap: float = DEFAULT_GAP) -> Lens
     return _resolved(replace(lens, surfaces=new, notes=_with_note(lens.notes, note), path=None))
 
 
+def _kind(value) -> str:
+    """What a value that ``float()`` reads but that is no number is, for a message."""
+    return "text, not a number" if isinstance(value, str) else "not a number"
+
+
 def insert_element(
     lens: Lens,
     after: int,
@@ -163,10 +170,16 @@ def insert_element(
         raise LensError(f"{lens.name}: the space after surface {after} is not air")
     if material.is_air:
         raise LensError(f"{lens.name}: an inserted element needs a glass, not air")
+    for v, what in ((thickness, "thickness"), (gap, "gap")):
+        if v is not None and not (isinstance(v, numbers.Real) and not isinstance(v, bool)):
+            raise LensError(
+                f"{lens.name}: the inserted element's {what} must be a length in mm (a positive "
+                f"number), got {v!r} ({number_problem(v) or _kind(v)})"
+            )
     if gap is None:
         gap = 0.5 * (s0.thickness - thickness)
     for v, what in ((thickness, "thickness"), (gap, "gap")):
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+        if not (math.isfinite(v) and v > 0):  # real numbers (checked above), numpy's too
             raise LensError(
                 f"{lens.name}: the inserted element's {what} must be positive (mm); the air "
                 f"space after surface {after} is {s0.thickness:g} mm"

@@ -301,3 +301,58 @@ def test_paraxial_object_distance_keeps_its_error_class(cooke):
         with pytest.raises(LensError, match="object"):
             osc.paraxial(cooke, object_distance=value)
     assert osc.paraxial(cooke, object_distance=np.float64(1000.0)).object_distance == 1000.0
+
+
+# a count, a distance or a thickness that is no number of the right kind: the module's own
+# error naming the keyword, not a bare TypeError from range(), a comparison or a subtraction
+_R = np.linspace(0.5, 20, 20)
+_DR = -0.5 * _R**3 / 400  # µm
+
+
+@pytest.mark.parametrize(
+    "call, value, error, says",
+    [
+        ("fit_radial", 2.5, "DataError", "n_terms must be at least 1 (a whole number"),
+        ("fit_radial", True, "DataError", "n_terms must be at least 1 (a whole number"),
+        ("fit_radial", "3", "DataError", "n_terms must be at least 1 (a whole number"),
+        ("decompose", 2.5, "DataError", "radial_terms must be 0 or more (a whole number"),
+        ("decompose", True, "DataError", "radial_terms must be 0 or more (a whole number"),
+        ("focus", 1j, "DataError", "distance_mm: expected a focus distance in mm"),
+        ("focus", [2000], "DataError", "distance_mm: expected a focus distance in mm"),
+        ("focus", "2 parsecs", "DataError", "distance_mm: unknown length unit"),
+        ("focus_index", 1.5, "DataError", "focus_index must lie in 0–2 (a whole number)"),
+        ("insert", "x", "LensError", "the inserted element's thickness must be a length in mm"),
+        ("insert", 1j, "LensError", "the inserted element's thickness must be a length in mm"),
+    ],
+)
+def test_a_count_distance_or_thickness_of_the_wrong_kind_names_the_keyword(
+    cooke, call, value, error, says
+):
+    calls = {
+        "fit_radial": lambda: osc.fit_radial(_R, _DR, n_terms=value),
+        "decompose": lambda: osc.decompose_distortion(
+            osc.distortion_grid(cooke, grid=(9, 7)), radial_terms=value
+        ),
+        "focus": lambda: osc.solve_focus(cooke, value, moving=1),
+        "focus_index": lambda: osc.focus_study(
+            cooke,
+            osc.unit_focus_configurations(cooke, [math.inf, 2000, 1000]),
+            focus_index=value,
+        ),
+        "insert": lambda: osc.insert_element(cooke, 2, osc.fixed_index(1.5), thickness=value),
+    }
+    with pytest.raises(OrthoscopeError) as e:
+        calls[call]()
+    assert type(e.value).__name__ == error and says in str(e.value), repr(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_valid_counts_distances_and_thicknesses_stay_accepted(cooke):
+    # numpy integers count; a focus distance may carry its unit as object_distance's does
+    assert len(osc.fit_radial(_R, _DR, n_terms=np.int64(2)).k) == 2
+    two_m = osc.solve_focus(cooke, 2000, moving=1)
+    assert osc.solve_focus(cooke, "2m", moving=1) == two_m
+    assert osc.solve_focus(cooke, np.float64(2000.0), moving=1) == two_m
+    assert osc.solve_focus(cooke, "inf", moving=1).object_distance == math.inf
+    for t in (2, 2.0, np.int64(2), np.float32(2.0)):
+        assert osc.insert_element(cooke, 2, osc.fixed_index(1.5), thickness=t).n_surfaces == 8

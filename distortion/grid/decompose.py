@@ -69,6 +69,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from raytrace.units import is_whole
+
 from ..errors import DataError
 
 #: the principal-point choices: fitted, or held at a named reference point
@@ -178,6 +180,14 @@ def point_pairs(
     return t, img, good
 
 
+def _check_radial_terms(radial_terms) -> None:
+    """DataError unless ``radial_terms`` is a whole number ≥ 0 (an int or numpy integer; not a
+    bool, a float such as 2.5 or a string)."""
+    if not (is_whole(radial_terms) and radial_terms >= 0):
+        why = "" if is_whole(radial_terms) else f" (a whole number), got {radial_terms!r}"
+        raise DataError(f"radial_terms must be 0 or more{why}")
+
+
 def basis_columns(tx: np.ndarray, ty: np.ndarray, radial_terms: int, asymmetric: bool) -> list:
     """The model's basis vector fields, each (x-part, y-part) over the points, in the order
     x0, y0, c, a1.., q1, q2, σ1, σ2 (the last four when ``asymmetric``)."""
@@ -246,8 +256,7 @@ def solve_linear(
     DataError
         Bad shapes, or a fitted camera constant that is not positive."""
     t, img, good = point_pairs(t, image)
-    if radial_terms < 0:
-        raise DataError("radial_terms must be 0 or more")
+    _check_radial_terms(radial_terms)
     tx, ty = t[good, 0], t[good, 1]
     bx, by = img[good, 0].copy(), img[good, 1].copy()
     cols = basis_columns(tx, ty, radial_terms, asymmetric)
@@ -490,6 +499,7 @@ def decompose_distortion(
         raise DataError(
             f"principal_point={principal_point!r}; use one of {', '.join(PRINCIPAL_POINTS)}"
         )
+    _check_radial_terms(radial_terms)
     if camera_constant not in CAMERA_CONSTANTS:
         raise DataError(
             f"camera_constant={camera_constant!r}; use one of {', '.join(CAMERA_CONSTANTS)}"

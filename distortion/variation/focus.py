@@ -52,6 +52,7 @@ from raytrace.files.configurations import (
     check_surfaces,
 )
 from raytrace.lens import Lens
+from raytrace.units import UnitError, is_whole, length_mm, real_number
 
 from ..errors import DataError
 from .analysis import Profile, ProfileSet, VariationAnalysis, analyze_variation
@@ -97,6 +98,25 @@ def _moved(lens: Lens, moving: int, compensating: int | None, delta: float, dist
     return replace(out, object_distance=od)
 
 
+def _focus_distance_mm(value) -> float:
+    """A focus distance as a float in mm: a number (mm), or a string with its unit as
+    ``object_distance`` takes it (``"2m"``, ``"2000mm"``, ``"inf"``; a bare number is mm).
+
+    Raises
+    ------
+    DataError
+        A value that is no real number or length (``1j``, ``True``, a list, ``"2 parsecs"``),
+        naming ``distance_mm`` and what it takes.
+    """
+    expected = "a focus distance in mm (a number, or a string with its unit such as '2m'; inf)"
+    if isinstance(value, str):
+        try:
+            return length_mm(value, "distance_mm", allow_inf=True)
+        except UnitError as e:
+            raise DataError(str(e)) from None  # names distance_mm and the units
+    return real_number(value, "distance_mm", expected, error=DataError)
+
+
 def solve_focus(
     lens: Lens,
     distance_mm: float,
@@ -121,9 +141,10 @@ def solve_focus(
     lens : Lens
         A centred lens; its image plane (the sensor) is the end of its last thickness and stays
         where it is.
-    distance_mm : float
+    distance_mm : float or str
         Focus distance in mm from the object plane to the image plane (positive; ``inf``), as a
-        focusing scale reads it — not the Lens convention (object plane to first vertex).
+        focusing scale reads it — not the Lens convention (object plane to first vertex). A
+        string may carry its unit as ``object_distance`` takes it (``"2m"``; bare: mm).
     moving : int
         The surface (1-based) whose following thickness changes by δ.
     compensating : int, optional
@@ -144,9 +165,10 @@ def solve_focus(
     Raises
     ------
     DataError
-        A surface number outside 1..n, ``compensating == moving``, a distance that is not
-        positive, an object plane inside the lens, a lens the paraxial trace refuses (afocal,
-        not centred; at the start or on the way), a solve that does not converge.
+        A surface number outside 1..n, ``compensating == moving``, a distance that is no
+        number or length (``1j``, ``True``) or not positive, an object plane inside the lens,
+        a lens the paraxial trace refuses (afocal, not centred; at the start or on the way), a
+        solve that does not converge.
     TraceError
         A wavelength the unit checks refuse.
     """
@@ -156,6 +178,7 @@ def solve_focus(
             raise DataError(f"{what} = {k}: {lens.name} has surfaces 1–{n}")
     if compensating == moving:
         raise DataError("moving and compensating must be different surfaces")
+    distance_mm = _focus_distance_mm(distance_mm)
     if not distance_mm > 0:
         raise DataError(
             f"focus distance must be positive (mm from the image plane), got {distance_mm}"
@@ -574,8 +597,9 @@ def focus_study(
 
 def _fs_analysis(settings, focus_index: int, fields, n_r: int, wavelength) -> VariationAnalysis:
     n = len(settings)
-    if not 0 <= focus_index < n:
-        raise DataError(f"focus_index must lie in 0–{n - 1}")
+    if not (is_whole(focus_index) and 0 <= focus_index < n):
+        why = "" if is_whole(focus_index) else f" (a whole number), got {focus_index!r}"
+        raise DataError(f"focus_index must lie in 0–{n - 1}{why}")
     foc = settings[focus_index]
     cross = []
     for i, s in enumerate(settings):
