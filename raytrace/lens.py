@@ -29,6 +29,7 @@ from .frames import AFTER_MODES, Placement
 from .kernels.codes import KIND_ASPHERE, KIND_PLANE, KIND_QBFS, KIND_QCON, KIND_QUADRIC
 from .materials import AIR, LAMBDA_D, Material
 from .qtype import QType, departure, vertex_curvature
+from .units import real_number
 
 #: shapes of a :class:`ClearAperture`
 APERTURE_SHAPES = ("circle", "rectangle", "ellipse")
@@ -292,6 +293,8 @@ class Aperture:
     def __post_init__(self) -> None:
         if self.kind not in APERTURE_KINDS:
             raise ValueError(f"unknown aperture kind {self.kind!r}")
+        v = real_number(self.value, f"aperture {self.kind}", "a number", error=ValueError)
+        object.__setattr__(self, "value", v)  # a bool or a complex number is refused
 
     def describe(self) -> str:
         """E.g. ``f/4``, ``EPD 10 mm``, ``NA 0.1``."""
@@ -326,6 +329,8 @@ class Field:
     def __post_init__(self) -> None:
         if self.kind not in ("angle", "height"):
             raise ValueError(f"unknown field kind {self.kind!r}")
+        v = real_number(self.value, f"field {self.kind}", "a number", error=ValueError)
+        object.__setattr__(self, "value", v)  # a bool or a complex number is refused
         pts = tuple((float(a) + 0.0, float(b) + 0.0) for a, b in self.points)
         if not all(math.isfinite(v) for p in pts for v in p):
             raise ValueError("field points must be finite numbers")

@@ -19,6 +19,7 @@ from raytrace.glass import catalog_glasses
 from raytrace.glass.catalog import RETIRED
 from raytrace.glass.legacy import VISIBLE_NM
 from raytrace.kernels.codes import STATUS_MISSED, STATUS_OK
+from raytrace.lens import Aperture, Field
 from raytrace.materials import (
     AIR,
     MODEL_RANGE_NM,
@@ -381,3 +382,20 @@ def test_a_lens_file_with_an_impossible_model_glass_says_where(tmp_path):
     msg = str(e.value)
     assert "bad-glass.zmx:74" in msg and "GLAS ___BLANK: model glass nd=15 is above 4.1" in msg, msg
     assert "\n" not in msg
+
+
+@pytest.mark.parametrize(
+    "build,says",
+    [
+        (lambda: Field("angle", True), "field angle: expected a number, got True (a bool"),
+        (lambda: Field("height", 2j), "field height: expected a number, got 2j (a complex"),
+        (lambda: Aperture("fnumber", True), "aperture fnumber: expected a number, got True"),
+        (lambda: Aperture("epd", [10.0]), "aperture epd: expected a number, got [10.0]"),
+    ],
+)
+def test_a_field_or_aperture_value_that_is_no_number_is_refused(build, says):
+    # a Field or Aperture built in Python: True was a half-field of 1 deg and f/1 (the lens
+    # files' readers refuse a bool themselves, with their file:line error)
+    with pytest.raises(ValueError, match=re.escape(says)):
+        build()
+    assert Field("angle", np.float32(20)).value == 20.0 and Aperture("fnumber", 4).value == 4.0
