@@ -64,8 +64,8 @@ def _not_real(value) -> str | None:
 def number_problem(value) -> str | None:
     """Why ``value`` is no real number (``"a bool, not a number"``, ``"a complex number"``,
     ``"not a number"``), or None when ``float()`` reads it as one (numbers, numpy scalars and
-    0-d arrays, numeric strings). For the messages of converters that check a sequence item by
-    item (:func:`real_number` checks one value)."""
+    0-d arrays, numeric strings): the test of :func:`real_number`, and of converters that check a
+    sequence item by item."""
     why = _not_real(value)
     if why is None:
         try:
@@ -112,13 +112,9 @@ def real_number(
         that is not one real number: ``"{what}: expected {expected}, got 1j (a complex
         number)"``.
     """
-    why = _not_real(value)
-    if why is None:
-        try:
-            return float(value)
-        except (TypeError, ValueError, OverflowError):
-            pass
-    raise error(_refusal(what, expected, value, why))
+    if number_problem(value) is None:
+        return float(value)
+    raise error(_refusal(what, expected, value, _not_real(value)))
 
 
 def real_array(value, what: str, expected: str = "numbers", *, error: type[Exception] = UnitError):
